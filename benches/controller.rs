@@ -1,0 +1,3 @@
+//! Controller-sample benchmark (in progress).
+
+fn main() {}

@@ -1,0 +1,3 @@
+//! Fuzzy-engine benchmark (in progress).
+
+fn main() {}

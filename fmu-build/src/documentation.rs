@@ -1,0 +1,117 @@
+//! `documentation/index.html` of an FMU: what it does, its variables (from the table),
+//! and a minimal fmpy example.
+
+use std::fmt::Write;
+
+use contour_fmu::models::{Causality, ModelInfo, Start, Variability};
+
+use crate::escape;
+
+fn start_text(start: Start) -> String {
+    match start {
+        Start::Real(x) => format!("{x}"),
+        Start::Integer(x) => format!("{x}"),
+        Start::Boolean(x) => format!("{x}"),
+        Start::String(x) => format!("\"{x}\""),
+    }
+}
+
+pub fn render(model: &ModelInfo) -> String {
+    let mut rows = String::new();
+    for v in model.variables {
+        let kind = match (v.causality, v.variability) {
+            (Causality::Parameter, Variability::Tunable) => "tunable parameter",
+            (Causality::Parameter, _) => "parameter",
+            (Causality::Input, _) => "input",
+            (Causality::Output, _) => "output",
+        };
+        let start = if v.causality == Causality::Output {
+            String::new()
+        } else {
+            start_text(v.start)
+        };
+        let range = match (v.min, v.max) {
+            (None, None) => String::new(),
+            (min, max) => format!(
+                "[{}, {}]",
+                min.map_or("−∞".into(), |m| m.to_string()),
+                max.map_or("∞".into(), |m| m.to_string())
+            ),
+        };
+        writeln!(
+            rows,
+            "<tr><td><code>{}</code></td><td>{}</td><td>{kind}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            escape(v.name),
+            v.vr,
+            v.var_type().name(),
+            escape(&start),
+            escape(v.unit.unwrap_or("")),
+            escape(&range),
+            escape(v.description),
+        )
+        .unwrap();
+    }
+    let inputs: Vec<&str> = model
+        .variables
+        .iter()
+        .filter(|v| v.causality == Causality::Input)
+        .map(|v| v.name)
+        .collect();
+    let outputs: Vec<&str> = model
+        .variables
+        .iter()
+        .filter(|v| v.causality == Causality::Output)
+        .map(|v| v.name)
+        .collect();
+    let e = model.default_experiment;
+    format!(
+        r#"<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<title>{id}</title>
+<style>
+body {{ font-family: sans-serif; max-width: 60em; margin: 2em auto; }}
+table {{ border-collapse: collapse; }}
+td, th {{ border: 1px solid #ccc; padding: 0.2em 0.5em; text-align: left; }}
+pre {{ background: #f4f4f4; padding: 0.8em; }}
+</style>
+</head>
+<body>
+<h1>{id}</h1>
+<p>{description}</p>
+<p>FMI 2.0 Co-Simulation, Linux x86-64. Inputs: {inputs}. Outputs: {outputs}.
+Default experiment: {start} s to {stop} s with {step} s steps; any communication step
+size is accepted.</p>
+<h2>Variables</h2>
+<table>
+<tr><th>name</th><th>value reference</th><th>kind</th><th>type</th><th>start</th><th>unit</th><th>range</th><th>description</th></tr>
+{rows}</table>
+<h2>Using it from Python (fmpy)</h2>
+<pre>from fmpy import simulate_fmu
+result = simulate_fmu("{id}.fmu", stop_time={stop}, output_interval={step})
+print(result.dtype.names)</pre>
+<h2>Behaviour at the FMI boundary</h2>
+<ul>
+<li>Calls in the wrong state return <code>fmi2Error</code> and log <code>&lt;function&gt;: illegal call sequence</code>.</li>
+<li>Non-finite or out-of-range values are refused with <code>fmi2Error</code>; the previous value stays.</li>
+<li>Parameters are checked again in <code>fmi2ExitInitializationMode</code>; on error the instance stays in initialization mode so they can be corrected.</li>
+<li>FMU states can be saved, restored and serialized (a versioned, checksummed byte format).</li>
+<li>Log categories: logEvents, logStatusWarning, logStatusError, logStatusFatal, logAll. Errors are always logged.</li>
+</ul>
+</body>
+</html>
+"#,
+        id = model.identifier,
+        description = escape(model.description),
+        inputs = if inputs.is_empty() {
+            "none".into()
+        } else {
+            inputs.join(", ")
+        },
+        outputs = outputs.join(", "),
+        start = e.start_time,
+        stop = e.stop_time,
+        step = e.step_size,
+    )
+}

@@ -1,0 +1,22 @@
+//! The packager's pieces: each model's `modelDescription.xml` and documentation are
+//! rendered from its variable table, then zipped with the shared library into a `.fmu`.
+
+pub mod documentation;
+pub mod model_description;
+pub mod package;
+
+/// Escapes text for XML/HTML attribute values and element content.
+pub fn escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            _ => out.push(c),
+        }
+    }
+    out
+}

@@ -1,0 +1,102 @@
+//! `cargo run --release -p fmu-build [-- --bless] [--out DIR]`: builds the library in
+//! release mode and writes one `.fmu` per model to `target/fmu/` (or DIR).
+//! `--bless` rewrites the committed `modelDescription/<Model>.xml` files from the code.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+use contour_fmu::models;
+use fmu_build::{model_description, package};
+
+const USAGE: &str = "usage: fmu-build [--bless] [--out DIR]\n\
+  builds the contour-fmu library (release) and packages target/fmu/<Model>.fmu\n\
+  --bless    rewrite modelDescription/<Model>.xml from the variable tables\n\
+  --out DIR  write the .fmu files to DIR instead of <target>/fmu";
+
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("fmu-build lives in the workspace")
+        .to_path_buf()
+}
+
+fn target_dir(root: &Path) -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from)
+}
+
+fn build_library(root: &Path) -> Result<PathBuf, String> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let status = Command::new(cargo)
+        .args(["build", "--release", "--lib", "-p", "contour-fmu"])
+        .current_dir(root)
+        .status()
+        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    if !status.success() {
+        return Err(format!("cargo build failed ({status})"));
+    }
+    let library = target_dir(root).join("release").join("libcontour_fmu.so");
+    if library.exists() {
+        Ok(library)
+    } else {
+        Err(format!("the build did not produce {}", library.display()))
+    }
+}
+
+fn run(args: &[String]) -> Result<(), String> {
+    let mut bless = false;
+    let mut out = None;
+    let mut rest = args.iter();
+    while let Some(arg) = rest.next() {
+        match arg.as_str() {
+            "--bless" => bless = true,
+            "--out" => out = Some(PathBuf::from(rest.next().ok_or("--out needs a directory")?)),
+            "-h" | "--help" => {
+                println!("{USAGE}");
+                return Ok(());
+            }
+            other => return Err(format!("unknown argument '{other}'\n{USAGE}")),
+        }
+    }
+    let root = workspace_root();
+    let out = out.unwrap_or_else(|| target_dir(&root).join("fmu"));
+
+    let committed_dir = root.join("modelDescription");
+    let mut stale = Vec::new();
+    for model in models::all() {
+        let xml = model_description::render(model);
+        let committed = committed_dir.join(format!("{}.xml", model.identifier));
+        if bless {
+            std::fs::create_dir_all(&committed_dir).map_err(|e| e.to_string())?;
+            std::fs::write(&committed, &xml)
+                .map_err(|e| format!("cannot write {}: {e}", committed.display()))?;
+            println!("blessed {}", committed.display());
+        } else if std::fs::read_to_string(&committed).ok().as_deref() != Some(xml.as_str()) {
+            stale.push(committed.display().to_string());
+        }
+    }
+
+    let library = build_library(&root)?;
+    for model in models::all() {
+        let fmu = package::write_fmu(model, &library, &out)?;
+        println!("wrote {}", fmu.display());
+    }
+    if !stale.is_empty() {
+        eprintln!(
+            "warning: the committed model descriptions differ from the code (the FMUs use the code's): {}\n\
+             run `cargo run --release -p fmu-build -- --bless` and commit the result",
+            stale.join(", ")
+        );
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match run(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("fmu-build: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,41 @@
+//! The committed `modelDescription/<Model>.xml` files must be exactly what the code
+//! renders: review sees every interface change, and a stale file fails here.
+
+use std::path::Path;
+
+use contour_fmu::models;
+use fmu_build::model_description;
+
+#[test]
+fn committed_xml_matches_the_code() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription");
+    for model in models::all() {
+        let path = dir.join(format!("{}.xml", model.identifier));
+        let committed = std::fs::read_to_string(&path).unwrap_or_else(|e| {
+            panic!(
+                "{}: {e}; run `cargo run -p fmu-build -- --bless`",
+                path.display()
+            )
+        });
+        assert!(
+            committed == model_description::render(model),
+            "{} is stale: run `cargo run --release -p fmu-build -- --bless` and commit it",
+            path.display()
+        );
+    }
+}
+
+#[test]
+fn every_output_is_listed_once_in_outputs_and_initial_unknowns() {
+    for model in models::all() {
+        let xml = model_description::render(model);
+        let outputs = model
+            .variables
+            .iter()
+            .filter(|v| v.causality == models::Causality::Output)
+            .count();
+        assert_eq!(xml.matches("dependencies=\"\"/>").count(), outputs);
+        assert_eq!(xml.matches("<Unknown index=").count(), 2 * outputs);
+        assert!(xml.contains(&format!("guid=\"{}\"", model.guid())));
+    }
+}

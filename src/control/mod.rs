@@ -1,0 +1,1 @@
+//! PID, Mamdani fuzzy engine and cross-coupled controller (in progress).

@@ -1,0 +1,851 @@
+//! The 34 exported `fmi2*` functions of FMI 2.0 Co-Simulation. Each one only converts C
+//! arguments and hands over to [`Instance`]; [`dispatch`] supplies what all share: the
+//! instance pointer check, the lock, the state machine, logging and panic capture.
+
+#![allow(non_snake_case)]
+
+use std::ffi::{c_char, CStr};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::ptr;
+use std::sync::{Mutex, MutexGuard};
+
+use fmi_sys::fmi2::*;
+
+use super::instance::Instance;
+use super::logger::{Category, Logger};
+use super::resource_uri::resource_dir;
+use super::state_machine::{Call, Mode};
+use super::status::{Failure, Outcome, Status};
+use crate::models::{self, Environment, Value, VarType};
+
+/// What an `fmi2Component` points to. The tag lets us refuse pointers that are not (or
+/// no longer) our instances instead of reading garbage.
+struct InstanceCell {
+    tag: u64,
+    instance: Mutex<Instance>,
+}
+
+const LIVE_TAG: u64 = 0x4343_4346_4d55_3201; // "CCCFMU2" + 1
+const FMU_STATE_TAG: u64 = 0x4343_4346_4d55_5354;
+
+/// What an `fmi2FMUstate` points to: a serialized snapshot.
+struct StateBox {
+    tag: u64,
+    bytes: Vec<u8>,
+}
+
+/// The instance behind `c`, or `None` for NULL or a pointer we did not hand out.
+///
+/// # Safety
+/// `c` must be NULL or a pointer returned by `fmi2Instantiate` (possibly freed: the tag
+/// is cleared on free, which catches the common double-free).
+unsafe fn cell<'a>(c: fmi2Component) -> Option<&'a InstanceCell> {
+    let cell = (c as *const InstanceCell).as_ref()?;
+    (cell.tag == LIVE_TAG).then_some(cell)
+}
+
+fn lock(cell: &InstanceCell) -> MutexGuard<'_, Instance> {
+    // A poisoned lock means an earlier call panicked: the instance is already marked
+    // Fatal (see `dispatch`), so handing it out again is safe and lets us answer.
+    cell.instance
+        .lock()
+        .unwrap_or_else(|poison| poison.into_inner())
+}
+
+fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into())
+}
+
+/// Runs one instance function: checks the pointer and the mode, runs `body`, logs a
+/// failure, and turns a panic into `fmi2Fatal` (the instance then only accepts
+/// `fmi2FreeInstance`).
+unsafe fn dispatch(
+    c: fmi2Component,
+    call: Call,
+    body: impl FnOnce(&mut Instance) -> Outcome,
+) -> fmi2Status {
+    let Some(cell) = cell(c) else {
+        return Status::Error.code();
+    };
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        let mut instance = lock(cell);
+        if !call.is_allowed_in(instance.mode) {
+            let failure =
+                Failure::error(format!("illegal call sequence (state {:?})", instance.mode));
+            return instance.report(call, &failure);
+        }
+        instance.logger.log(
+            Status::Ok,
+            Category::All,
+            &format!("{} called", call.name()),
+        );
+        match body(&mut instance) {
+            Ok(()) => Status::Ok,
+            Err(failure) => instance.report(call, &failure),
+        }
+    }));
+    match result {
+        Ok(status) => status.code(),
+        Err(payload) => {
+            let message = panic_text(payload.as_ref());
+            let caught = catch_unwind(AssertUnwindSafe(|| {
+                let mut instance = lock(cell);
+                instance.mode = Mode::Fatal;
+                instance.report(
+                    call,
+                    &Failure {
+                        status: Status::Fatal,
+                        message: format!("internal error (panic): {message}"),
+                    },
+                );
+            }));
+            drop(caught);
+            Status::Fatal.code()
+        }
+    }
+}
+
+/// A slice from a C array, refusing NULL with a non-zero length.
+unsafe fn slice<'a, T>(data: *const T, len: usize, what: &str) -> Outcome<&'a [T]> {
+    if len == 0 {
+        Ok(&[])
+    } else if data.is_null() {
+        Err(Failure::error(format!(
+            "{what} is NULL but its length is {len}"
+        )))
+    } else {
+        Ok(std::slice::from_raw_parts(data, len))
+    }
+}
+
+unsafe fn slice_mut<'a, T>(data: *mut T, len: usize, what: &str) -> Outcome<&'a mut [T]> {
+    if len == 0 {
+        Ok(&mut [])
+    } else if data.is_null() {
+        Err(Failure::error(format!(
+            "{what} is NULL but its length is {len}"
+        )))
+    } else {
+        Ok(std::slice::from_raw_parts_mut(data, len))
+    }
+}
+
+unsafe fn c_str<'a>(text: fmi2String) -> Option<&'a str> {
+    if text.is_null() {
+        None
+    } else {
+        CStr::from_ptr(text).to_str().ok()
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Library information
+
+#[no_mangle]
+pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
+    fmi2TypesPlatform.as_ptr() as *const c_char
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetVersion() -> *const c_char {
+    fmi2Version.as_ptr() as *const c_char
+}
+
+// ---------------------------------------------------------------------------------------
+// Life cycle
+
+/// # Safety
+/// Arguments as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2Instantiate(
+    instanceName: fmi2String,
+    fmuType: fmi2Type,
+    fmuGUID: fmi2String,
+    fmuResourceLocation: fmi2String,
+    functions: *const fmi2CallbackFunctions,
+    _visible: fmi2Boolean,
+    loggingOn: fmi2Boolean,
+) -> fmi2Component {
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        // Without callbacks there is no way to say what went wrong: just refuse.
+        let functions = functions.as_ref()?;
+        functions.logger?;
+        let name = c_str(instanceName).unwrap_or("");
+        let logger = Logger::new(
+            functions.logger,
+            functions.componentEnvironment,
+            name,
+            loggingOn != 0,
+        );
+        let refuse = |message: String| {
+            logger.log(
+                Status::Error,
+                Category::StatusError,
+                &format!("fmi2Instantiate: {message}"),
+            );
+            None
+        };
+        if name.trim().is_empty() {
+            return refuse("the instance name is NULL or empty".into());
+        }
+        if fmuType != fmi2Type_fmi2CoSimulation {
+            return refuse(format!(
+                "fmuType {fmuType} is not supported: these FMUs are Co-Simulation only"
+            ));
+        }
+        let Some(guid) = c_str(fmuGUID) else {
+            return refuse("the GUID is NULL or not UTF-8".into());
+        };
+        let Some(info) = models::by_guid(guid) else {
+            let known: Vec<String> = models::all()
+                .iter()
+                .map(|m| format!("{} {}", m.identifier, m.guid()))
+                .collect();
+            return refuse(format!(
+                "unknown GUID {guid}: the modelDescription.xml does not match this binary (it serves {})",
+                known.join(", ")
+            ));
+        };
+        let mut environment = Environment::default();
+        if !fmuResourceLocation.is_null() {
+            match c_str(fmuResourceLocation)
+                .ok_or_else(|| "resource location is not UTF-8".to_string())
+                .and_then(resource_dir)
+            {
+                Ok(dir) => environment.resource_dir = Some(dir),
+                Err(message) => logger.log(
+                    Status::Warning,
+                    Category::StatusWarning,
+                    &format!("fmi2Instantiate: {message}; continuing without resources"),
+                ),
+            }
+        }
+        let instance = Instance::new(info, environment, logger);
+        instance.log_event(&format!("instantiated {} (GUID {guid})", info.identifier));
+        let cell = Box::new(InstanceCell {
+            tag: LIVE_TAG,
+            instance: Mutex::new(instance),
+        });
+        Some(Box::into_raw(cell) as fmi2Component)
+    }));
+    match result {
+        Ok(Some(c)) => c,
+        _ => ptr::null_mut(),
+    }
+}
+
+/// # Safety
+/// `c` as returned by `fmi2Instantiate`; it is invalid afterwards.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
+    let mut free = false;
+    dispatch(c, Call::FreeInstance, |instance| {
+        instance.log_event("freed");
+        free = true;
+        Ok(())
+    });
+    if free {
+        let cell = c as *mut InstanceCell;
+        (*cell).tag = 0;
+        let _ = catch_unwind(AssertUnwindSafe(|| drop(Box::from_raw(cell))));
+    }
+}
+
+/// # Safety
+/// Arguments as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetDebugLogging(
+    c: fmi2Component,
+    loggingOn: fmi2Boolean,
+    nCategories: usize,
+    categories: *const fmi2String,
+) -> fmi2Status {
+    dispatch(c, Call::SetDebugLogging, |instance| {
+        let pointers = slice(categories, nCategories, "categories")?;
+        let mut names = Vec::with_capacity(pointers.len());
+        for &p in pointers {
+            names.push(c_str(p).ok_or_else(|| Failure::error("a category is NULL or not UTF-8"))?);
+        }
+        instance.set_debug_logging(loggingOn != 0, &names)
+    })
+}
+
+/// # Safety
+/// Arguments as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetupExperiment(
+    c: fmi2Component,
+    _toleranceDefined: fmi2Boolean,
+    _tolerance: fmi2Real,
+    startTime: fmi2Real,
+    stopTimeDefined: fmi2Boolean,
+    stopTime: fmi2Real,
+) -> fmi2Status {
+    dispatch(c, Call::SetupExperiment, |instance| {
+        instance.setup_experiment(startTime, (stopTimeDefined != 0).then_some(stopTime))
+    })
+}
+
+/// # Safety
+/// `c` as returned by `fmi2Instantiate`.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
+    dispatch(
+        c,
+        Call::EnterInitializationMode,
+        Instance::enter_initialization_mode,
+    )
+}
+
+/// # Safety
+/// `c` as returned by `fmi2Instantiate`.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
+    dispatch(
+        c,
+        Call::ExitInitializationMode,
+        Instance::exit_initialization_mode,
+    )
+}
+
+/// # Safety
+/// `c` as returned by `fmi2Instantiate`.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
+    dispatch(c, Call::Terminate, Instance::terminate)
+}
+
+/// # Safety
+/// `c` as returned by `fmi2Instantiate`.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
+    dispatch(c, Call::Reset, Instance::reset)
+}
+
+// ---------------------------------------------------------------------------------------
+// Getting and setting values
+
+/// Shared body of the four getters: check references and type, then convert each value.
+unsafe fn get<T>(
+    c: fmi2Component,
+    name: &'static str,
+    var_type: VarType,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut T,
+    convert: impl Fn(&Value) -> T,
+) -> fmi2Status {
+    dispatch(c, Call::GetValues(name), |instance| {
+        let vrs = slice(vr, nvr, "vr")?;
+        let out = slice_mut(value, nvr, "value")?;
+        instance.check_type(vrs, var_type)?;
+        instance.get_values(vrs, |i, v| out[i] = convert(v))
+    })
+}
+
+/// Shared body of the four setters.
+unsafe fn set<T: Copy>(
+    c: fmi2Component,
+    name: &'static str,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const T,
+    convert: impl Fn(T) -> Result<Value, String>,
+) -> fmi2Status {
+    dispatch(c, Call::SetValues(name), |instance| {
+        let vrs = slice(vr, nvr, "vr")?;
+        let values = slice(value, nvr, "value")?;
+        instance.set_values(vrs, |i| convert(values[i]))
+    })
+}
+
+/// # Safety
+/// Arrays of `nvr` elements as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetReal(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2Real,
+) -> fmi2Status {
+    get(
+        c,
+        "fmi2GetReal",
+        VarType::Real,
+        vr,
+        nvr,
+        value,
+        |v| match *v {
+            Value::Real(x) => x,
+            _ => unreachable!("type checked"),
+        },
+    )
+}
+
+/// # Safety
+/// Arrays of `nvr` elements as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetInteger(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2Integer,
+) -> fmi2Status {
+    get(
+        c,
+        "fmi2GetInteger",
+        VarType::Integer,
+        vr,
+        nvr,
+        value,
+        |v| match *v {
+            Value::Integer(x) => x,
+            _ => unreachable!("type checked"),
+        },
+    )
+}
+
+/// # Safety
+/// Arrays of `nvr` elements as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetBoolean(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2Boolean,
+) -> fmi2Status {
+    get(
+        c,
+        "fmi2GetBoolean",
+        VarType::Boolean,
+        vr,
+        nvr,
+        value,
+        |v| match *v {
+            Value::Boolean(x) => x as fmi2Boolean,
+            _ => unreachable!("type checked"),
+        },
+    )
+}
+
+/// # Safety
+/// Arrays of `nvr` elements as the FMI 2.0 standard defines them. The returned strings
+/// stay valid until the next call on this instance.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetString(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2String,
+) -> fmi2Status {
+    dispatch(c, Call::GetValues("fmi2GetString"), |instance| {
+        let vrs = slice(vr, nvr, "vr")?;
+        let out = slice_mut(value, nvr, "value")?;
+        let held = instance.hold_strings(vrs)?;
+        for (slot, text) in out.iter_mut().zip(held) {
+            *slot = text.as_ptr();
+        }
+        Ok(())
+    })
+}
+
+/// # Safety
+/// Arrays of `nvr` elements as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetReal(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const fmi2Real,
+) -> fmi2Status {
+    set(c, "fmi2SetReal", vr, nvr, value, |x| Ok(Value::Real(x)))
+}
+
+/// # Safety
+/// Arrays of `nvr` elements as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetInteger(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const fmi2Integer,
+) -> fmi2Status {
+    set(c, "fmi2SetInteger", vr, nvr, value, |x| {
+        Ok(Value::Integer(x))
+    })
+}
+
+/// # Safety
+/// Arrays of `nvr` elements as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetBoolean(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const fmi2Boolean,
+) -> fmi2Status {
+    set(c, "fmi2SetBoolean", vr, nvr, value, |x| {
+        Ok(Value::Boolean(x != 0))
+    })
+}
+
+/// # Safety
+/// Arrays of `nvr` elements as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetString(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const fmi2String,
+) -> fmi2Status {
+    set(c, "fmi2SetString", vr, nvr, value, |p| {
+        c_str(p)
+            .map(|s| Value::String(s.to_owned()))
+            .ok_or_else(|| "a string value is NULL or not UTF-8".to_string())
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// FMU state
+
+/// # Safety
+/// `state` points to NULL or to a state this instance returned earlier.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
+    dispatch(c, Call::FmuState("fmi2GetFMUstate"), |instance| {
+        let slot = state
+            .as_mut()
+            .ok_or_else(|| Failure::error("FMUstate is NULL"))?;
+        let bytes = instance.snapshot()?;
+        match (*slot as *mut StateBox).as_mut() {
+            // The importer hands back an earlier state to be overwritten.
+            Some(existing) if existing.tag == FMU_STATE_TAG => existing.bytes = bytes,
+            Some(_) => return Err(Failure::error("*FMUstate is not a state of this library")),
+            None => {
+                *slot = Box::into_raw(Box::new(StateBox {
+                    tag: FMU_STATE_TAG,
+                    bytes,
+                })) as fmi2FMUstate
+            }
+        }
+        Ok(())
+    })
+}
+
+unsafe fn state_bytes<'a>(state: fmi2FMUstate) -> Outcome<&'a [u8]> {
+    match (state as *const StateBox).as_ref() {
+        Some(b) if b.tag == FMU_STATE_TAG => Ok(&b.bytes),
+        Some(_) => Err(Failure::error("FMUstate is not a state of this library")),
+        None => Err(Failure::error("FMUstate is NULL")),
+    }
+}
+
+/// # Safety
+/// `state` as returned by `fmi2GetFMUstate` or `fmi2DeSerializeFMUstate`.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status {
+    dispatch(c, Call::FmuState("fmi2SetFMUstate"), |instance| {
+        instance.restore(state_bytes(state)?)
+    })
+}
+
+/// # Safety
+/// `state` points to NULL or to a state this library returned.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2FreeFMUstate(
+    c: fmi2Component,
+    state: *mut fmi2FMUstate,
+) -> fmi2Status {
+    dispatch(c, Call::FmuState("fmi2FreeFMUstate"), |_| {
+        let Some(slot) = state.as_mut() else {
+            return Ok(());
+        };
+        if slot.is_null() {
+            return Ok(());
+        }
+        state_bytes(*slot)?;
+        let boxed = *slot as *mut StateBox;
+        (*boxed).tag = 0;
+        drop(Box::from_raw(boxed));
+        *slot = ptr::null_mut();
+        Ok(())
+    })
+}
+
+/// # Safety
+/// `state` as returned by this library; `size` writable.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    size: *mut usize,
+) -> fmi2Status {
+    dispatch(c, Call::FmuState("fmi2SerializedFMUstateSize"), |_| {
+        let bytes = state_bytes(state)?;
+        *size
+            .as_mut()
+            .ok_or_else(|| Failure::error("size is NULL"))? = bytes.len();
+        Ok(())
+    })
+}
+
+/// # Safety
+/// `serializedState` has room for `size` bytes.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SerializeFMUstate(
+    c: fmi2Component,
+    state: fmi2FMUstate,
+    serializedState: *mut fmi2Byte,
+    size: usize,
+) -> fmi2Status {
+    dispatch(c, Call::FmuState("fmi2SerializeFMUstate"), |_| {
+        let bytes = state_bytes(state)?;
+        if size < bytes.len() {
+            return Err(Failure::error(format!(
+                "buffer of {size} bytes is too small for the state's {} bytes",
+                bytes.len()
+            )));
+        }
+        let out = slice_mut(serializedState as *mut u8, bytes.len(), "serializedState")?;
+        out.copy_from_slice(bytes);
+        Ok(())
+    })
+}
+
+/// # Safety
+/// `serializedState` holds `size` readable bytes; `state` is writable.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+    c: fmi2Component,
+    serializedState: *const fmi2Byte,
+    size: usize,
+    state: *mut fmi2FMUstate,
+) -> fmi2Status {
+    dispatch(c, Call::FmuState("fmi2DeSerializeFMUstate"), |instance| {
+        let bytes = slice(serializedState as *const u8, size, "serializedState")?;
+        let slot = state
+            .as_mut()
+            .ok_or_else(|| Failure::error("FMUstate is NULL"))?;
+        instance.check_snapshot(bytes)?;
+        *slot = Box::into_raw(Box::new(StateBox {
+            tag: FMU_STATE_TAG,
+            bytes: bytes.to_vec(),
+        })) as fmi2FMUstate;
+        Ok(())
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// Not supported (the model descriptions say so): a clear error instead of a silent no-op
+
+/// # Safety
+/// Arguments as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
+    c: fmi2Component,
+    _vUnknown_ref: *const fmi2ValueReference,
+    _nUnknown: usize,
+    _vKnown_ref: *const fmi2ValueReference,
+    _nKnown: usize,
+    _dvKnown: *const fmi2Real,
+    _dvUnknown: *mut fmi2Real,
+) -> fmi2Status {
+    dispatch(c, Call::GetDirectionalDerivative, |_| {
+        Err(Failure::error(
+            "not supported (providesDirectionalDerivative=\"false\")",
+        ))
+    })
+}
+
+/// # Safety
+/// Arguments as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
+    c: fmi2Component,
+    _vr: *const fmi2ValueReference,
+    _nvr: usize,
+    _order: *const fmi2Integer,
+    _value: *const fmi2Real,
+) -> fmi2Status {
+    dispatch(c, Call::SetRealInputDerivatives, |_| {
+        Err(Failure::error(
+            "not supported (canInterpolateInputs=\"false\")",
+        ))
+    })
+}
+
+/// # Safety
+/// Arguments as the FMI 2.0 standard defines them.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
+    c: fmi2Component,
+    _vr: *const fmi2ValueReference,
+    _nvr: usize,
+    _order: *const fmi2Integer,
+    _value: *mut fmi2Real,
+) -> fmi2Status {
+    dispatch(c, Call::GetRealOutputDerivatives, |_| {
+        Err(Failure::error(
+            "not supported (maxOutputDerivativeOrder=\"0\")",
+        ))
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// Stepping and status
+
+/// # Safety
+/// `c` as returned by `fmi2Instantiate`.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2DoStep(
+    c: fmi2Component,
+    currentCommunicationPoint: fmi2Real,
+    communicationStepSize: fmi2Real,
+    _noSetFMUStatePriorToCurrentPoint: fmi2Boolean,
+) -> fmi2Status {
+    dispatch(c, Call::DoStep, |instance| {
+        instance.do_step(currentCommunicationPoint, communicationStepSize)
+    })
+}
+
+/// # Safety
+/// `c` as returned by `fmi2Instantiate`.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
+    // Steps are synchronous: there is never a step in progress to cancel, so the state
+    // machine refuses every call.
+    dispatch(c, Call::CancelStep, |_| Ok(()))
+}
+
+/// # Safety
+/// `value` writable.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetStatus(
+    c: fmi2Component,
+    _s: fmi2StatusKind,
+    _value: *mut fmi2Status,
+) -> fmi2Status {
+    dispatch(c, Call::Status("fmi2GetStatus"), |_| {
+        Err(Failure::discard(
+            "no asynchronous step status: steps are synchronous",
+        ))
+    })
+}
+
+/// # Safety
+/// `value` writable.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetRealStatus(
+    c: fmi2Component,
+    s: fmi2StatusKind,
+    value: *mut fmi2Real,
+) -> fmi2Status {
+    dispatch(c, Call::Status("fmi2GetRealStatus"), |instance| {
+        if s != fmi2StatusKind_fmi2LastSuccessfulTime {
+            return Err(Failure::discard(format!(
+                "status kind {s} has no Real value"
+            )));
+        }
+        *value
+            .as_mut()
+            .ok_or_else(|| Failure::error("value is NULL"))? = instance.last_successful_time();
+        Ok(())
+    })
+}
+
+/// # Safety
+/// `value` writable.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetIntegerStatus(
+    c: fmi2Component,
+    s: fmi2StatusKind,
+    _value: *mut fmi2Integer,
+) -> fmi2Status {
+    dispatch(c, Call::Status("fmi2GetIntegerStatus"), |_| {
+        Err(Failure::discard(format!(
+            "status kind {s} has no Integer value"
+        )))
+    })
+}
+
+/// # Safety
+/// `value` writable.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetBooleanStatus(
+    c: fmi2Component,
+    s: fmi2StatusKind,
+    value: *mut fmi2Boolean,
+) -> fmi2Status {
+    dispatch(c, Call::Status("fmi2GetBooleanStatus"), |_| {
+        if s != fmi2StatusKind_fmi2Terminated {
+            return Err(Failure::discard(format!(
+                "status kind {s} has no Boolean value"
+            )));
+        }
+        // The slave never asks the master to end the simulation.
+        *value
+            .as_mut()
+            .ok_or_else(|| Failure::error("value is NULL"))? = fmi2False as fmi2Boolean;
+        Ok(())
+    })
+}
+
+/// # Safety
+/// `value` writable.
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetStringStatus(
+    c: fmi2Component,
+    s: fmi2StatusKind,
+    _value: *mut fmi2String,
+) -> fmi2Status {
+    dispatch(c, Call::Status("fmi2GetStringStatus"), |_| {
+        Err(Failure::discard(format!(
+            "status kind {s} has no String value"
+        )))
+    })
+}
+
+// ---------------------------------------------------------------------------------------
+// Compile-time check of every signature against the standard's header (via fmi-sys):
+// a mismatch is a type error here, not a crash in an importer.
+
+const _: () = {
+    let _: fmi2GetTypesPlatformTYPE = Some(fmi2GetTypesPlatform);
+    let _: fmi2GetVersionTYPE = Some(fmi2GetVersion);
+    let _: fmi2SetDebugLoggingTYPE = Some(fmi2SetDebugLogging);
+    let _: fmi2InstantiateTYPE = Some(fmi2Instantiate);
+    let _: fmi2FreeInstanceTYPE = Some(fmi2FreeInstance);
+    let _: fmi2SetupExperimentTYPE = Some(fmi2SetupExperiment);
+    let _: fmi2EnterInitializationModeTYPE = Some(fmi2EnterInitializationMode);
+    let _: fmi2ExitInitializationModeTYPE = Some(fmi2ExitInitializationMode);
+    let _: fmi2TerminateTYPE = Some(fmi2Terminate);
+    let _: fmi2ResetTYPE = Some(fmi2Reset);
+    let _: fmi2GetRealTYPE = Some(fmi2GetReal);
+    let _: fmi2GetIntegerTYPE = Some(fmi2GetInteger);
+    let _: fmi2GetBooleanTYPE = Some(fmi2GetBoolean);
+    let _: fmi2GetStringTYPE = Some(fmi2GetString);
+    let _: fmi2SetRealTYPE = Some(fmi2SetReal);
+    let _: fmi2SetIntegerTYPE = Some(fmi2SetInteger);
+    let _: fmi2SetBooleanTYPE = Some(fmi2SetBoolean);
+    let _: fmi2SetStringTYPE = Some(fmi2SetString);
+    let _: fmi2GetFMUstateTYPE = Some(fmi2GetFMUstate);
+    let _: fmi2SetFMUstateTYPE = Some(fmi2SetFMUstate);
+    let _: fmi2FreeFMUstateTYPE = Some(fmi2FreeFMUstate);
+    let _: fmi2SerializedFMUstateSizeTYPE = Some(fmi2SerializedFMUstateSize);
+    let _: fmi2SerializeFMUstateTYPE = Some(fmi2SerializeFMUstate);
+    let _: fmi2DeSerializeFMUstateTYPE = Some(fmi2DeSerializeFMUstate);
+    let _: fmi2GetDirectionalDerivativeTYPE = Some(fmi2GetDirectionalDerivative);
+    let _: fmi2SetRealInputDerivativesTYPE = Some(fmi2SetRealInputDerivatives);
+    let _: fmi2GetRealOutputDerivativesTYPE = Some(fmi2GetRealOutputDerivatives);
+    let _: fmi2DoStepTYPE = Some(fmi2DoStep);
+    let _: fmi2CancelStepTYPE = Some(fmi2CancelStep);
+    let _: fmi2GetStatusTYPE = Some(fmi2GetStatus);
+    let _: fmi2GetRealStatusTYPE = Some(fmi2GetRealStatus);
+    let _: fmi2GetIntegerStatusTYPE = Some(fmi2GetIntegerStatus);
+    let _: fmi2GetBooleanStatusTYPE = Some(fmi2GetBooleanStatus);
+    let _: fmi2GetStringStatusTYPE = Some(fmi2GetStringStatus);
+};

@@ -1,0 +1,143 @@
+//! The FMI 2.0 Co-Simulation state machine (standard section 4.3.3) as one table: for
+//! every function taking an instance, the modes in which it may be called.
+//!
+//! Steps are synchronous, so the standard's `stepInProgress` and `stepCanceled` never
+//! occur. A refused call (wrong mode, bad argument) leaves the mode unchanged; only a
+//! failing model computation moves to `Error`, and a panic to `Fatal`.
+
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Mode {
+    Instantiated,
+    Initialization,
+    StepComplete,
+    StepFailed,
+    Terminated,
+    Error,
+    Fatal,
+}
+
+impl Mode {
+    const fn bit(self) -> u8 {
+        1 << self as u8
+    }
+}
+
+/// The instance functions of FMI 2.0 Co-Simulation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Call {
+    SetDebugLogging,
+    FreeInstance,
+    SetupExperiment,
+    EnterInitializationMode,
+    ExitInitializationMode,
+    Terminate,
+    Reset,
+    GetValues(&'static str),
+    SetValues(&'static str),
+    FmuState(&'static str),
+    GetDirectionalDerivative,
+    SetRealInputDerivatives,
+    GetRealOutputDerivatives,
+    DoStep,
+    CancelStep,
+    Status(&'static str),
+}
+
+const INST: u8 = Mode::Instantiated.bit();
+const INIT: u8 = Mode::Initialization.bit();
+const STEP: u8 = Mode::StepComplete.bit();
+const FAIL: u8 = Mode::StepFailed.bit();
+const TERM: u8 = Mode::Terminated.bit();
+const ERR: u8 = Mode::Error.bit();
+const FATAL: u8 = Mode::Fatal.bit();
+/// Every mode an instance can be in before a fatal error.
+const ALIVE: u8 = INST | INIT | STEP | FAIL | TERM | ERR;
+/// No mode: the function is only meaningful in `stepInProgress`, which never occurs.
+const NEVER: u8 = 0;
+
+impl Call {
+    /// The standard's table (FMI 2.0.4, section 4.3.3), one row per function.
+    const fn allowed(self) -> u8 {
+        match self {
+            Call::SetDebugLogging => ALIVE,
+            // Freeing after a fatal error lets the importer release memory; it touches
+            // nothing the failed computation left behind.
+            Call::FreeInstance => ALIVE | FATAL,
+            Call::SetupExperiment => INST,
+            Call::EnterInitializationMode => INST,
+            Call::ExitInitializationMode => INIT,
+            Call::Terminate => STEP | FAIL,
+            Call::Reset => ALIVE,
+            Call::GetValues(_) => INIT | STEP | FAIL | TERM | ERR,
+            Call::SetValues(_) => INST | INIT | STEP,
+            Call::FmuState(_) => ALIVE,
+            Call::GetDirectionalDerivative => INIT | STEP | FAIL | TERM | ERR,
+            Call::SetRealInputDerivatives => INST | INIT | STEP,
+            Call::GetRealOutputDerivatives => STEP | FAIL | TERM | ERR,
+            Call::DoStep => STEP,
+            Call::CancelStep => NEVER,
+            Call::Status(_) => STEP | FAIL | TERM,
+        }
+    }
+
+    pub fn is_allowed_in(self, mode: Mode) -> bool {
+        self.allowed() & mode.bit() != 0
+    }
+
+    /// The C function's name, for log messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Call::SetDebugLogging => "fmi2SetDebugLogging",
+            Call::FreeInstance => "fmi2FreeInstance",
+            Call::SetupExperiment => "fmi2SetupExperiment",
+            Call::EnterInitializationMode => "fmi2EnterInitializationMode",
+            Call::ExitInitializationMode => "fmi2ExitInitializationMode",
+            Call::Terminate => "fmi2Terminate",
+            Call::Reset => "fmi2Reset",
+            Call::GetValues(name)
+            | Call::SetValues(name)
+            | Call::FmuState(name)
+            | Call::Status(name) => name,
+            Call::GetDirectionalDerivative => "fmi2GetDirectionalDerivative",
+            Call::SetRealInputDerivatives => "fmi2SetRealInputDerivatives",
+            Call::GetRealOutputDerivatives => "fmi2GetRealOutputDerivatives",
+            Call::DoStep => "fmi2DoStep",
+            Call::CancelStep => "fmi2CancelStep",
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn do_step_only_after_initialization() {
+        assert!(Call::DoStep.is_allowed_in(Mode::StepComplete));
+        for mode in [
+            Mode::Instantiated,
+            Mode::Initialization,
+            Mode::Terminated,
+            Mode::Error,
+        ] {
+            assert!(!Call::DoStep.is_allowed_in(mode));
+        }
+    }
+
+    #[test]
+    fn fatal_allows_only_free() {
+        let calls = [
+            Call::SetDebugLogging,
+            Call::Reset,
+            Call::GetValues("fmi2GetReal"),
+            Call::FmuState("fmi2GetFMUstate"),
+            Call::DoStep,
+        ];
+        for call in calls {
+            assert!(!call.is_allowed_in(Mode::Fatal), "{call:?}");
+        }
+        assert!(Call::FreeInstance.is_allowed_in(Mode::Fatal));
+    }
+}

@@ -1,0 +1,172 @@
+//! One feed axis of the test plant (DESIGN 4.5): a servo drive whose PI loop closes on
+//! motor speed, a motor with inertia and viscous friction, and a ball screw.
+//!
+//! The drive takes a velocity command `v` (mm/s). In screw coordinates (x = θ·lead/2π)
+//! the three states are position x (mm), velocity ẋ (mm/s) and the PI integral z of the
+//! velocity error (mm), and the dynamics are linear:
+//!
+//! ```text
+//! ẍ = (CT·(Kvp·(v − ẋ) + Kvi·z) − B·ẋ) / J,    ż = v − ẋ
+//! ```
+//!
+//! (the lead cancels out of the dynamics; it only scales the motor current). The
+//! command is held constant over a step (zero-order hold), so the exact discretisation
+//! by the matrix exponential makes the trajectory independent of the step size.
+
+use nalgebra::{Matrix3, Matrix4, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// Physical and drive parameters of one axis, SI-like units as the paper gives them.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AxisParams {
+    /// Rotor plus reflected load inertia, kg·m².
+    pub inertia: f64,
+    /// Viscous friction, N·m·s/rad.
+    pub friction: f64,
+    /// Motor torque constant, N·m/A.
+    pub torque_constant: f64,
+    /// Ball-screw lead, mm per revolution.
+    pub lead: f64,
+    /// Drive velocity-loop proportional gain, A·s/rad.
+    pub kvp: f64,
+    /// Drive velocity-loop integral gain, A/rad.
+    pub kvi: f64,
+}
+
+impl AxisParams {
+    /// The paper's motor (CT = 0.57 N·m/A, B = 1.2 N·m·s, J = 0.015 kg·m², 10 mm lead)
+    /// with DESIGN's drive: the PI zero cancels the B/J pole, 50 Hz velocity bandwidth.
+    pub const PAPER: AxisParams = AxisParams {
+        inertia: 0.015,
+        friction: 1.2,
+        torque_constant: 0.57,
+        lead: 10.0,
+        kvp: 8.26,
+        kvi: 661.0,
+    };
+
+    /// Checks that the parameters describe a physical, stable drive; the error names
+    /// the offending field.
+    pub fn validate(&self) -> Result<(), String> {
+        let positive = [
+            ("inertia", self.inertia),
+            ("torque_constant", self.torque_constant),
+            ("lead", self.lead),
+        ];
+        for (name, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(format!("{name} must be finite and > 0 (got {value})"));
+            }
+        }
+        let non_negative = [
+            ("friction", self.friction),
+            ("kvp", self.kvp),
+            ("kvi", self.kvi),
+        ];
+        for (name, value) in non_negative {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(format!("{name} must be finite and >= 0 (got {value})"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Continuous-time system matrices (A, b) of the state (x, ẋ, z) with input v.
+    fn continuous(&self) -> (Matrix3<f64>, Vector3<f64>) {
+        let ct_j = self.torque_constant / self.inertia;
+        let a = Matrix3::new(
+            0.0,
+            1.0,
+            0.0,
+            0.0,
+            -(self.friction / self.inertia + ct_j * self.kvp),
+            ct_j * self.kvi,
+            0.0,
+            -1.0,
+            0.0,
+        );
+        let b = Vector3::new(0.0, ct_j * self.kvp, 1.0);
+        (a, b)
+    }
+}
+
+/// Exact zero-order-hold transition for one step length: s ← Φ·s + Γ·v.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+struct Discretisation {
+    step: f64,
+    phi: Matrix3<f64>,
+    gamma: Vector3<f64>,
+}
+
+impl Discretisation {
+    fn new(params: &AxisParams, step: f64) -> Self {
+        let (a, b) = params.continuous();
+        // exp([[A, b], [0, 0]]·h) holds Φ = e^{Ah} and Γ = ∫e^{As}ds·b side by side.
+        let mut augmented = Matrix4::zeros();
+        augmented.fixed_view_mut::<3, 3>(0, 0).copy_from(&a);
+        augmented.fixed_view_mut::<3, 1>(0, 3).copy_from(&b);
+        let exp = (augmented * step).exp();
+        Discretisation {
+            step,
+            phi: exp.fixed_view::<3, 3>(0, 0).into_owned(),
+            gamma: exp.fixed_view::<3, 1>(0, 3).into_owned(),
+        }
+    }
+}
+
+/// State and parameters of one axis.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ServoAxis {
+    params: AxisParams,
+    /// (x mm, ẋ mm/s, z mm).
+    state: Vector3<f64>,
+    /// The last step length's transition, reused while the step length stays the same.
+    cached: Option<Discretisation>,
+}
+
+impl ServoAxis {
+    /// An axis at rest at `position` (mm).
+    pub fn new(params: AxisParams, position: f64) -> Self {
+        ServoAxis {
+            params,
+            state: Vector3::new(position, 0.0, 0.0),
+            cached: None,
+        }
+    }
+
+    pub fn params(&self) -> &AxisParams {
+        &self.params
+    }
+
+    /// Position, mm.
+    pub fn position(&self) -> f64 {
+        self.state[0]
+    }
+
+    /// Velocity, mm/s.
+    pub fn velocity(&self) -> f64 {
+        self.state[1]
+    }
+
+    /// Motor current demanded by the drive, A.
+    pub fn current(&self, command: f64) -> f64 {
+        let p = &self.params;
+        let scale = 2.0 * std::f64::consts::PI / p.lead;
+        scale * (p.kvp * (command - self.state[1]) + p.kvi * self.state[2])
+    }
+
+    /// Advances by `step` seconds with the velocity command `command` (mm/s) held.
+    /// No heap allocation; the matrix exponential is only recomputed when the step
+    /// length changes.
+    pub fn step(&mut self, command: f64, step: f64) {
+        let d = match self.cached {
+            Some(d) if d.step == step => d,
+            _ => {
+                let d = Discretisation::new(&self.params, step);
+                self.cached = Some(d);
+                d
+            }
+        };
+        self.state = d.phi * self.state + d.gamma * command;
+    }
+}

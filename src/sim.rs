@@ -1,0 +1,1 @@
+//! In-process closed loop (in progress).

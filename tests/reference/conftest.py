@@ -1,0 +1,33 @@
+"""Shared fixtures for the checks of the Rust library against independent Python references.
+
+The Rust side is reached through small example programs (`examples/*.rs`) that print their
+results as JSON; the Python side recomputes the same quantities with an outside library
+(geomdl, scikit-fuzzy, scipy) and the test compares the two.
+"""
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _cargo_example(name, *args):
+    cmd = ["cargo", "run", "--quiet", "--release", "--example", name, "--", *map(str, args)]
+    done = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, env=os.environ.copy())
+    if done.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{done.stderr}")
+    return done.stdout
+
+
+@pytest.fixture(scope="session")
+def rust_json():
+    """Run `cargo run --example NAME -- ARGS` and parse its standard output as JSON."""
+
+    def run(name, *args):
+        return json.loads(_cargo_example(name, *args))
+
+    return run
