@@ -1,1 +1,315 @@
-//! Paths: lines, arcs, NURBS, built-in shapes and feed-rate interpolation (in progress).
+//! Two-axis reference paths (lines, arcs, NURBS), the built-in shapes and the feed-rate
+//! interpolator that samples them every `Ts` (DESIGN 4.6). Units: mm, s.
+//!
+//! Every geometric type implements [`Curve`], and [`Path`] is the closed set the FMUs
+//! choose from by name ([`builtin::by_name`]) or by file ([`file::load_nurbs`]).
+
+pub mod arc;
+pub mod builtin;
+pub mod file;
+pub mod interpolator;
+pub mod line;
+pub mod nurbs;
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+pub use arc::Arc;
+pub use interpolator::{Interpolator, Sample};
+pub use line::Line;
+pub use nurbs::{Nurbs, MAX_DEGREE};
+
+/// Why a path could not be built, loaded or sampled.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PathError {
+    /// Geometry or parameters rejected by a constructor; the message says which and why.
+    Invalid(String),
+    /// A path name that is neither a built-in nor a readable file.
+    UnknownName(String),
+    /// A path file could not be read or parsed; `line`/`column` are 1-based when known.
+    File {
+        /// The file as given by the caller.
+        file: String,
+        /// 1-based line of a JSON error, 0 when not applicable.
+        line: usize,
+        /// 1-based column of a JSON error, 0 when not applicable.
+        column: usize,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl PathError {
+    pub(crate) fn invalid(msg: impl Into<String>) -> Self {
+        PathError::Invalid(msg.into())
+    }
+}
+
+impl fmt::Display for PathError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PathError::Invalid(m) => write!(f, "invalid path: {m}"),
+            PathError::UnknownName(n) => write!(
+                f,
+                "unknown path '{n}': expected circle, line, arc, infinity, trident or a NURBS JSON file"
+            ),
+            PathError::File {
+                file,
+                line,
+                column,
+                message,
+            } => {
+                if *line > 0 {
+                    write!(f, "{file}:{line}:{column}: {message}")
+                } else {
+                    write!(f, "{file}: {message}")
+                }
+            }
+        }
+    }
+}
+
+impl std::error::Error for PathError {}
+
+/// Point and first two parameter derivatives of a curve at one parameter value.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CurvePoint {
+    /// C(u), mm.
+    pub p: [f64; 2],
+    /// C'(u), mm per unit parameter.
+    pub d1: [f64; 2],
+    /// C''(u).
+    pub d2: [f64; 2],
+}
+
+/// A planar parametric curve on a closed parameter interval.
+///
+/// Evaluation never allocates and never panics: parameters outside the interval (and NaN)
+/// are clamped to it, so a corrupt caller cannot index out of bounds.
+pub trait Curve {
+    /// Parameter interval `(u_start, u_end)`, `u_start < u_end`.
+    fn param_range(&self) -> (f64, f64);
+    /// Point and derivatives at `u`.
+    fn eval(&self, u: f64) -> CurvePoint;
+    /// Point only (implementations may skip the derivative work).
+    fn point(&self, u: f64) -> [f64; 2] {
+        self.eval(u).p
+    }
+    /// Arc length between two parameters (absolute, mm).
+    fn length_between(&self, u0: f64, u1: f64) -> f64;
+    /// Total arc length, mm.
+    fn length(&self) -> f64 {
+        let (a, b) = self.param_range();
+        self.length_between(a, b)
+    }
+    /// Parameter values where derivatives may jump (knots); always includes both ends.
+    /// Used to split integration and search so that each piece is smooth.
+    fn breakpoints(&self) -> Vec<f64> {
+        let (a, b) = self.param_range();
+        vec![a, b]
+    }
+}
+
+/// Clamps a parameter into `[a, b]`, mapping NaN to `a`.
+#[inline]
+pub(crate) fn clamp_param(u: f64, a: f64, b: f64) -> f64 {
+    if u.is_nan() {
+        a
+    } else {
+        u.clamp(a, b)
+    }
+}
+
+/// Any path the interpolator and the FMUs can follow.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Path {
+    /// Straight segment.
+    Line(Line),
+    /// Circular arc or full circle.
+    Arc(Arc),
+    /// NURBS curve of any degree up to [`MAX_DEGREE`].
+    Nurbs(Nurbs),
+}
+
+impl Path {
+    /// Builds a path from a built-in name (`circle`, `line`, `arc`, `infinity`, `trident`)
+    /// or, failing that, from a NURBS JSON file (relative names resolved against `base_dir`).
+    pub fn from_spec(spec: &str, base_dir: Option<&std::path::Path>) -> Result<Path, PathError> {
+        match builtin::by_name(spec) {
+            Ok(p) => Ok(p),
+            Err(PathError::UnknownName(_)) => {
+                let fs = std::path::Path::new(spec);
+                let full = match base_dir {
+                    Some(dir) if fs.is_relative() => dir.join(fs),
+                    _ => fs.to_path_buf(),
+                };
+                // Something that looks like a file gets the file's own error (naming it).
+                let looks_like_file = spec.ends_with(".json") || spec.contains(['/', '\\']);
+                if full.is_file() || looks_like_file {
+                    file::load_nurbs(&full).map(Path::Nurbs)
+                } else {
+                    Err(PathError::UnknownName(spec.to_string()))
+                }
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// First point of the path.
+    pub fn start_point(&self) -> [f64; 2] {
+        self.point(self.param_range().0)
+    }
+
+    /// Last point of the path.
+    pub fn end_point(&self) -> [f64; 2] {
+        self.point(self.param_range().1)
+    }
+}
+
+impl Curve for Path {
+    fn param_range(&self) -> (f64, f64) {
+        match self {
+            Path::Line(c) => c.param_range(),
+            Path::Arc(c) => c.param_range(),
+            Path::Nurbs(c) => c.param_range(),
+        }
+    }
+    fn eval(&self, u: f64) -> CurvePoint {
+        match self {
+            Path::Line(c) => c.eval(u),
+            Path::Arc(c) => c.eval(u),
+            Path::Nurbs(c) => c.eval(u),
+        }
+    }
+    fn point(&self, u: f64) -> [f64; 2] {
+        match self {
+            Path::Line(c) => c.point(u),
+            Path::Arc(c) => c.point(u),
+            Path::Nurbs(c) => c.point(u),
+        }
+    }
+    fn length_between(&self, u0: f64, u1: f64) -> f64 {
+        match self {
+            Path::Line(c) => c.length_between(u0, u1),
+            Path::Arc(c) => c.length_between(u0, u1),
+            Path::Nurbs(c) => c.length_between(u0, u1),
+        }
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        match self {
+            Path::Line(c) => c.breakpoints(),
+            Path::Arc(c) => c.breakpoints(),
+            Path::Nurbs(c) => c.breakpoints(),
+        }
+    }
+}
+
+impl From<Line> for Path {
+    fn from(c: Line) -> Self {
+        Path::Line(c)
+    }
+}
+impl From<Arc> for Path {
+    fn from(c: Arc) -> Self {
+        Path::Arc(c)
+    }
+}
+impl From<Nurbs> for Path {
+    fn from(c: Nurbs) -> Self {
+        Path::Nurbs(c)
+    }
+}
+
+/// Small vector helpers shared by path and contour code.
+pub(crate) mod v2 {
+    #[inline]
+    pub fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+        [a[0] - b[0], a[1] - b[1]]
+    }
+    #[inline]
+    pub fn add(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+        [a[0] + b[0], a[1] + b[1]]
+    }
+    #[inline]
+    pub fn scale(a: [f64; 2], s: f64) -> [f64; 2] {
+        [a[0] * s, a[1] * s]
+    }
+    #[inline]
+    pub fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
+        a[0] * b[0] + a[1] * b[1]
+    }
+    /// z-component of the 2-D cross product; positive when `b` is left of `a`.
+    #[inline]
+    pub fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
+        a[0] * b[1] - a[1] * b[0]
+    }
+    #[inline]
+    pub fn norm(a: [f64; 2]) -> f64 {
+        a[0].hypot(a[1])
+    }
+    #[inline]
+    pub fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+        norm(sub(a, b))
+    }
+    /// Squared distance: cheaper than `dist` (no hypot) where only comparisons matter.
+    #[inline]
+    pub fn dist2(a: [f64; 2], b: [f64; 2]) -> f64 {
+        let d = sub(a, b);
+        d[0] * d[0] + d[1] * d[1]
+    }
+    /// Left perpendicular (rotation by +90°).
+    #[inline]
+    pub fn perp(a: [f64; 2]) -> [f64; 2] {
+        [-a[1], a[0]]
+    }
+    #[inline]
+    pub fn finite(a: [f64; 2]) -> bool {
+        a[0].is_finite() && a[1].is_finite()
+    }
+}
+
+/// Arc length of a smooth piece by adaptive Gauss–Legendre quadrature of |C'(u)|.
+///
+/// Compares a 5-point rule on the whole interval with the sum over its halves and splits
+/// until they agree to `tol` (absolute, mm); depth is bounded so the cost is bounded.
+pub(crate) fn gauss_length<C: Curve + ?Sized>(c: &C, a: f64, b: f64, tol: f64) -> f64 {
+    fn gl5<C: Curve + ?Sized>(c: &C, a: f64, b: f64) -> f64 {
+        // Nodes and weights of the 5-point Gauss–Legendre rule on [-1, 1].
+        const X: [f64; 5] = [
+            0.0,
+            -0.538_469_310_105_683_1,
+            0.538_469_310_105_683_1,
+            -0.906_179_845_938_664,
+            0.906_179_845_938_664,
+        ];
+        const W: [f64; 5] = [
+            0.568_888_888_888_888_9,
+            0.478_628_670_499_366_5,
+            0.478_628_670_499_366_5,
+            0.236_926_885_056_189_1,
+            0.236_926_885_056_189_1,
+        ];
+        let m = 0.5 * (a + b);
+        let h = 0.5 * (b - a);
+        let mut s = 0.0;
+        for k in 0..5 {
+            s += W[k] * v2::norm(c.eval(m + h * X[k]).d1);
+        }
+        s * h
+    }
+    fn rec<C: Curve + ?Sized>(c: &C, a: f64, b: f64, whole: f64, tol: f64, depth: u32) -> f64 {
+        let m = 0.5 * (a + b);
+        let l = gl5(c, a, m);
+        let r = gl5(c, m, b);
+        if depth == 0 || (l + r - whole).abs() <= tol {
+            l + r
+        } else {
+            rec(c, a, m, l, 0.5 * tol, depth - 1) + rec(c, m, b, r, 0.5 * tol, depth - 1)
+        }
+    }
+    if b <= a {
+        return 0.0;
+    }
+    rec(c, a, b, gl5(c, a, b), tol, 30)
+}

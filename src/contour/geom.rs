@@ -1,0 +1,140 @@
+//! Local-circle geometry shared by the estimators.
+//!
+//! A circle is described by a point `a` on it, the unit tangent `t` of travel there and the
+//! signed curvature κ (> 0 turning left). The signed contour error of P (positive right of
+//! travel) is then, with q = P − a and left normal n = perp(t),
+//!   ε = (κ|q|² − 2 q·n) / (1 + |κq − n|),   normal = (n − κq)/|n − κq|,
+//! which is ‖P − O‖ − r for a CCW circle and r − ‖P − O‖ for a CW one, rewritten so that it
+//! stays exact as κ → 0, where it becomes the signed distance to the tangent line. So
+//! collinear samples need no special threshold and large radii lose no digits.
+
+use crate::contour::ContourEstimate;
+use crate::path::v2;
+
+/// Signed error of `p` against the circle through `a` with tangent `t` and curvature `kappa`.
+pub(crate) fn circle_error(p: [f64; 2], a: [f64; 2], t: [f64; 2], kappa: f64) -> ContourEstimate {
+    let q = v2::sub(p, a);
+    let n = v2::perp(t);
+    let m = v2::sub(n, v2::scale(q, kappa));
+    let mlen = v2::norm(m);
+    let error = (kappa * v2::dot(q, q) - 2.0 * v2::dot(q, n)) / (1.0 + mlen);
+    let normal = if mlen > 1e-300 {
+        v2::scale(m, 1.0 / mlen)
+    } else {
+        // P at the centre: every direction is a foot direction; keep the anchor's normal.
+        n
+    };
+    ContourEstimate { error, normal }
+}
+
+/// Signed curvature of the circle through three points in travel order `a → b → c`
+/// (κ = 2·(b − a)×(c − b) / (|b − a||c − b||c − a|)); 0 when degenerate.
+pub(crate) fn curvature3(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    let (ab, bc, ac) = (v2::sub(b, a), v2::sub(c, b), v2::sub(c, a));
+    let den = v2::norm(ab) * v2::norm(bc) * v2::norm(ac);
+    let k = 2.0 * v2::cross(ab, bc) / den;
+    if den > 0.0 && k.is_finite() {
+        k
+    } else {
+        0.0
+    }
+}
+
+/// Unit tangent at an end of the chord `x → y` of a circle of curvature `kappa`: the
+/// chord direction turned back (at `x`) or forward (at `y`) by half the subtended angle.
+pub(crate) fn chord_tangent(x: [f64; 2], y: [f64; 2], kappa: f64, at_end: bool) -> [f64; 2] {
+    let c = v2::sub(y, x);
+    let len = v2::norm(c);
+    if len == 0.0 {
+        return [0.0, 0.0];
+    }
+    let dir = v2::scale(c, 1.0 / len);
+    let half = (0.5 * kappa * len).clamp(-1.0, 1.0).asin();
+    let ang = if at_end { half } else { -half };
+    let (s, co) = ang.sin_cos();
+    [dir[0] * co - dir[1] * s, dir[0] * s + dir[1] * co]
+}
+
+/// Estimate against the circle through `a → b → c` at whichever of the three is `anchor`
+/// (0 = a, 1 = b, 2 = c).
+pub(crate) fn triple_error(p: [f64; 2], pts: [[f64; 2]; 3], anchor: usize) -> ContourEstimate {
+    let [a, b, c] = pts;
+    let k = curvature3(a, b, c);
+    let t = match anchor {
+        0 => chord_tangent(a, b, k, false),
+        2 => chord_tangent(b, c, k, true),
+        _ => {
+            let t1 = chord_tangent(a, b, k, true);
+            let t2 = chord_tangent(b, c, k, false);
+            let s = v2::add(t1, t2);
+            let l = v2::norm(s);
+            if l > 0.0 {
+                v2::scale(s, 1.0 / l)
+            } else {
+                t2
+            }
+        }
+    };
+    circle_error(p, pts[anchor.min(2)], t, k)
+}
+
+/// Mean of two estimates: errors averaged, normals averaged and renormalised.
+pub(crate) fn mean(e1: ContourEstimate, e2: ContourEstimate) -> ContourEstimate {
+    let s = v2::add(e1.normal, e2.normal);
+    let l = v2::norm(s);
+    ContourEstimate {
+        error: 0.5 * (e1.error + e2.error),
+        normal: if l > 0.0 {
+            v2::scale(s, 1.0 / l)
+        } else {
+            e1.normal
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn circle_error_matches_radial_distance_both_directions() {
+        // Unit circle about the origin, anchor (1, 0).
+        let a = [1.0, 0.0];
+        // CCW: tangent +y, κ = +1. Outside point → positive (right of travel).
+        let e = circle_error([2.0, 0.0], a, [0.0, 1.0], 1.0);
+        assert!((e.error - 1.0).abs() < 1e-15);
+        assert!((e.normal[0] + 1.0).abs() < 1e-15);
+        let e = circle_error([0.0, 0.5], a, [0.0, 1.0], 1.0);
+        assert!((e.error + 0.5).abs() < 1e-15);
+        // CW: tangent −y, κ = −1. Inside point is right of travel → positive.
+        let e = circle_error([0.0, 0.5], a, [0.0, -1.0], -1.0);
+        assert!((e.error - 0.5).abs() < 1e-15);
+        assert!((e.normal[1] - 1.0).abs() < 1e-15);
+        // Centre: ε = −r (CCW), finite normal.
+        let e = circle_error([0.0, 0.0], a, [0.0, 1.0], 1.0);
+        assert!((e.error + 1.0).abs() < 1e-15 && e.normal[0].is_finite());
+        // κ = 0: line distance.
+        let e = circle_error([5.0, -3.0], a, [0.0, 1.0], 0.0);
+        assert!((e.error - 4.0).abs() < 1e-15 && e.normal == [-1.0, 0.0]);
+    }
+
+    #[test]
+    fn triple_recovers_circle() {
+        let pt = |t: f64| [3.0 + 2.0 * t.cos(), -1.0 + 2.0 * t.sin()];
+        let pts = [pt(0.1), pt(0.15), pt(0.2)];
+        assert!((curvature3(pts[0], pts[1], pts[2]) - 0.5).abs() < 1e-12);
+        for anchor in 0..3 {
+            let p = [3.0 + 2.5 * 0.3f64.cos(), -1.0 + 2.5 * 0.3f64.sin()];
+            let e = triple_error(p, pts, anchor);
+            assert!(
+                (e.error - 0.5).abs() < 1e-12,
+                "anchor {anchor}: {}",
+                e.error
+            );
+        }
+        // Reversed order = clockwise travel: the outside is then left of travel, so the
+        // error flips sign.
+        let e = triple_error([3.0 + 2.5, -1.0], [pts[2], pts[1], pts[0]], 1);
+        assert!((e.error + 0.5).abs() < 1e-12);
+    }
+}

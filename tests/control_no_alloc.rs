@@ -1,0 +1,119 @@
+//! Proves that a controller sample and a fuzzy evaluation never touch the heap once the
+//! controller is built: they run inside `fmi2DoStep`, where allocation means unbounded
+//! latency. A counting global allocator (this test binary only) counts the allocations
+//! made by the current thread.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::hint::black_box;
+
+use contour_fmu::contour::{ContourEstimate, ContourEstimator};
+use contour_fmu::control::{
+    CccConfig, CccMode, ControllerConfig, CrossCoupledController, FuzzyEngine,
+};
+
+thread_local! {
+    // Const-initialised and without a destructor, so reading it never allocates.
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+struct Counting;
+
+// SAFETY: every call is forwarded unchanged to the system allocator, which upholds the
+// `GlobalAlloc` contract; the only extra work is bumping a thread-local counter, which
+// neither allocates nor unwinds (`try_with` ignores a torn-down thread-local).
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc_zeroed(layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations_during(f: impl FnOnce()) -> u64 {
+    let before = ALLOCATIONS.with(Cell::get);
+    f();
+    ALLOCATIONS.with(Cell::get) - before
+}
+
+/// Exact circle error, like the estimators of DESIGN 4.1 (no history needed).
+struct Circle;
+
+impl ContourEstimator for Circle {
+    fn estimate(&mut self, _reference: [f64; 2], p: [f64; 2]) -> ContourEstimate {
+        let d = [p[0] + 10.0, p[1]];
+        let rho = d[0].hypot(d[1]);
+        ContourEstimate {
+            error: rho - 10.0,
+            normal: [-d[0] / rho, -d[1] / rho],
+        }
+    }
+    fn reset(&mut self) {}
+}
+
+fn point(t: f64) -> [f64; 2] {
+    let a = std::f64::consts::PI * t;
+    [10.0 * a.cos() - 10.0, 10.0 * a.sin()]
+}
+
+#[test]
+fn sample_and_fuzzy_evaluation_do_not_allocate() {
+    // The counter works: a visible allocation is seen.
+    let seen = allocations_during(|| {
+        black_box(vec![1u8; 64]);
+    });
+    assert!(seen >= 1, "counting allocator is not active");
+
+    let engine = FuzzyEngine::default();
+    let fuzzy = allocations_during(|| {
+        let mut acc = 0.0;
+        for k in 0..20_000 {
+            let x = (k as f64 * 0.37).sin() * 3.5;
+            let y = (k as f64 * 0.11).cos() * 3.5;
+            let out = engine.evaluate(black_box(x), black_box(y));
+            acc += out.dkp + out.dki + out.dkd;
+        }
+        black_box(acc);
+    });
+    assert_eq!(fuzzy, 0, "fuzzy evaluation allocated");
+
+    for mode in [CccMode::Off, CccMode::Fixed, CccMode::Fuzzy] {
+        let config = ControllerConfig {
+            ccc: CccConfig {
+                mode,
+                ..CccConfig::default()
+            },
+            ..ControllerConfig::default()
+        };
+        let mut controller = CrossCoupledController::new(config, Circle).unwrap();
+        let ts = config.ts;
+        let mut p = point(0.0);
+        let count = allocations_during(|| {
+            for k in 0..5_000 {
+                let out = controller.sample(black_box(point(k as f64 * ts)), black_box(p));
+                p = [p[0] + out.u[0] * ts, p[1] + out.u[1] * ts];
+            }
+            controller.reset();
+            black_box(controller.sample(point(0.0), point(0.0)));
+        });
+        assert_eq!(count, 0, "{mode:?}: sample() allocated");
+        assert!(p[0].is_finite() && p[1].is_finite());
+    }
+}
