@@ -1,6 +1,10 @@
 //! The FMUs' models: each is a plain Rust type with a variable table and a step
 //! function. Nothing here knows FMI types; `crate::fmi2` adapts these to the C ABI.
 
+pub mod contour_ccc_2d;
+pub mod geometry;
+pub mod path_interpolator_2d;
+pub mod sample_clock;
 pub mod units;
 pub mod variables;
 pub mod xy_servo_plant;
@@ -106,7 +110,11 @@ impl ModelInfo {
 
 /// Every model this library serves (the packager builds one FMU per entry).
 pub fn all() -> Vec<&'static ModelInfo> {
-    vec![&xy_servo_plant::INFO]
+    vec![
+        &path_interpolator_2d::INFO,
+        &contour_ccc_2d::INFO,
+        &xy_servo_plant::INFO,
+    ]
 }
 
 /// Models reachable through `fmi2Instantiate`: [`all`] plus test-only models.

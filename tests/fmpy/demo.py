@@ -1,77 +1,127 @@
-"""Closed-loop demo: the paper's circle tracked by XYServoPlant under a P position loop.
+"""The paper's comparison, through the FMUs: PathInterpolator2D -> ContourCCC2D <-
+XYServoPlant, stepped by the fixed-step master in master.py (fmpy's FMU2Slave), on the
+circle, the infinity curve and the trident, without CCC and with the fuzzy-PID CCC.
 
-A small fixed-step master on fmpy's FMU2Slave: every 1 ms the reference point of the
-circle x = 10 cos(pi t) - 10, y = 10 sin(pi t) is compared with the measured position,
-and Kpp times the following error is sent to the drives as a velocity command. Prints
-the maximum contour error (distance to the circle) and writes out/demo_circle.csv and
-out/demo_circle.png. (The cross-coupled controller FMU replaces the P loop later.)
+Prints a table like the paper's Tables 4-5 (max and mean |true contour error|, the
+reduction), and writes to out/: one CSV time series per run, one PNG per path (path
+tracking and contour error vs time), and the FMI cross-check files of ContourCCC2D
+(out/cross-check/ContourCCC2D/: _in.csv, _ref.csv, _ref.opt) from the fuzzy circle run.
+
+usage: python tests/fmpy/demo.py [--fmu-dir DIR] [--out DIR]
 """
 
+import argparse
 import csv
-import shutil
-import tempfile
+import math
+import sys
 from pathlib import Path
 
 import numpy as np
-from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
 
-REPO = Path(__file__).resolve().parents[2]
-FMU = REPO / "target" / "fmu" / "XYServoPlant.fmu"
-OUT = REPO / "out"
-TS, STOP, KPP, RADIUS = 1e-3, 2.0, 28.5, 10.0
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from master import closed_loop  # noqa: E402
+from reference_paths import ContourReference  # noqa: E402
+
+REPO = HERE.parents[1]
+STEP = 1e-3
+
+# (path, feed mm/s): the paper's circle at its own feed (2 s per turn); the NURBS at a
+# feed that keeps the drives' current demand in a realistic range.
+PATHS = [("circle", 10 * math.pi), ("infinity", 50.0), ("trident", 50.0)]
+
+VARIANTS = [
+    ("no CCC", {"ccc.enable": False}),
+    ("fuzzy-PID CCC", {}),  # the FMU's defaults: the paper's fuzzy factors (1, 1.2, 87, 8.5, 4)
+]
 
 
-def reference(t):
-    return np.array([RADIUS * np.cos(np.pi * t) - RADIUS, RADIUS * np.sin(np.pi * t)])
+def run_path(fmu_dir, path, feed, controller):
+    reference = ContourReference(path)
+    length = np.sum(np.hypot(*np.diff(reference.points, axis=0).T))
+    stop = round(math.ceil(length / feed / STEP - 1e-6) * STEP, 9)
+    before, after = closed_loop(fmu_dir, path=path, feed=feed, stop=stop, controller=controller)
+    error = reference.distance(np.column_stack([before["plant.pos.x"], before["plant.pos.y"]]))
+    return before, after, error
 
 
-def main():
-    md = read_model_description(str(FMU))
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    unzipped = extract(str(FMU))
-    plant = FMU2Slave(guid=md.guid, unzipDirectory=unzipped,
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="plant")
-    plant.instantiate()
-    plant.setupExperiment(startTime=0.0, stopTime=STOP)
-    plant.enterInitializationMode()
-    plant.exitInitializationMode()
-    rows = []
-    steps = int(round(STOP / TS))
-    for k in range(steps):
-        t = k * TS
-        pos = np.array(plant.getReal([vr["pos.x"], vr["pos.y"]]))
-        ref = reference(t)
-        u = KPP * (ref - pos)
-        plant.setReal([vr["u.x"], vr["u.y"]], list(u))
-        plant.doStep(currentCommunicationPoint=t, communicationStepSize=TS)
-        contour = np.hypot(pos[0] + RADIUS, pos[1]) - RADIUS
-        rows.append((t, ref[0], ref[1], pos[0], pos[1], contour))
-    plant.terminate()
-    plant.freeInstance()
-    shutil.rmtree(unzipped, ignore_errors=True)
-
-    data = np.array(rows)
-    settled = data[data[:, 0] >= 0.1]
-    print(f"XYServoPlant + P position loop (Kpp = {KPP} 1/s) on the paper's circle, Ts = {TS * 1e3:g} ms")
-    print(f"  max |contour error| after 0.1 s: {np.max(np.abs(settled[:, 5])) * 1e3:.2f} um")
-    print(f"  mean |contour error|:            {np.mean(np.abs(settled[:, 5])) * 1e3:.2f} um")
-    OUT.mkdir(exist_ok=True)
-    with open(OUT / "demo_circle.csv", "w", newline="") as f:
+def write_csv(filename, columns):
+    with open(filename, "w", newline="") as f:
         writer = csv.writer(f)
-        writer.writerow(["time", "ref.x", "ref.y", "pos.x", "pos.y", "contourError"])
-        writer.writerows(rows)
+        writer.writerow(list(columns))
+        writer.writerows(zip(*columns.values()))
+
+
+def write_cross_check(out, before, after):
+    """Inputs at t_k and the outputs the FMU reports after its step to t_k+1."""
+    directory = out / "cross-check" / "ContourCCC2D"
+    directory.mkdir(parents=True, exist_ok=True)
+    inputs = {"time": before["time"]}
+    for ours, theirs in (("ref.x", "interpolator.ref.x"), ("ref.y", "interpolator.ref.y"),
+                         ("pos.x", "plant.pos.x"), ("pos.y", "plant.pos.y")):
+        inputs[ours] = before[theirs]
+    write_csv(directory / "ContourCCC2D_in.csv", inputs)
+    outputs = {"time": np.concatenate([[0.0], after["time"]])}
+    for name in ("u.x", "u.y", "contourError", "ccc.Kp", "ccc.Ki", "ccc.Kd"):
+        outputs[name] = np.concatenate([[0.0], after[f"controller.{name}"]])
+    write_csv(directory / "ContourCCC2D_ref.csv", outputs)
+    stop = float(after["time"][-1])
+    (directory / "ContourCCC2D_ref.opt").write_text(
+        f"StartTime,0.0\nStopTime,{stop!r}\nStepSize,{STEP!r}\nRelTol,1e-6\n")
+
+
+def plot(out, path, runs):
+    import matplotlib
+
+    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.5))
-    a.plot(data[:, 1], data[:, 2], label="reference")
-    a.plot(data[:, 3], data[:, 4], "--", label="actual")
-    a.set_aspect("equal"), a.set_xlabel("x (mm)"), a.set_ylabel("y (mm)"), a.legend()
-    b.plot(data[:, 0], data[:, 5] * 1e3)
-    b.set_xlabel("time (s)"), b.set_ylabel("contour error (um)")
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.5))
+    first = runs[0][1]
+    a.plot(first["interpolator.ref.x"], first["interpolator.ref.y"], "k-", lw=1, label="reference")
+    for label, before, error in runs:
+        a.plot(before["plant.pos.x"], before["plant.pos.y"], "--", lw=1, label=label)
+        b.plot(before["time"], error * 1e3, lw=1, label=label)
+    a.set_aspect("equal"), a.set_xlabel("x (mm)"), a.set_ylabel("y (mm)"), a.legend(fontsize=8)
+    a.set_title(f"{path}: path tracking")
+    b.set_xlabel("time (s)"), b.set_ylabel("|contour error| (µm)"), b.legend(fontsize=8)
+    b.set_title(f"{path}: true contour error")
     fig.tight_layout()
-    fig.savefig(OUT / "demo_circle.png", dpi=120)
-    print(f"  wrote {OUT / 'demo_circle.csv'} and {OUT / 'demo_circle.png'}")
+    fig.savefig(out / f"{path}.png", dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--fmu-dir", type=Path, default=REPO / "target" / "fmu")
+    parser.add_argument("--out", type=Path, default=REPO / "out")
+    args = parser.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+
+    rows = []
+    for path, feed in PATHS:
+        runs = []
+        for label, controller in VARIANTS:
+            before, after, error = run_path(args.fmu_dir, path, feed, controller)
+            runs.append((label, before, error))
+            columns = {name: before[name] for name in before.dtype.names}
+            columns["trueContourError"] = error
+            write_csv(args.out / f"{path}_{label.replace(' ', '_')}.csv", columns)
+            if path == "circle" and controller == {}:
+                write_cross_check(args.out, before, after)
+        plot(args.out, path, runs)
+        base_max, base_mean = runs[0][2].max(), runs[0][2].mean()
+        for label, _, error in runs:
+            rows.append((path, feed, label, error.max(), error.mean(),
+                         100 * (1 - error.max() / base_max), 100 * (1 - error.mean() / base_mean)))
+
+    print("Closed loop through the FMUs (PathInterpolator2D -> ContourCCC2D <- XYServoPlant), Ts = 1 ms")
+    print(f"{'path':9} {'feed mm/s':>9}  {'controller':15} {'max |e| um':>11} {'mean |e| um':>12} "
+          f"{'max red. %':>10} {'mean red. %':>11}")
+    for path, feed, label, emax, emean, rmax, rmean in rows:
+        print(f"{path:9} {feed:9.2f}  {label:15} {emax * 1e3:11.3f} {emean * 1e3:12.3f} {rmax:10.1f} {rmean:11.1f}")
+    print(f"wrote CSV, PNG and cross-check files to {args.out}")
+    return rows
 
 
 if __name__ == "__main__":

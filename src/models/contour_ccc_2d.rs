@@ -1,0 +1,350 @@
+//! `ContourCCC2D`: the two-axis controller. Per axis a position loop on the following
+//! error, plus the cross-coupled correction along the contour normal with fixed or
+//! fuzzy-adapted PID gains (DESIGN 4.2, 4.3). The control law runs every `Ts` inside
+//! `fmi2DoStep` on the inputs held over the step, whatever the communication step.
+
+use super::sample_clock::SampleClock;
+use super::variables::{Start, Values, Variable, Vr};
+use super::{
+    decode_state, encode_state, geometry, DefaultExperiment, Environment, Model, ModelInfo,
+    ModelResult,
+};
+use crate::contour::{ArcEstimator, Estimator, EstimatorKind, FreeCurveEstimator, LineEstimator};
+use crate::control::{
+    CccConfig, CccMode, ControllerConfig, CrossCoupledController, FuzzyFactors, PidGains,
+};
+
+pub const REF_X: Vr = 0;
+pub const REF_Y: Vr = 1;
+pub const POS_X: Vr = 2;
+pub const POS_Y: Vr = 3;
+pub const U_X: Vr = 4;
+pub const U_Y: Vr = 5;
+pub const CONTOUR_ERROR: Vr = 6;
+pub const ERR_X: Vr = 7;
+pub const ERR_Y: Vr = 8;
+pub const CCC_KP: Vr = 9;
+pub const CCC_KI: Vr = 10;
+pub const CCC_KD: Vr = 11;
+pub const TS: Vr = 12;
+/// Kp, Ki, Kd of the X position loop, then of Y.
+pub const AXIS_GAINS: Vr = 13;
+pub const CCC_ENABLE: Vr = 19;
+pub const FUZZY_ENABLE: Vr = 20;
+/// Kp0, Ki0, Kd0.
+pub const CCC_GAINS0: Vr = 21;
+pub const CCC_LIMIT: Vr = 24;
+/// ke, kde, kp, ki, kd.
+pub const FUZZY_FACTORS: Vr = 25;
+pub const ESTIMATOR: Vr = 30;
+pub const GEOMETRY: Vr = 31;
+
+const DEFAULT: ControllerConfig = ControllerConfig {
+    ts: 1e-3,
+    axis: [PidGains {
+        kp: 28.5,
+        ki: 0.0,
+        kd: 0.0,
+    }; 2],
+    axis_limit: None,
+    ccc: CccConfig {
+        mode: CccMode::Fuzzy,
+        gains0: PidGains {
+            kp: 100.0,
+            ki: 5000.0,
+            kd: 0.0,
+        },
+        fuzzy: FuzzyFactors {
+            ke: 1.0,
+            kde: 1.2,
+            kpf: 87.0,
+            kif: 8.5,
+            kdf: 4.0,
+        },
+        limit: Some(100.0),
+    },
+};
+
+const fn real(vr: Vr, name: &'static str, start: f64, description: &'static str) -> Variable {
+    Variable::parameter(vr, name, Start::Real(start), description).min(0.0)
+}
+
+const G: [Variable; geometry::COUNT] = geometry::variables(GEOMETRY);
+const A: [PidGains; 2] = DEFAULT.axis;
+const C: CccConfig = DEFAULT.ccc;
+
+static VARIABLES: [Variable; 31 + geometry::COUNT] = [
+    Variable::input(REF_X, "ref.x", 0.0, "Reference (command) position, x").unit("mm"),
+    Variable::input(REF_Y, "ref.y", 0.0, "Reference (command) position, y").unit("mm"),
+    Variable::input(POS_X, "pos.x", 0.0, "Measured position, x").unit("mm"),
+    Variable::input(POS_Y, "pos.y", 0.0, "Measured position, y").unit("mm"),
+    Variable::output(U_X, "u.x", "Velocity command to the X drive").unit("mm/s"),
+    Variable::output(U_Y, "u.y", "Velocity command to the Y drive").unit("mm/s"),
+    Variable::output(
+        CONTOUR_ERROR,
+        "contourError",
+        "Estimated contour error, > 0 when the tool is right of the direction of travel",
+    )
+    .unit("mm"),
+    Variable::output(ERR_X, "err.x", "Following error ref.x - pos.x").unit("mm"),
+    Variable::output(ERR_Y, "err.y", "Following error ref.y - pos.y").unit("mm"),
+    Variable::output(CCC_KP, "ccc.Kp", "Contour PID gain Kp in use").unit("1/s"),
+    Variable::output(CCC_KI, "ccc.Ki", "Contour PID gain Ki in use").unit("1/s2"),
+    Variable::output(CCC_KD, "ccc.Kd", "Contour PID gain Kd in use"),
+    Variable::parameter(TS, "Ts", Start::Real(DEFAULT.ts), "Control period (> 0)").unit("s"),
+    real(
+        AXIS_GAINS,
+        "axis.x.Kp",
+        A[0].kp,
+        "X position loop, proportional gain",
+    )
+    .unit("1/s"),
+    real(
+        AXIS_GAINS + 1,
+        "axis.x.Ki",
+        A[0].ki,
+        "X position loop, integral gain",
+    )
+    .unit("1/s2"),
+    real(
+        AXIS_GAINS + 2,
+        "axis.x.Kd",
+        A[0].kd,
+        "X position loop, derivative gain",
+    ),
+    real(
+        AXIS_GAINS + 3,
+        "axis.y.Kp",
+        A[1].kp,
+        "Y position loop, proportional gain",
+    )
+    .unit("1/s"),
+    real(
+        AXIS_GAINS + 4,
+        "axis.y.Ki",
+        A[1].ki,
+        "Y position loop, integral gain",
+    )
+    .unit("1/s2"),
+    real(
+        AXIS_GAINS + 5,
+        "axis.y.Kd",
+        A[1].kd,
+        "Y position loop, derivative gain",
+    ),
+    Variable::parameter(
+        CCC_ENABLE,
+        "ccc.enable",
+        Start::Boolean(true),
+        "Apply the cross-coupled correction",
+    ),
+    Variable::parameter(
+        FUZZY_ENABLE,
+        "fuzzy.enable",
+        Start::Boolean(true),
+        "Adapt the contour PID gains with the fuzzy system (else fixed Kp0, Ki0, Kd0)",
+    ),
+    real(
+        CCC_GAINS0,
+        "ccc.Kp0",
+        C.gains0.kp,
+        "Contour PID base gain Kp0",
+    )
+    .unit("1/s"),
+    real(
+        CCC_GAINS0 + 1,
+        "ccc.Ki0",
+        C.gains0.ki,
+        "Contour PID base gain Ki0",
+    )
+    .unit("1/s2"),
+    real(
+        CCC_GAINS0 + 2,
+        "ccc.Kd0",
+        C.gains0.kd,
+        "Contour PID base gain Kd0",
+    ),
+    Variable::parameter(
+        CCC_LIMIT,
+        "ccc.limit",
+        Start::Real(100.0),
+        "Bound on the contour correction (> 0), with anti-windup",
+    )
+    .unit("mm/s"),
+    real(
+        FUZZY_FACTORS,
+        "fuzzy.ke",
+        C.fuzzy.ke,
+        "Contour error quantisation factor (per um)",
+    ),
+    real(
+        FUZZY_FACTORS + 1,
+        "fuzzy.kde",
+        C.fuzzy.kde,
+        "Error change quantisation factor (per um/sample)",
+    ),
+    real(
+        FUZZY_FACTORS + 2,
+        "fuzzy.kp",
+        C.fuzzy.kpf,
+        "Scale of the fuzzy Kp adjustment",
+    )
+    .unit("1/s"),
+    real(
+        FUZZY_FACTORS + 3,
+        "fuzzy.ki",
+        C.fuzzy.kif,
+        "Scale of the fuzzy Ki adjustment",
+    )
+    .unit("1/s2"),
+    real(
+        FUZZY_FACTORS + 4,
+        "fuzzy.kd",
+        C.fuzzy.kdf,
+        "Scale of the fuzzy Kd adjustment",
+    ),
+    Variable::parameter(
+        ESTIMATOR,
+        "estimator",
+        Start::String("free_curve"),
+        "Contour estimator: free_curve (two circles through recent references), or line / arc \
+         (exact, from the line.*/arc.* parameters)",
+    ),
+    G[0],
+    G[1],
+    G[2],
+    G[3],
+    G[4],
+    G[5],
+    G[6],
+    G[7],
+    G[8],
+];
+
+pub static INFO: ModelInfo = ModelInfo {
+    identifier: "ContourCCC2D",
+    description:
+        "Two-axis cross-coupled contour controller: position loops plus a contour correction \
+                  whose PID gains are adapted by a 7-set Mamdani fuzzy system",
+    variables: &VARIABLES,
+    default_experiment: DefaultExperiment {
+        start_time: 0.0,
+        stop_time: 2.0,
+        step_size: 1e-3,
+    },
+    create: |_: &Environment| Box::new(ContourCcc2D { state: None }),
+};
+
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
+struct State {
+    controller: CrossCoupledController<Estimator>,
+    clock: SampleClock,
+}
+
+pub struct ContourCcc2D {
+    state: Option<State>,
+}
+
+fn gains(values: &Values, first: Vr) -> PidGains {
+    PidGains::new(
+        values.real(first),
+        values.real(first + 1),
+        values.real(first + 2),
+    )
+}
+
+fn config(values: &Values) -> ControllerConfig {
+    let f = |i| values.real(FUZZY_FACTORS + i);
+    let mode = match (values.boolean(CCC_ENABLE), values.boolean(FUZZY_ENABLE)) {
+        (false, _) => CccMode::Off,
+        (true, false) => CccMode::Fixed,
+        (true, true) => CccMode::Fuzzy,
+    };
+    ControllerConfig {
+        ts: values.real(TS),
+        axis: [gains(values, AXIS_GAINS), gains(values, AXIS_GAINS + 3)],
+        axis_limit: None,
+        ccc: CccConfig {
+            mode,
+            gains0: gains(values, CCC_GAINS0),
+            fuzzy: FuzzyFactors {
+                ke: f(0),
+                kde: f(1),
+                kpf: f(2),
+                kif: f(3),
+                kdf: f(4),
+            },
+            limit: Some(values.real(CCC_LIMIT)),
+        },
+    }
+}
+
+fn estimator(values: &Values) -> Result<Estimator, String> {
+    let kind: EstimatorKind = values
+        .string(ESTIMATOR)
+        .parse()
+        .map_err(|e| format!("parameter 'estimator': {e}"))?;
+    Ok(match kind {
+        EstimatorKind::FreeCurve => Estimator::FreeCurve(FreeCurveEstimator::default()),
+        EstimatorKind::Line => {
+            Estimator::Line(LineEstimator::new(&geometry::line(values, GEOMETRY)?))
+        }
+        EstimatorKind::Arc => Estimator::Arc(ArcEstimator::new(&geometry::arc(values, GEOMETRY)?)),
+    })
+}
+
+impl Model for ContourCcc2D {
+    fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult {
+        let config = config(values);
+        let controller =
+            CrossCoupledController::new(config, estimator(values)?).map_err(|e| e.to_string())?;
+        self.state = Some(State {
+            controller,
+            clock: SampleClock::new(start_time, config.ts),
+        });
+        for vr in U_X..=CCC_KD {
+            values.set_real(vr, 0.0);
+        }
+        Ok(())
+    }
+
+    fn do_step(&mut self, values: &mut Values, time: f64, step: f64) -> ModelResult {
+        let state = self.state.as_mut().ok_or("not initialized")?;
+        let reference = [values.real(REF_X), values.real(REF_Y)];
+        let actual = [values.real(POS_X), values.real(POS_Y)];
+        while state.clock.take_before(time + step) {
+            let out = state.controller.sample(reference, actual);
+            values.set_real(U_X, out.u[0]);
+            values.set_real(U_Y, out.u[1]);
+            values.set_real(CONTOUR_ERROR, out.contour.error);
+            values.set_real(ERR_X, out.following_error[0]);
+            values.set_real(ERR_Y, out.following_error[1]);
+            values.set_real(CCC_KP, out.gains.0);
+            values.set_real(CCC_KI, out.gains.1);
+            values.set_real(CCC_KD, out.gains.2);
+        }
+        Ok(())
+    }
+
+    fn save_state(&self) -> Result<Vec<u8>, String> {
+        encode_state(&self.state)
+    }
+
+    fn restore_state(&mut self, bytes: &[u8]) -> ModelResult {
+        self.state = decode_state(bytes)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn start_values_are_the_controller_library_defaults() {
+        assert_eq!(DEFAULT, ControllerConfig::default());
+        let values = Values::from_table(&VARIABLES);
+        assert_eq!(config(&values), ControllerConfig::default());
+        assert_eq!(estimator(&values).unwrap().kind(), EstimatorKind::FreeCurve);
+    }
+}

@@ -1,0 +1,174 @@
+//! `PathInterpolator2D`: the reference trajectory. Follows a line, an arc, the paper's
+//! circle, the built-in `infinity` and `trident` NURBS or a NURBS file at a constant
+//! feed, one sample every `Ts`; `ref.x`, `ref.y` hold the latest sample between samples.
+
+use std::f64::consts::PI;
+
+use super::sample_clock::SampleClock;
+use super::variables::{Start, Values, Variable, Vr};
+use super::{
+    decode_state, encode_state, geometry, DefaultExperiment, Environment, Model, ModelInfo,
+    ModelResult,
+};
+use crate::path::{Interpolator, Path};
+
+pub const REF_X: Vr = 0;
+pub const REF_Y: Vr = 1;
+pub const DONE: Vr = 2;
+pub const PATH: Vr = 3;
+pub const FEED: Vr = 4;
+pub const TS: Vr = 5;
+pub const GEOMETRY: Vr = 6;
+
+const G: [Variable; geometry::COUNT] = geometry::variables(GEOMETRY);
+
+static VARIABLES: [Variable; 6 + geometry::COUNT] = [
+    Variable::output(REF_X, "ref.x", "Reference position, x").unit("mm"),
+    Variable::output(REF_Y, "ref.y", "Reference position, y").unit("mm"),
+    Variable::discrete_output(
+        DONE,
+        "done",
+        Start::Boolean(false),
+        "The end of the path has been reached",
+    ),
+    Variable::parameter(
+        PATH,
+        "path",
+        Start::String("circle"),
+        "circle (the paper's), line or arc (from the line.*/arc.* parameters), infinity, \
+         trident, or a NURBS JSON file: absolute, or relative to the FMU's resources folder",
+    ),
+    Variable::parameter(
+        FEED,
+        "feed",
+        Start::Real(10.0 * PI),
+        "Feed rate along the path (> 0)",
+    )
+    .unit("mm/s"),
+    Variable::parameter(TS, "Ts", Start::Real(1e-3), "Interpolation period (> 0)").unit("s"),
+    G[0],
+    G[1],
+    G[2],
+    G[3],
+    G[4],
+    G[5],
+    G[6],
+    G[7],
+    G[8],
+];
+
+pub static INFO: ModelInfo = ModelInfo {
+    identifier: "PathInterpolator2D",
+    description:
+        "Two-axis reference trajectory: a line, arc, circle or NURBS path sampled every Ts \
+                  at a constant feed (second-order Taylor interpolation)",
+    variables: &VARIABLES,
+    default_experiment: DefaultExperiment {
+        start_time: 0.0,
+        stop_time: 2.0,
+        step_size: 1e-3,
+    },
+    create: |environment: &Environment| {
+        Box::new(PathInterpolator2D {
+            environment: environment.clone(),
+            state: None,
+        })
+    },
+};
+
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
+struct State {
+    interpolator: Interpolator,
+    clock: SampleClock,
+}
+
+pub struct PathInterpolator2D {
+    environment: Environment,
+    /// `None` until initialized.
+    state: Option<State>,
+}
+
+fn positive(values: &Values, vr: Vr, name: &str) -> Result<f64, String> {
+    let v = values.real(vr);
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("parameter '{name}' must be > 0 (got {v})"))
+    }
+}
+
+/// The path the parameters describe; file errors name the file and line.
+fn path(values: &Values, environment: &Environment) -> Result<Path, String> {
+    let spec = values.string(PATH).trim();
+    match spec.to_ascii_lowercase().as_str() {
+        "line" => geometry::line(values, GEOMETRY).map(Path::Line),
+        "arc" => geometry::arc(values, GEOMETRY).map(Path::Arc),
+        _ => Path::from_spec(spec, environment.resource_dir.as_deref())
+            .map_err(|e| format!("parameter 'path': {e}")),
+    }
+}
+
+impl PathInterpolator2D {
+    fn write_outputs(&self, values: &mut Values) {
+        if let Some(state) = &self.state {
+            let sample = state.interpolator.current();
+            values.set_real(REF_X, sample.point[0]);
+            values.set_real(REF_Y, sample.point[1]);
+            values.set_boolean(DONE, sample.done);
+        }
+    }
+}
+
+impl Model for PathInterpolator2D {
+    fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult {
+        let feed = positive(values, FEED, "feed")?;
+        let ts = positive(values, TS, "Ts")?;
+        let interpolator = Interpolator::new(path(values, &self.environment)?, feed, ts)
+            .map_err(|e| e.to_string())?;
+        self.state = Some(State {
+            interpolator,
+            clock: SampleClock::new(start_time, ts),
+        });
+        self.write_outputs(values);
+        Ok(())
+    }
+
+    fn do_step(&mut self, values: &mut Values, time: f64, step: f64) -> ModelResult {
+        let state = self.state.as_mut().ok_or("not initialized")?;
+        while state.clock.take_until(time + step) {
+            state.interpolator.step();
+        }
+        self.write_outputs(values);
+        Ok(())
+    }
+
+    fn save_state(&self) -> Result<Vec<u8>, String> {
+        encode_state(&self.state)
+    }
+
+    fn restore_state(&mut self, bytes: &[u8]) -> ModelResult {
+        self.state = decode_state(bytes)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::path::builtin;
+
+    #[test]
+    fn start_values_give_the_papers_circle_and_geometry_defaults_the_built_ins() {
+        let mut values = Values::from_table(&VARIABLES);
+        let env = Environment::default();
+        assert_eq!(
+            path(&values, &env).unwrap(),
+            builtin::by_name("circle").unwrap()
+        );
+        values.set(PATH, super::super::Value::String("line".into()));
+        assert_eq!(
+            path(&values, &env).unwrap(),
+            builtin::by_name("line").unwrap()
+        );
+    }
+}

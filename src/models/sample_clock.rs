@@ -1,0 +1,91 @@
+//! Which control samples fall inside a communication step.
+//!
+//! Sampled models (interpolator, controllers) run at their own period `Ts` whatever
+//! communication step the importer uses: sample n is due at t0 + n·Ts. Counting samples
+//! with an integer (instead of accumulating time) keeps the phase exact over any number
+//! of steps, and a tolerance of 1e-6·Ts absorbs the rounding of importers' clocks.
+
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SampleClock {
+    start: f64,
+    period: f64,
+    /// Samples taken so far; the next one is due at start + taken·period.
+    taken: u64,
+}
+
+impl SampleClock {
+    pub fn new(start: f64, period: f64) -> Self {
+        SampleClock {
+            start,
+            period,
+            taken: 0,
+        }
+    }
+
+    fn due(&self, n: u64) -> f64 {
+        self.start + n as f64 * self.period
+    }
+
+    fn tolerance(&self) -> f64 {
+        1e-6 * self.period
+    }
+
+    /// Takes the next sample if it is due strictly before `end` (a controller acting at
+    /// the start of its period on the inputs held over it). Returns whether it did.
+    pub fn take_before(&mut self, end: f64) -> bool {
+        let due = self.due(self.taken) < end - self.tolerance();
+        self.taken += u64::from(due);
+        due
+    }
+
+    /// Takes the next sample after the current one if it is due at or before `end` (an
+    /// interpolator whose output at `end` is the latest sample). Returns whether it did.
+    pub fn take_until(&mut self, end: f64) -> bool {
+        let due = self.due(self.taken + 1) <= end + self.tolerance();
+        self.taken += u64::from(due);
+        due
+    }
+
+    /// Samples taken so far.
+    pub fn taken(&self) -> u64 {
+        self.taken
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fired_before(steps: &[f64], ts: f64) -> Vec<u64> {
+        let mut clock = SampleClock::new(0.0, ts);
+        let mut t = 0.0;
+        let mut counts = Vec::new();
+        for &h in steps {
+            t += h;
+            while clock.take_before(t) {}
+            counts.push(clock.taken());
+        }
+        counts
+    }
+
+    #[test]
+    fn a_controller_fires_at_every_multiple_of_its_period() {
+        // 2.5 ms steps over a 1 ms period: samples at 0, 1, 2 | 3, 4 | 5, 6, 7 | …
+        assert_eq!(fired_before(&[0.0025; 4], 0.001), vec![3, 5, 8, 10]);
+        // Importer rounding (0.1 + 0.2 style) does not add or drop a sample.
+        assert_eq!(fired_before(&[0.1, 0.2, 0.3], 0.1), vec![1, 3, 6]);
+        let counts = fired_before(&[0.001; 1000], 0.001);
+        assert_eq!(counts.last(), Some(&1000));
+    }
+
+    #[test]
+    fn an_interpolator_holds_the_latest_sample() {
+        let mut clock = SampleClock::new(0.0, 0.001);
+        while clock.take_until(0.0025) {}
+        assert_eq!(clock.taken(), 2);
+        while clock.take_until(0.003 - 1e-15) {}
+        assert_eq!(clock.taken(), 3);
+    }
+}

@@ -1,0 +1,254 @@
+"""PathInterpolator2D and ContourCCC2D through fmpy: validation, multi-rate sampling,
+state save/restore, bad input, the closed loop on the paper's three paths, and the FMI
+cross-check files."""
+
+import json
+import math
+import shutil
+
+import numpy as np
+import pytest
+from fmpy import extract, read_csv, read_model_description, simulate_fmu
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+from fmpy.validation import validate_fmu
+
+import demo
+from fmu_log import CapturedLog
+from master import closed_loop
+from reference_paths import ContourReference
+
+CONTROLLER_OUTPUTS = ["u.x", "u.y", "contourError", "err.x", "err.y", "ccc.Kp", "ccc.Ki", "ccc.Kd"]
+
+
+class Slave:
+    """One FMU2Slave with a captured log and access by variable name."""
+
+    def __init__(self, fmu_path, name="test"):
+        self.md = read_model_description(fmu_path)
+        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+        self.dir = extract(fmu_path)
+        self.log = CapturedLog()
+        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,
+                             modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
+        self.fmu.instantiate(callbacks=self.log.callbacks)
+        self.fmu.setupExperiment(startTime=0.0)
+        self.fmu.enterInitializationMode()
+
+    def set(self, **values):
+        for name, value in values.items():
+            name = name.replace("__", ".")
+            kind = next(v.type for v in self.md.modelVariables if v.name == name)
+            setter = {"Real": self.fmu.setReal, "Boolean": self.fmu.setBoolean,
+                      "String": self.fmu.setString, "Integer": self.fmu.setInteger}[kind]
+            setter([self.vr[name]], [value])
+
+    def reals(self, names):
+        return np.array(self.fmu.getReal([self.vr[n] for n in names]))
+
+    def close(self):
+        self.fmu.freeInstance()
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+
+@pytest.fixture
+def controller(fmu_dir):
+    s = Slave(str(fmu_dir / "ContourCCC2D.fmu"))
+    yield s
+    s.close()
+
+
+@pytest.fixture
+def interpolator(fmu_dir):
+    s = Slave(str(fmu_dir / "PathInterpolator2D.fmu"))
+    yield s
+    s.close()
+
+
+@pytest.mark.parametrize("model", ["PathInterpolator2D", "ContourCCC2D"])
+def test_validates_without_problems(fmu_dir, model):
+    assert validate_fmu(str(fmu_dir / f"{model}.fmu")) == []
+
+
+# ---------------------------------------------------------------------------------------
+# Multi-rate: the control law fires at every multiple of Ts, whatever the step.
+
+def held_inputs(t):
+    """Piecewise-constant inputs, changing every 5 ms: a circle and a point lagging inside it."""
+    k = math.floor(t / 0.005 + 1e-9)
+    a = 0.05 * k
+    return [10 * math.cos(a) - 10, 10 * math.sin(a), 9.98 * math.cos(a - 0.01) - 10, 9.98 * math.sin(a - 0.01)]
+
+
+def run_controller(fmu_dir, h, stop=0.1):
+    s = Slave(str(fmu_dir / "ContourCCC2D.fmu"))
+    s.fmu.exitInitializationMode()
+    inputs = [s.vr[n] for n in ("ref.x", "ref.y", "pos.x", "pos.y")]
+    outputs = {}
+    steps = int(round(stop / h))
+    for k in range(steps):
+        t = k * h
+        s.fmu.setReal(inputs, held_inputs(t))
+        s.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+        outputs[round((k + 1) * h, 9)] = s.reals(CONTROLLER_OUTPUTS)
+    s.close()
+    return outputs
+
+
+def test_controller_output_is_independent_of_the_communication_step(fmu_dir):
+    runs = {h: run_controller(fmu_dir, h) for h in (0.001, 0.0025, 0.005)}
+    shared = sorted(set(runs[0.001]) & set(runs[0.0025]) & set(runs[0.005]))
+    assert len(shared) == 20
+    for t in shared:
+        assert np.array_equal(runs[0.001][t], runs[0.0025][t]), t
+        assert np.array_equal(runs[0.001][t], runs[0.005][t]), t
+    # The controller really acted: the CCC gains and commands are not trivial.
+    last = runs[0.001][shared[-1]]
+    assert abs(last[0]) > 1.0 and last[5] > 0.0
+
+
+def test_interpolator_output_is_independent_of_the_communication_step(fmu_dir):
+    def run(h):
+        s = Slave(str(fmu_dir / "PathInterpolator2D.fmu"))
+        s.set(path="trident", feed=40.0)
+        s.fmu.exitInitializationMode()
+        out = {}
+        for k in range(int(round(0.2 / h))):
+            s.fmu.doStep(currentCommunicationPoint=k * h, communicationStepSize=h)
+            out[round((k + 1) * h, 9)] = s.reals(["ref.x", "ref.y"])
+        s.close()
+        return out
+
+    fine, coarse = run(0.001), run(0.0025)
+    shared = sorted(set(fine) & set(coarse))
+    assert len(shared) == 40
+    for t in shared:
+        assert np.array_equal(fine[t], coarse[t])
+    # 0.2 s at 40 mm/s from the trident's start point (40.2, -0.1): 8 mm along the path.
+    travelled = np.hypot(*(fine[0.2] - np.array([40.2, -0.1])))
+    assert 6.0 < travelled < 8.0
+
+
+# ---------------------------------------------------------------------------------------
+# FMU state of the controller covers the estimator history and the PID memories.
+
+def test_controller_state_restores_the_estimator_and_pid_memories(controller):
+    c = controller
+    c.fmu.exitInitializationMode()
+    inputs = [c.vr[n] for n in ("ref.x", "ref.y", "pos.x", "pos.y")]
+
+    def go(k0, k1):
+        out = []
+        for k in range(k0, k1):
+            c.fmu.setReal(inputs, held_inputs(k * 0.005))
+            c.fmu.doStep(currentCommunicationPoint=k * 0.001, communicationStepSize=0.001)
+            out.append(c.reals(CONTROLLER_OUTPUTS))
+        return np.array(out)
+
+    go(0, 40)
+    state = c.fmu.getFMUstate()
+    serialized = c.fmu.serializeFMUstate(state)
+    expected = go(40, 90)
+    c.fmu.setFMUstate(state)
+    assert np.array_equal(go(40, 90), expected)
+    restored = c.fmu.deSerializeFMUstate(serialized)
+    c.fmu.setFMUstate(restored)
+    assert np.array_equal(go(40, 90), expected)
+    c.fmu.freeFMUstate(state)
+    c.fmu.freeFMUstate(restored)
+
+
+# ---------------------------------------------------------------------------------------
+# Bad input
+
+def test_nan_input_is_refused_and_outputs_stay(controller):
+    c = controller
+    c.fmu.exitInitializationMode()
+    c.set(ref__x=1.0, pos__x=0.5)
+    c.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.001)
+    before = c.reals(CONTROLLER_OUTPUTS + ["pos.x"])
+    with pytest.raises(FMICallException) as failure:
+        c.set(pos__x=float("nan"))
+    assert failure.value.status == 3  # fmi2Error
+    assert any("'pos.x' refuses the non-finite value NaN" in m for m in c.log.errors())
+    assert np.array_equal(c.reals(CONTROLLER_OUTPUTS + ["pos.x"]), before)
+
+
+@pytest.mark.parametrize("fixture, values, words", [
+    ("controller", {"Ts": 0.0}, "parameter Ts = 0 is invalid"),
+    ("controller", {"Ts": -0.001}, "parameter Ts = -0.001 is invalid"),
+    ("controller", {"estimator": "kalman"}, "parameter 'estimator': unknown contour estimator 'kalman'"),
+    ("controller", {"estimator": "arc", "arc__r": 0.0}, "parameters 'arc.*'"),
+    ("interpolator", {"feed": 0.0}, "parameter 'feed' must be > 0"),
+    ("interpolator", {"feed": -5.0}, "parameter 'feed' must be > 0"),
+    ("interpolator", {"Ts": 0.0}, "parameter 'Ts' must be > 0"),
+    ("interpolator", {"path": "spiral"}, "unknown path 'spiral'"),
+])
+def test_bad_parameters_are_refused_when_initialization_ends(request, fixture, values, words):
+    s = request.getfixturevalue(fixture)
+    s.set(**values)
+    with pytest.raises(FMICallException):
+        s.fmu.exitInitializationMode()
+    assert any(words in m for m in s.log.errors()), s.log.errors()
+
+
+def test_negative_fuzzy_factors_are_refused_with_the_parameter_named(controller):
+    for name in ("fuzzy.ke", "fuzzy.kde", "fuzzy.kp", "fuzzy.ki", "fuzzy.kd"):
+        with pytest.raises(FMICallException):
+            controller.fmu.setReal([controller.vr[name]], [-1.0])
+        assert controller.log.errors()[-1].endswith(f"variable '{name}' = -1 is below its minimum 0")
+    controller.fmu.exitInitializationMode()  # the refused values were not stored
+
+
+def test_missing_and_malformed_path_files_name_the_file_and_line(interpolator, tmp_path):
+    missing = tmp_path / "nowhere.json"
+    interpolator.set(path=str(missing))
+    with pytest.raises(FMICallException):
+        interpolator.fmu.exitInitializationMode()
+    assert any(str(missing) in m for m in interpolator.log.errors())
+
+    broken = tmp_path / "broken.json"
+    broken.write_text('{\n  "degree": 3,\n  "knots": [0, 0, 0, 0, 1, 1, 1, 1],\n  "control_points": [[0, 0], [1, 1]\n}\n')
+    interpolator.set(path=str(broken))
+    with pytest.raises(FMICallException):
+        interpolator.fmu.exitInitializationMode()
+    assert any(f"{broken}:5:" in m for m in interpolator.log.errors()), interpolator.log.errors()
+
+    good = tmp_path / "quarter.json"
+    good.write_text(json.dumps({"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0], [3, 4]]}))
+    interpolator.set(path=str(good), feed=5.0)
+    interpolator.fmu.exitInitializationMode()
+    interpolator.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.5)
+    assert np.allclose(interpolator.reals(["ref.x", "ref.y"]), [1.5, 2.0], atol=1e-9)
+
+
+# ---------------------------------------------------------------------------------------
+# The closed loop
+
+@pytest.mark.parametrize("path, feed", demo.PATHS)
+def test_fuzzy_ccc_beats_no_ccc_through_the_fmus(fmu_dir, path, feed):
+    _, _, without = demo.run_path(fmu_dir, path, feed, {"ccc.enable": False})
+    _, _, fixed = demo.run_path(fmu_dir, path, feed, {"fuzzy.enable": False})
+    _, _, fuzzy = demo.run_path(fmu_dir, path, feed, {})
+    assert fuzzy.max() < 0.5 * without.max()
+    assert fixed.max() < 0.5 * without.max()
+    assert fuzzy.mean() < 0.1 * without.mean()
+    if path == "circle":
+        # DESIGN 4.2: 47.7 um without CCC on the paper's circle and plant.
+        assert 0.0476 < without.max() < 0.0478
+
+
+def test_cross_check_files_reproduce_through_simulate_fmu(fmu_dir, tmp_path):
+    before, after = closed_loop(fmu_dir, path="circle", stop=0.2)
+    demo.write_cross_check(tmp_path, before, after)
+    folder = tmp_path / "cross-check" / "ContourCCC2D"
+    inputs = read_csv(folder / "ContourCCC2D_in.csv")
+    reference = read_csv(folder / "ContourCCC2D_ref.csv")
+    options = dict(line.split(",") for line in (folder / "ContourCCC2D_ref.opt").read_text().split())
+    result = simulate_fmu(str(fmu_dir / "ContourCCC2D.fmu"), stop_time=float(options["StopTime"]),
+                          step_size=float(options["StepSize"]), output_interval=float(options["StepSize"]),
+                          input=inputs, output=list(reference.dtype.names[1:]))
+    assert len(result) == len(reference)
+    for name in reference.dtype.names[1:]:
+        assert np.max(np.abs(result[name] - reference[name])) < 1e-9, name
+    assert np.max(np.abs(reference["u.x"])) > 1.0
