@@ -1,0 +1,117 @@
+"""Runs the closed loop PathInterpolator2D -> ContourCCC2D <- XYServoPlant in libcosim
+(libcosimpy) and prints the trajectories as one line of JSON.
+
+Kept in its own process: libcosim can take the interpreter down on a broken FMU.
+usage: python cosim_closed_loop.py FMU_DIR STEP_NS STEPS [UNIT.VARIABLE=VALUE ...]
+
+The printed object holds
+- "time_ns": the execution's final time (integer ns);
+- "steps", "time_ns_points": step numbers 1..STEPS and their time points (ns) from the
+  time-series observer, which samples every observed variable after each step: step n is
+  the state at t = n * STEP_NS;
+- "series": {"unit.variable": [values at steps 1..STEPS]};
+- "last": {"unit.variable": value} from a last-value observer after the run.
+"""
+
+import json
+import sys
+from pathlib import Path
+
+from libcosimpy.CosimEnums import CosimVariableType
+from libcosimpy.CosimExecution import CosimExecution
+from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+from libcosimpy.CosimObserver import CosimObserver
+from libcosimpy.CosimSlave import CosimLocalSlave
+
+UNITS = {  # instance name -> FMU file, as in master.closed_loop
+    "interpolator": "PathInterpolator2D.fmu",
+    "controller": "ContourCCC2D.fmu",
+    "plant": "XYServoPlant.fmu",
+}
+# master.CLOSED_LOOP_CONNECTIONS; repeated here so that this process loads libcosim only.
+CONNECTIONS = [
+    ("interpolator", "ref.x", "controller", "ref.x"),
+    ("interpolator", "ref.y", "controller", "ref.y"),
+    ("plant", "pos.x", "controller", "pos.x"),
+    ("plant", "pos.y", "controller", "pos.y"),
+    ("controller", "u.x", "plant", "u.x"),
+    ("controller", "u.y", "plant", "u.y"),
+]
+SERIES = [
+    ("interpolator", "ref.x"), ("interpolator", "ref.y"),
+    ("controller", "u.x"), ("controller", "u.y"), ("controller", "contourError"),
+    ("plant", "pos.x"), ("plant", "pos.y"),
+]
+LAST_REAL = [("interpolator", "ref.x"), ("interpolator", "ref.y"), ("plant", "pos.x"), ("plant", "pos.y")]
+LAST_BOOLEAN = [("interpolator", "done")]
+
+
+def check(ok, what):
+    if ok is False or (not isinstance(ok, bool) and ok != 0):
+        raise SystemExit(f"libcosim: {what} failed")
+
+
+def set_initial(execution, index, variable, text):
+    kind = CosimVariableType(variable.type)
+    ref = variable.reference
+    if kind == CosimVariableType.REAL:
+        check(execution.real_initial_value(index, ref, float(text)), f"initial value {text}")
+    elif kind == CosimVariableType.INTEGER:
+        check(execution.integer_initial_value(index, ref, int(text)), f"initial value {text}")
+    elif kind == CosimVariableType.BOOLEAN:
+        check(execution.boolean_initial_value(index, ref, text.lower() in ("1", "true")), f"initial value {text}")
+    else:
+        check(execution.string_initial_value(index, ref, text), f"initial value {text}")
+
+
+def main(argv):
+    fmu_dir, step_ns, steps = Path(argv[0]), int(argv[1]), int(argv[2])
+    assignments = [a.split("=", 1) for a in argv[3:]]
+    log_output_level(CosimLogLevel.WARNING)
+
+    execution = CosimExecution.from_step_size(step_size=step_ns)
+    slaves, index, variables = {}, {}, {}
+    for name, file in UNITS.items():
+        slaves[name] = CosimLocalSlave(fmu_path=str(fmu_dir / file), instance_name=name)
+        index[name] = execution.add_local_slave(local_slave=slaves[name])
+        check(index[name] >= 0, f"adding {file}")
+        variables[name] = {v.name.decode(): v for v in execution.slave_variables(index[name])}
+
+    def ref(unit, name):
+        return variables[unit][name].reference
+
+    for src, out, dst, inp in CONNECTIONS:
+        check(execution.connect_real_variables(index[src], ref(src, out), index[dst], ref(dst, inp)),
+              f"connecting {src}.{out} -> {dst}.{inp}")
+    for target, text in assignments:
+        unit, name = target.split(".", 1)
+        set_initial(execution, index[unit], variables[unit][name], text)
+
+    series = CosimObserver.create_time_series(buffer_size=steps + 16)
+    check(execution.add_observer(observer=series), "adding the time-series observer")
+    for unit, name in SERIES:
+        check(series.start_time_series(index[unit], ref(unit, name), CosimVariableType.REAL),
+              f"observing {unit}.{name}")
+    last = CosimObserver.create_last_value()
+    check(execution.add_observer(observer=last), "adding the last-value observer")
+
+    check(execution.step(step_count=steps), "stepping")
+    status = execution.status()
+
+    result = {"time_ns": status.current_time, "series": {}, "last": {}}
+    for unit, name in SERIES:
+        # From step 1: libcosimpy trims its sample arrays by the number of zero step numbers,
+        # so asking from step 0 would drop the last sample.
+        points, numbers, values = series.time_series_real_samples(
+            index[unit], ref(unit, name), from_step=1, sample_count=steps)
+        result["series"][f"{unit}.{name}"] = list(values)
+        result["steps"], result["time_ns_points"] = list(numbers), list(points)
+    for unit, name in LAST_REAL:
+        result["last"][f"{unit}.{name}"] = last.last_real_values(index[unit], [ref(unit, name)])[0]
+    for unit, name in LAST_BOOLEAN:
+        result["last"][f"{unit}.{name}"] = bool(last.last_boolean_values(index[unit], [ref(unit, name)])[0])
+    print(json.dumps(result))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
