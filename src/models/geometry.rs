@@ -1,6 +1,7 @@
 //! The line and arc geometry parameters shared by `PathInterpolator2D` (the path to
 //! follow) and `ContourCCC2D` (the exact line/arc estimators): the same names and
-//! defaults in both FMUs, so one set of values describes one path.
+//! defaults in both FMUs, so one set of values describes one path. The defaults are the
+//! built-in `line` and `arc` paths (crate::path::builtin).
 
 use std::f64::consts::PI;
 
@@ -31,14 +32,9 @@ pub const fn variables(first: Vr) -> [Variable; COUNT] {
         length(first + LINE_Y0, "line.y0", 0.0, "Line start, y"),
         length(first + LINE_X1, "line.x1", 40.0, "Line end, x"),
         length(first + LINE_Y1, "line.y1", 30.0, "Line end, y"),
-        length(
-            first + ARC_CX,
-            "arc.cx",
-            -10.0,
-            "Arc centre, x (default: the paper's circle)",
-        ),
+        length(first + ARC_CX, "arc.cx", -20.0, "Arc centre, x"),
         length(first + ARC_CY, "arc.cy", 0.0, "Arc centre, y"),
-        length(first + ARC_R, "arc.r", 10.0, "Arc radius"),
+        length(first + ARC_R, "arc.r", 20.0, "Arc radius"),
         Variable::parameter(
             first + ARC_START,
             "arc.start",
@@ -49,7 +45,7 @@ pub const fn variables(first: Vr) -> [Variable; COUNT] {
         Variable::parameter(
             first + ARC_SWEEP,
             "arc.sweep",
-            Start::Real(2.0 * PI),
+            Start::Real(-PI),
             "Swept angle: > 0 counter-clockwise, < 0 clockwise, ±2π a full circle",
         )
         .unit("rad"),

@@ -165,10 +165,12 @@ mod tests {
             path(&values, &env).unwrap(),
             builtin::by_name("circle").unwrap()
         );
-        values.set(PATH, super::super::Value::String("line".into()));
-        assert_eq!(
-            path(&values, &env).unwrap(),
-            builtin::by_name("line").unwrap()
-        );
+        for name in ["line", "arc"] {
+            values.set(PATH, super::super::Value::String(name.into()));
+            assert_eq!(
+                path(&values, &env).unwrap(),
+                builtin::by_name(name).unwrap()
+            );
+        }
     }
 }
