@@ -6,7 +6,7 @@ min/max, centroid). Rust: `examples/fuzzy_timing.rs`, which times N evaluations 
 three outputs. Prints both and their ratio; the target is a ratio of at least 100.
 
 Run from the repository root:
-    CARGO_TARGET_DIR=/work/target-control .venv/bin/python benches/fuzzy_vs_skfuzzy.py \
+    .venv/bin/python benches/fuzzy_vs_skfuzzy.py \
         [--evals 100] [--points 20001 601]
 """
 

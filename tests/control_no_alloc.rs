@@ -1,16 +1,22 @@
 //! Proves that a controller sample and a fuzzy evaluation never touch the heap once the
 //! controller is built: they run inside `fmi2DoStep`, where allocation means unbounded
-//! latency. A counting global allocator (this test binary only) counts the allocations
-//! made by the current thread.
+//! latency. The same for the other per-sample work: an interpolator step, a free-curve
+//! estimate, a true-error query and one closed-loop sample of `sim` (the PSO runs that
+//! thousands of times). A counting global allocator (this test binary only) counts the
+//! allocations made by the current thread.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::hint::black_box;
 
-use contour_fmu::contour::{ContourEstimate, ContourEstimator};
+use contour_fmu::contour::{
+    ContourEstimate, ContourEstimator, Estimator, EstimatorKind, TrueErrorIndex,
+};
 use contour_fmu::control::{
     CccConfig, CccMode, ControllerConfig, CrossCoupledController, FuzzyEngine,
 };
+use contour_fmu::path::{builtin, Curve, Interpolator};
+use contour_fmu::sim::{SimConfig, Simulator};
 
 thread_local! {
     // Const-initialised and without a destructor, so reading it never allocates.
@@ -115,5 +121,79 @@ fn sample_and_fuzzy_evaluation_do_not_allocate() {
         });
         assert_eq!(count, 0, "{mode:?}: sample() allocated");
         assert!(p[0].is_finite() && p[1].is_finite());
+    }
+}
+
+#[test]
+fn path_estimator_and_true_error_do_not_allocate() {
+    for name in ["circle", "infinity", "trident"] {
+        let path = builtin::by_name(name).unwrap();
+        let mut interp = Interpolator::new(path.clone(), 50.0, 1e-3).unwrap();
+        let mut refs = Vec::with_capacity(10_000);
+        let count = allocations_during(|| {
+            let mut s = interp.current();
+            while !s.done {
+                s = interp.step();
+                // Capacity reserved above: pushing does not allocate.
+                refs.push(black_box(s));
+            }
+        });
+        assert_eq!(count, 0, "{name}: Interpolator::step allocated");
+        assert!(refs.len() > 1000 && refs.len() < 10_000);
+
+        // The free-curve estimator and the true error of a point lagging 35 samples and
+        // 0.1 mm off the path, as in the closed loop.
+        let mut estimator = Estimator::for_path(EstimatorKind::FreeCurve, &path);
+        let index = TrueErrorIndex::new(&path);
+        let mut acc = 0.0;
+        let count = allocations_during(|| {
+            let mut hint = 0.0;
+            for k in 0..refs.len() {
+                let lag = refs[k.saturating_sub(35)];
+                let d = path.eval(lag.u).d1;
+                let s = 0.1 / d[0].hypot(d[1]);
+                let p = [lag.point[0] - d[1] * s, lag.point[1] + d[0] * s];
+                let est = estimator.estimate(black_box(refs[k].point), black_box(p));
+                let truth = index.error(black_box(p), hint);
+                hint = truth.u;
+                acc += est.error + truth.error;
+            }
+        });
+        assert_eq!(count, 0, "{name}: estimate or true error allocated");
+        assert!(acc.is_finite());
+    }
+}
+
+#[test]
+fn closed_loop_samples_do_not_allocate() {
+    for name in ["circle", "trident"] {
+        let sim = Simulator::new(SimConfig::builtin(name).unwrap()).unwrap();
+        let mut run = sim.start();
+        let mut n = 0;
+        let count = allocations_during(|| {
+            for r in run.by_ref() {
+                black_box(r);
+                n += 1;
+            }
+        });
+        assert_eq!(count, 0, "{name}: a closed-loop sample allocated");
+        assert_eq!(n, sim.samples());
+        assert!(run.metrics().is_stable());
+
+        // A whole metrics-only run allocates a fixed amount (the controller), however
+        // long it is.
+        let mut short = sim.config().clone();
+        short.duration = Some(0.5);
+        let short = Simulator::new(short).unwrap();
+        let long_count = allocations_during(|| {
+            black_box(sim.metrics());
+        });
+        let short_count = allocations_during(|| {
+            black_box(short.metrics());
+        });
+        assert_eq!(
+            long_count, short_count,
+            "{name}: allocations grow with run length"
+        );
     }
 }

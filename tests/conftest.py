@@ -1,8 +1,8 @@
-"""Shared fixtures for the checks of the Rust library against independent Python references.
+"""Fixtures shared by tests/reference and tests/fmpy.
 
-The Rust side is reached through small example programs (`examples/*.rs`) that print their
-results as JSON; the Python side recomputes the same quantities with an outside library
-(geomdl, scikit-fuzzy, scipy) and the test compares the two.
+The Rust library is reached through small example programs (`examples/*.rs`) that print
+their results as JSON; the Python side recomputes the same quantities with an outside
+library (geomdl, scikit-fuzzy, scipy, fmpy) and the test compares the two.
 """
 
 import json
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[1]
 
 
 def _cargo_example(name, *args):
