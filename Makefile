@@ -6,7 +6,7 @@ VENV   := .venv
 PYTHON := $(VENV)/bin/python
 CARGO  ?= cargo
 
-.PHONY: demo test fmus setup libclang lint bench
+.PHONY: demo test fmus setup libclang lint bench pso-claim
 
 setup: libclang $(VENV)/.installed
 
@@ -26,7 +26,8 @@ fmus: setup
 	$(CARGO) run --release -p fmu-build
 
 demo: fmus
-	MPLBACKEND=Agg $(PYTHON) tests/fmpy/demo.py
+	$(CARGO) build --release --bin ccc-tune
+	MPLBACKEND=Agg $(PYTHON) tests/fmpy/demo.py --tune
 
 lint: setup
 	$(CARGO) fmt --all -- --check
@@ -38,3 +39,10 @@ test: setup lint
 
 bench: setup
 	$(CARGO) bench --bench fuzzy --bench controller
+	$(CARGO) build --release --bin ccc-tune --example fuzzy_timing
+	$(PYTHON) benches/fuzzy_vs_skfuzzy.py
+	$(PYTHON) benches/tuning_vs_pyswarms_fmu.py
+
+# The paper's PSO claim at its full budget (about 10 minutes).
+pso-claim: setup
+	$(CARGO) run --release --example pso_claim

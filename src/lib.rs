@@ -11,3 +11,4 @@ pub mod models;
 pub mod path;
 pub mod plant;
 pub mod sim;
+pub mod tuning;

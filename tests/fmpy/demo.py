@@ -1,18 +1,26 @@
 """The paper's comparison, through the FMUs: PathInterpolator2D -> ContourCCC2D <-
 XYServoPlant, stepped by the fixed-step master in master.py (fmpy's FMU2Slave), on the
-circle, the infinity curve and the trident, without CCC and with the fuzzy-PID CCC.
+circle, the infinity curve and the trident: without CCC, with the fuzzy-PID CCC and the
+paper's factors, and with factors tuned by PSO (`ccc-tune`, applied as start values).
 
 Prints a table like the paper's Tables 4-5 (max and mean |true contour error|, the
 reduction), and writes to out/: one CSV time series per run, one PNG per path (path
-tracking and contour error vs time), and the FMI cross-check files of ContourCCC2D
+tracking and contour error vs time), the PSO fitness histories (standard vs improved,
+like the paper's Figures 10 and 13), and the FMI cross-check files of ContourCCC2D
 (out/cross-check/ContourCCC2D/: _in.csv, _ref.csv, _ref.opt) from the fuzzy circle run.
 
 usage: python tests/fmpy/demo.py [--fmu-dir DIR] [--out DIR]
+                                 [--tune | --params tuned.json] [--ccc-tune PROGRAM]
+
+--tune runs ccc-tune (improved and standard PSO, the paper's budget, fitness = max
+|true contour error|) on each path; --params applies one ccc-tune result to every path.
 """
 
 import argparse
 import csv
+import json
 import math
+import subprocess
 import sys
 from pathlib import Path
 
@@ -22,6 +30,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 from master import closed_loop  # noqa: E402
 from reference_paths import ContourReference  # noqa: E402
+from tuned import start_values  # noqa: E402
 
 REPO = HERE.parents[1]
 STEP = 1e-3
@@ -34,6 +43,37 @@ VARIANTS = [
     ("no CCC", {"ccc.enable": False}),
     ("fuzzy-PID CCC", {}),  # the FMU's defaults: the paper's fuzzy factors (1, 1.2, 87, 8.5, 4)
 ]
+
+
+# The tuner scores the maximum error: a part's tolerance band is about the worst point,
+# and on the circle the paper's mean is flat in the factors (the integral action fixes
+# the steady state), so it gives the swarm nothing to improve.
+TUNING_FITNESS = "max"
+
+
+def tune(program, out, path, feed, algorithm):
+    """Runs ccc-tune; returns its JSON document (also written to out/)."""
+    target = out / f"tuned_{path}_{algorithm}.json"
+    subprocess.run([str(program), "--path", path, "--feed", repr(feed), "--algorithm", algorithm,
+                    "--fitness", TUNING_FITNESS, "--seed", "1", "--out", str(target)],
+                   check=True, stderr=subprocess.DEVNULL)
+    return target
+
+
+def plot_histories(out, path, histories):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for algorithm, history in histories.items():
+        ax.plot(range(1, len(history) + 1), [h * 1e3 for h in history], label=f"{algorithm} PSO")
+    ax.set_xlabel("iteration"), ax.set_ylabel(f"best fitness: {TUNING_FITNESS} |contour error| (µm)")
+    ax.set_title(f"{path}: PSO convergence"), ax.legend()
+    fig.tight_layout()
+    fig.savefig(out / f"pso_{path}.png", dpi=120)
+    plt.close(fig)
 
 
 def run_path(fmu_dir, path, feed, controller):
@@ -95,13 +135,27 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--fmu-dir", type=Path, default=REPO / "target" / "fmu")
     parser.add_argument("--out", type=Path, default=REPO / "out")
+    choice = parser.add_mutually_exclusive_group()
+    choice.add_argument("--tune", action="store_true", help="tune each path with ccc-tune")
+    choice.add_argument("--params", type=Path, help="a ccc-tune JSON applied to every path")
+    parser.add_argument("--ccc-tune", type=Path, default=REPO / "target" / "release" / "ccc-tune")
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
 
     rows = []
     for path, feed in PATHS:
+        variants = list(VARIANTS)
+        if args.tune:
+            histories = {}
+            for algorithm in ("improved", "standard"):
+                document = tune(args.ccc_tune, args.out, path, feed, algorithm)
+                histories[algorithm] = json.loads(document.read_text())["history_mm"]
+            plot_histories(args.out, path, histories)
+            variants.append(("PSO-tuned CCC", start_values(args.out / f"tuned_{path}_improved.json")))
+        elif args.params:
+            variants.append(("PSO-tuned CCC", start_values(args.params)))
         runs = []
-        for label, controller in VARIANTS:
+        for label, controller in variants:
             before, after, error = run_path(args.fmu_dir, path, feed, controller)
             runs.append((label, before, error))
             columns = {name: before[name] for name in before.dtype.names}

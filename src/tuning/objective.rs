@@ -1,0 +1,164 @@
+//! The tuner's objective (DESIGN 4.4): a closed-loop run of the in-process simulator
+//! with candidate fuzzy factors, scored by the true contour error (against the exact
+//! path, not the controller's estimate). Diverging runs get a large finite penalty, so
+//! the swarm is steered away from them instead of crashing on NaN.
+
+use serde::{Deserialize, Serialize};
+
+use crate::control::{ControllerConfig, FuzzyFactors};
+use crate::path::Path;
+use crate::plant::XyTableParams;
+use crate::sim::{Metrics, SimConfig, Simulator};
+
+/// The tuned factors, in the order of a PSO position, named as in ContourCCC2D
+/// (`fuzzy.<name>`).
+pub const FACTOR_NAMES: [&str; 5] = ["ke", "kde", "kp", "ki", "kd"];
+
+/// Default search box. The paper's optimum (1, 1.2, 87, 8.5, 4) lies well inside; kε and
+/// kΔε of 10 per µm saturate the fuzzy inputs at 0.3 µm, and kpf = 1000 swings Kp by
+/// ±3000 1/s around Kp0 = 100 (tuning runs on the trident pushed against a narrower box).
+pub const LOWER: [f64; 5] = [0.0; 5];
+pub const UPPER: [f64; 5] = [10.0, 10.0, 1000.0, 3000.0, 50.0];
+
+/// Fitness of a run that diverged: above any stable run's (those abort at 10 mm), and
+/// lower the later the divergence, so the swarm still sees a slope.
+const PENALTY_MM: f64 = 1000.0;
+
+/// What the swarm minimises.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Fitness {
+    /// Mean |true contour error| over the run (DESIGN 4.4, the paper's).
+    Mean,
+    /// Maximum |true contour error| over the run.
+    Max,
+}
+
+impl std::str::FromStr for Fitness {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "mean" => Ok(Fitness::Mean),
+            "max" => Ok(Fitness::Max),
+            _ => Err(format!("unknown fitness '{s}': expected mean or max")),
+        }
+    }
+}
+
+/// The closed loop a tuning run scores; shared read-only by the evaluating threads.
+pub struct ContourObjective {
+    simulator: Simulator,
+    base: ControllerConfig,
+    fitness: Fitness,
+}
+
+/// The plant preset called `name`.
+pub fn plant_preset(name: &str) -> Result<XyTableParams, String> {
+    match name {
+        "paper" => Ok(XyTableParams::PAPER),
+        "mismatched" => Ok(XyTableParams::mismatched()),
+        _ => Err(format!(
+            "unknown plant '{name}': expected paper or mismatched"
+        )),
+    }
+}
+
+/// The controller configuration with `factors` (ke, kde, kp, ki, kd) as fuzzy factors.
+pub fn with_factors(base: &ControllerConfig, factors: &[f64]) -> ControllerConfig {
+    let mut config = *base;
+    config.ccc.fuzzy = FuzzyFactors {
+        ke: factors[0],
+        kde: factors[1],
+        kpf: factors[2],
+        kif: factors[3],
+        kdf: factors[4],
+    };
+    config
+}
+
+impl ContourObjective {
+    /// The default fuzzy-PID CCC on `path` at `feed` with the named plant preset.
+    pub fn new(path: Path, feed: f64, plant: &str, fitness: Fitness) -> Result<Self, String> {
+        let config = SimConfig::new(path, feed).with_plant(plant_preset(plant)?);
+        let base = config.effective_controller();
+        let simulator = Simulator::new(config).map_err(|e| e.to_string())?;
+        Ok(ContourObjective {
+            simulator,
+            base,
+            fitness,
+        })
+    }
+
+    pub fn ts(&self) -> f64 {
+        self.simulator.config().ts
+    }
+
+    /// Metrics of the closed loop with these factors.
+    pub fn metrics(&self, factors: &[f64]) -> Result<Metrics, String> {
+        self.simulator
+            .metrics_with(&with_factors(&self.base, factors))
+            .map_err(|e| e.to_string())
+    }
+
+    /// The fitness (mm) of these factors; always finite.
+    pub fn evaluate(&self, factors: &[f64]) -> f64 {
+        match self.metrics(factors) {
+            Ok(m) => self.score(&m),
+            Err(_) => 2.0 * PENALTY_MM,
+        }
+    }
+
+    /// The fitness of a run's metrics.
+    pub fn score(&self, m: &Metrics) -> f64 {
+        if m.is_stable() {
+            match self.fitness {
+                Fitness::Mean => m.mean_abs_error,
+                Fitness::Max => m.max_abs_error,
+            }
+        } else {
+            let planned = self.simulator.samples().max(1) as f64;
+            PENALTY_MM * (2.0 - m.samples as f64 / planned)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::path::builtin;
+
+    #[test]
+    fn paper_factors_score_the_simulators_metrics_and_divergence_is_penalised() {
+        let circle = Path::Arc(builtin::circle());
+        let objective = ContourObjective::new(
+            circle.clone(),
+            crate::sim::PAPER_CIRCLE_FEED,
+            "paper",
+            Fitness::Mean,
+        )
+        .unwrap();
+        let paper = [1.0, 1.2, 87.0, 8.5, 4.0];
+        let sim = Simulator::new(SimConfig::new(circle, crate::sim::PAPER_CIRCLE_FEED)).unwrap();
+        let m = sim.metrics();
+        assert_eq!(objective.evaluate(&paper), m.mean_abs_error);
+        assert!(m.mean_abs_error > 0.0 && m.mean_abs_error < 1e-3);
+        // Even absurd factors stay stable: the correction is bounded by ccc.limit.
+        let wild = objective.evaluate(&[5.0, 5.0, 1e9, 1e9, 1e9]);
+        assert!(wild.is_finite() && wild < 1.0, "{wild}");
+        // A diverged run scores above any stable one, less so the later it diverged.
+        let diverged = |samples| Metrics {
+            samples,
+            divergence: Some(crate::sim::Divergence {
+                k: samples,
+                t: samples as f64 * 1e-3,
+                kind: crate::sim::DivergenceKind::NonFinite,
+                value: f64::NAN,
+            }),
+            ..m
+        };
+        let early = objective.score(&diverged(10));
+        let late = objective.score(&diverged(1500));
+        assert!(early > late && late > PENALTY_MM && early.is_finite());
+        assert!(plant_preset("steel").is_err());
+    }
+}
