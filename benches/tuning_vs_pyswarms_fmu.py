@@ -18,7 +18,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-import pyswarms as ps
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests" / "fmpy"))
@@ -54,6 +53,7 @@ def main():
 
     logging.disable(logging.CRITICAL)
     os.chdir(tempfile.mkdtemp())  # pyswarms writes report.log into the working directory
+    import pyswarms as ps
     optimizer = ps.single.GlobalBestPSO(n_particles=args.particles, dimensions=5,
                                         options={"c1": 1.49445, "c2": 1.49445, "w": 0.729},
                                         bounds=(np.array(LOWER), np.array(UPPER)))

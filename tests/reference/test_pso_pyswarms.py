@@ -11,7 +11,6 @@ import logging
 import statistics
 
 import numpy as np
-import pyswarms as ps
 
 SEEDS, SWARM, ITERATIONS = 20, 30, 200
 
@@ -25,6 +24,8 @@ TOLERANCE = {"sphere": 1e-8, "rosenbrock": 4.0, "rastrigin": 10.0}
 
 
 def pyswarms_runs(f, bound):
+    import pyswarms as ps  # imported late: it creates report.log in the working directory
+
     logging.disable(logging.CRITICAL)  # pyswarms logs every run
     finals = []
     for seed in range(SEEDS):
