@@ -561,6 +561,61 @@ fn logging_categories_are_honoured_and_errors_always_logged() {
 }
 
 #[test]
+fn a_logger_may_call_back_into_the_instance() {
+    let i = Instance::new(&plant::INFO);
+    i.start();
+    i.log
+        .reenter
+        .store(i.c, std::sync::atomic::Ordering::SeqCst);
+    // The error is logged while the call is in progress; the logger's own call must get
+    // through instead of deadlocking on the instance.
+    let c = i.c as usize;
+    let (sender, receiver) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let status = unsafe { lib().fmi2DoStep(c as fmi2Component, 0.0, -1.0, 1) };
+        sender.send(status).unwrap();
+    });
+    let status = receiver
+        .recv_timeout(std::time::Duration::from_secs(10))
+        .expect("fmi2DoStep deadlocked in its logger callback");
+    assert_eq!(status, ERROR);
+    let records = i.records();
+    assert!(
+        records
+            .iter()
+            .any(|r| r.category == "reentered" && r.message.ends_with("returned 0")),
+        "{records:?}"
+    );
+}
+
+#[test]
+fn debug_logging_with_categories_logs_only_those() {
+    let (c, log, _cb) = instantiate_raw(
+        Some("cat"),
+        fmi2Type_fmi2CoSimulation,
+        Some(&plant::INFO.guid()),
+        None,
+        true,
+    );
+    let only = cstr("logStatusWarning");
+    let p = only.as_ptr();
+    assert_eq!(unsafe { lib().fmi2SetDebugLogging(c, 1, 1, &p) }, OK);
+    log.records.lock().unwrap().clear();
+    unsafe {
+        assert_eq!(lib().fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
+        assert_eq!(lib().fmi2EnterInitializationMode(c), OK);
+        assert_eq!(lib().fmi2ExitInitializationMode(c), OK);
+    }
+    // Neither call traces (logAll) nor events (logEvents): only warnings were asked for.
+    assert!(
+        log.records.lock().unwrap().is_empty(),
+        "{:?}",
+        log.records.lock().unwrap()
+    );
+    unsafe { lib().fmi2FreeInstance(c) };
+}
+
+#[test]
 fn messages_are_always_passed_through_a_percent_s_format() {
     let (c, log, _cb) = instantiate_raw(
         Some("%s%n%x"),
@@ -782,7 +837,9 @@ fn state_save_restore_and_serialization_give_bit_identical_trajectories() {
     // Serialize, deserialize into a fresh instance, continue there.
     let (s, bytes) = i.serialize(state);
     assert_eq!(s, OK);
+    // A state saved after initialization goes into an initialized instance.
     let other = Instance::new(&plant::INFO);
+    other.start();
     let (s, mut restored) = other.deserialize(&bytes);
     assert_eq!(s, OK);
     assert_eq!(other.set_state(restored), OK);
@@ -836,6 +893,28 @@ fn corrupt_truncated_and_foreign_state_bytes_are_refused() {
     assert_eq!(i.get_real(POS_X), before);
     i.free_state(&mut state);
     probe.free_state(&mut probe_state);
+}
+
+#[test]
+fn restoring_a_state_keeps_the_mode_and_refuses_mixing_before_and_after_initialization() {
+    let i = Instance::new(&plant::INFO);
+    let (_, mut early) = i.get_state();
+    i.start();
+    run_plant(&i, 0, 10);
+    let (_, mut running) = i.get_state();
+    // Saved before initialization: refused now, and the instance carries on.
+    assert_eq!(i.set_state(early), ERROR);
+    assert!(i.last_error().contains("saved before initialization"));
+    run_plant(&i, 10, 20);
+    // After termination a running state restores the values but not the ability to step.
+    assert_eq!(i.terminate(), OK);
+    assert_eq!(i.set_state(running), OK);
+    assert_eq!(i.step(0.01, 0.001), ERROR);
+    assert!(i
+        .last_error()
+        .contains("illegal call sequence (state Terminated)"));
+    i.free_state(&mut early);
+    i.free_state(&mut running);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -6,26 +6,9 @@ use std::fmt::Write;
 
 use contour_fmu::fmi2::LogCategory;
 use contour_fmu::models::units::{self, UnitDefinition};
-use contour_fmu::models::{Causality, ModelInfo, Start, Variability, Variable};
+use contour_fmu::models::{Causality, ModelInfo, Start, Variable};
 
 use crate::escape;
-
-fn causality(v: &Variable) -> &'static str {
-    match v.causality {
-        Causality::Parameter => "parameter",
-        Causality::Input => "input",
-        Causality::Output => "output",
-    }
-}
-
-fn variability(v: &Variable) -> &'static str {
-    match v.variability {
-        Variability::Fixed => "fixed",
-        Variability::Tunable => "tunable",
-        Variability::Discrete => "discrete",
-        Variability::Continuous => "continuous",
-    }
-}
 
 fn number(x: f64) -> String {
     // Debug formatting round-trips every f64 exactly and never loses the exponent.
@@ -161,8 +144,8 @@ pub fn render(model: &ModelInfo) -> String {
             escape(v.name),
             v.vr,
             escape(v.description),
-            causality(v),
-            variability(v),
+            v.causality.name(),
+            v.variability.name(),
         )
         .unwrap();
         writeln!(w, "      {}", type_element(v)).unwrap();

@@ -73,26 +73,33 @@ unsafe fn dispatch(
     };
     let result = catch_unwind(AssertUnwindSafe(|| {
         let mut instance = lock(cell);
-        if !call.is_allowed_in(instance.mode) {
+        let status = if !call.is_allowed_in(instance.mode) {
             let failure =
                 Failure::error(format!("illegal call sequence (state {:?})", instance.mode));
-            return instance.report(call, &failure);
+            instance.report(call, &failure)
+        } else {
+            if instance.logger.is_enabled(Category::All) {
+                let trace = format!("{} called", call.name());
+                instance.logger.log(Status::Ok, Category::All, &trace);
+            }
+            match body(&mut instance) {
+                Ok(()) => Status::Ok,
+                Err(failure) => instance.report(call, &failure),
+            }
+        };
+        // Sent after the lock is released: the importer's logger may call us back.
+        let outbox = instance.logger.take();
+        drop(instance);
+        if let Some(outbox) = outbox {
+            outbox.send();
         }
-        instance.logger.log(
-            Status::Ok,
-            Category::All,
-            &format!("{} called", call.name()),
-        );
-        match body(&mut instance) {
-            Ok(()) => Status::Ok,
-            Err(failure) => instance.report(call, &failure),
-        }
+        status
     }));
     match result {
         Ok(status) => status.code(),
         Err(payload) => {
             let message = panic_text(payload.as_ref());
-            let caught = catch_unwind(AssertUnwindSafe(|| {
+            let _ = catch_unwind(AssertUnwindSafe(|| {
                 let mut instance = lock(cell);
                 instance.mode = Mode::Fatal;
                 instance.report(
@@ -102,8 +109,12 @@ unsafe fn dispatch(
                         message: format!("internal error (panic): {message}"),
                     },
                 );
+                let outbox = instance.logger.take();
+                drop(instance);
+                if let Some(outbox) = outbox {
+                    outbox.send();
+                }
             }));
-            drop(caught);
             Status::Fatal.code()
         }
     }
@@ -187,6 +198,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 Category::StatusError,
                 &format!("fmi2Instantiate: {message}"),
             );
+            logger.flush();
             None
         };
         if name.trim().is_empty() {
@@ -226,6 +238,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
         }
         let instance = Instance::new(info, environment, logger);
         instance.log_event(&format!("instantiated {} (GUID {guid})", info.identifier));
+        instance.logger.flush();
         let cell = Box::new(InstanceCell {
             tag: LIVE_TAG,
             instance: Mutex::new(instance),

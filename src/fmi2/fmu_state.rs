@@ -10,6 +10,8 @@ use super::state_machine::Mode;
 use crate::models::Values;
 
 const MAGIC: &[u8; 8] = b"CCCFMUst";
+/// The library that wrote a state; models' internal layouts may change between versions.
+pub const LIBRARY_VERSION: &str = env!("CARGO_PKG_VERSION");
 const FORMAT_VERSION: u16 = 1;
 const HEADER: usize = MAGIC.len() + 2;
 const TRAILER: usize = 4;
@@ -17,6 +19,8 @@ const TRAILER: usize = 4;
 /// Everything needed to put an instance back where it was.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Snapshot {
+    /// [`LIBRARY_VERSION`] of the writer.
+    pub library: String,
     /// GUID of the model the state belongs to; restoring into another model is refused.
     pub guid: String,
     pub mode: Mode,
@@ -72,6 +76,7 @@ mod tests {
         let mut values = Values::from_table(crate::models::xy_servo_plant::INFO.variables);
         values.set(0, Value::Real(1.5));
         Snapshot {
+            library: LIBRARY_VERSION.into(),
             guid: "{guid}".into(),
             mode: Mode::StepComplete,
             time: 0.25,

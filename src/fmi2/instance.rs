@@ -257,6 +257,7 @@ impl Instance {
     pub fn snapshot(&self) -> Outcome<Vec<u8>> {
         let model = self.model.save_state().map_err(Failure::error)?;
         fmu_state::encode(&Snapshot {
+            library: fmu_state::LIBRARY_VERSION.to_string(),
             guid: self.guid.clone(),
             mode: self.mode,
             time: self.time,
@@ -277,12 +278,22 @@ impl Instance {
                 snapshot.guid, self.info.identifier, self.guid
             )));
         }
+        if snapshot.library != fmu_state::LIBRARY_VERSION {
+            // The GUID covers the interface, not the model's internal state layout.
+            return Err(Failure::error(format!(
+                "the FMU state was saved by contour-fmu {}, this is {}",
+                snapshot.library,
+                fmu_state::LIBRARY_VERSION
+            )));
+        }
         let table = self.info.variables;
         let fits = snapshot.values.len() == table.len()
-            && table
-                .iter()
-                .all(|v| snapshot.values.get(v.vr).var_type() == v.var_type());
-        if !fits || matches!(snapshot.mode, Mode::Error | Mode::Fatal) {
+            && table.iter().all(|v| {
+                let value = snapshot.values.get(v.vr);
+                value.var_type() == v.var_type()
+                    && (v.causality == Causality::Output || v.check(value).is_ok())
+            });
+        if !fits || snapshot.mode == Mode::Fatal {
             return Err(Failure::error(
                 "the FMU state does not fit this model's variables",
             ));
@@ -290,14 +301,41 @@ impl Instance {
         Ok(snapshot)
     }
 
+    /// The mode after restoring a snapshot taken in `saved`: the state machine has no
+    /// transition for fmi2SetFMUstate, so the mode stays, except that a snapshot is the way
+    /// out of the error state. Mixing states from before and after initialization is refused.
+    fn mode_after_restore(&self, saved: Mode) -> Outcome<Mode> {
+        let initialized = |m: Mode| !matches!(m, Mode::Instantiated | Mode::Initialization);
+        if self.mode == Mode::Error {
+            return Ok(saved);
+        }
+        if initialized(saved) != initialized(self.mode) {
+            return Err(Failure::error(format!(
+                "the FMU state was saved {} initialization and cannot be restored {} it",
+                if initialized(saved) {
+                    "after"
+                } else {
+                    "before"
+                },
+                if initialized(self.mode) {
+                    "after"
+                } else {
+                    "before"
+                },
+            )));
+        }
+        Ok(self.mode)
+    }
+
     /// Restores a snapshot; nothing changes when it is refused.
     pub fn restore(&mut self, bytes: &[u8]) -> Outcome {
         let snapshot = self.check_snapshot(bytes)?;
+        let mode = self.mode_after_restore(snapshot.mode)?;
         self.model
             .restore_state(&snapshot.model)
             .map_err(Failure::error)?;
         self.values = snapshot.values;
-        self.mode = snapshot.mode;
+        self.mode = mode;
         self.time = snapshot.time;
         self.last_successful_time = snapshot.time;
         self.stop_time = snapshot.stop_time;

@@ -2,9 +2,10 @@
 //! descriptions. Messages are always passed as the argument of a `"%s"` format, so a
 //! `%` in a message can never be read as a conversion.
 
+use std::cell::RefCell;
 use std::ffi::{c_char, CStr, CString};
 
-use fmi_sys::fmi2::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status};
+use fmi_sys::fmi2::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2String};
 
 use super::status::Status;
 
@@ -37,6 +38,17 @@ impl Category {
         }
     }
 
+    /// The name as a C string.
+    pub fn name_c(self) -> &'static CStr {
+        match self {
+            Category::Events => c"logEvents",
+            Category::StatusWarning => c"logStatusWarning",
+            Category::StatusError => c"logStatusError",
+            Category::StatusFatal => c"logStatusFatal",
+            Category::All => c"logAll",
+        }
+    }
+
     pub fn description(self) -> &'static str {
         match self {
             Category::Events => {
@@ -64,11 +76,36 @@ impl Category {
     }
 }
 
+/// Where an instance's messages go. Messages are queued while the instance is locked and
+/// sent once the lock is released ([`Logger::take`] then [`Outbox::send`]): an importer's
+/// logger may call back into the same instance, which must not deadlock.
 pub struct Logger {
     callback: fmi2CallbackLogger,
     environment: fmi2ComponentEnvironment,
     instance_name: CString,
     enabled: [bool; 5],
+    pending: RefCell<Vec<Message>>,
+}
+
+struct Message {
+    status: Status,
+    category: Category,
+    text: CString,
+}
+
+/// Messages taken out of a [`Logger`], ready to be sent without holding the instance.
+pub struct Outbox {
+    callback: unsafe extern "C" fn(
+        fmi2ComponentEnvironment,
+        fmi2String,
+        fmi2Status,
+        fmi2String,
+        fmi2String,
+        ...
+    ),
+    environment: fmi2ComponentEnvironment,
+    instance_name: CString,
+    messages: Vec<Message>,
 }
 
 impl Logger {
@@ -83,47 +120,81 @@ impl Logger {
             environment,
             instance_name: to_c_string(instance_name),
             enabled: [logging_on; 5],
+            pending: RefCell::new(Vec::new()),
         }
     }
 
-    /// `fmi2SetDebugLogging`: with no categories the switch applies to all of them.
+    /// `fmi2SetDebugLogging` (FMI 2.0 section 2.1.5): switched on with categories, only
+    /// those are logged; on or off without categories, all of them; off with categories,
+    /// those are switched off and the rest stay as they were.
     pub fn set(&mut self, on: bool, categories: &[Category]) {
         if categories.is_empty() {
             self.enabled = [on; 5];
+            return;
+        }
+        if on {
+            self.enabled = [false; 5];
         }
         for &c in categories {
             self.enabled[c as usize] = on;
         }
     }
 
+    /// Whether messages of `category` are logged (`logAll`, when on, includes every other).
     pub fn is_enabled(&self, category: Category) -> bool {
         self.enabled[category as usize] || self.enabled[Category::All as usize]
     }
 
-    /// Sends a message; errors and fatal errors always, the rest when their category is on.
+    /// Queues a message: errors and fatal errors always, the rest when their category is on.
     pub fn log(&self, status: Status, category: Category, message: &str) {
         let always = matches!(status, Status::Error | Status::Fatal);
-        if !always && !self.is_enabled(category) {
+        if self.callback.is_none() || (!always && !self.is_enabled(category)) {
             return;
         }
-        let Some(callback) = self.callback else {
-            return;
-        };
-        let category = to_c_string(category.name());
-        let message = to_c_string(message);
+        self.pending.borrow_mut().push(Message {
+            status,
+            category,
+            text: to_c_string(message),
+        });
+    }
+
+    /// The queued messages, if any (nothing is allocated when there are none).
+    pub fn take(&self) -> Option<Outbox> {
+        let callback = self.callback?;
+        let messages = std::mem::take(&mut *self.pending.borrow_mut());
+        (!messages.is_empty()).then(|| Outbox {
+            callback,
+            environment: self.environment,
+            instance_name: self.instance_name.clone(),
+            messages,
+        })
+    }
+
+    /// Sends the queued messages now (for callers that hold no lock).
+    pub fn flush(&self) {
+        if let Some(outbox) = self.take() {
+            outbox.send();
+        }
+    }
+}
+
+impl Outbox {
+    pub fn send(self) {
         let format: &CStr = c"%s";
-        // SAFETY: the importer guaranteed the callback and its environment stay valid for
-        // the instance's lifetime; every string is NUL-terminated and outlives the call,
-        // and the variadic argument matches the "%s" conversion.
-        unsafe {
-            callback(
-                self.environment,
-                self.instance_name.as_ptr(),
-                status as fmi2Status,
-                category.as_ptr(),
-                format.as_ptr(),
-                message.as_ptr() as *const c_char,
-            );
+        for m in &self.messages {
+            // SAFETY: the importer guaranteed the callback and its environment stay valid
+            // for the instance's lifetime; every string is NUL-terminated and outlives the
+            // call, and the variadic argument matches the "%s" conversion.
+            unsafe {
+                (self.callback)(
+                    self.environment,
+                    self.instance_name.as_ptr(),
+                    m.status as fmi2Status,
+                    m.category.name_c().as_ptr(),
+                    format.as_ptr(),
+                    m.text.as_ptr() as *const c_char,
+                );
+            }
         }
     }
 }

@@ -49,6 +49,10 @@ fn percent_decode(text: &str) -> Option<String> {
     while i < bytes.len() {
         if bytes[i] == b'%' {
             let hex = text.get(i + 1..i + 3)?;
+            // from_str_radix alone would also take a sign ("%+1").
+            if !hex.bytes().all(|b| b.is_ascii_hexdigit()) {
+                return None;
+            }
             out.push(u8::from_str_radix(hex, 16).ok()?);
             i += 3;
         } else {
@@ -86,6 +90,7 @@ mod tests {
             "file:relative/path",
             "file:///bad%2",
             "file:///bad%zz",
+            "file:///bad%+1",
         ] {
             assert!(resource_dir(uri).is_err(), "{uri}");
         }

@@ -3,7 +3,7 @@
 //! fuzzy-adapted PID gains (DESIGN 4.2, 4.3). The control law runs every `Ts` inside
 //! `fmi2DoStep` on the inputs held over the step, whatever the communication step.
 
-use super::sample_clock::SampleClock;
+use super::sample_clock::{check_period, SampleClock};
 use super::variables::{Start, Values, Variable, Vr};
 use super::{
     decode_state, encode_state, geometry, DefaultExperiment, Environment, Model, ModelInfo,
@@ -91,7 +91,13 @@ static VARIABLES: [Variable; 31 + geometry::COUNT] = [
     Variable::output(CCC_KP, "ccc.Kp", "Contour PID gain Kp in use").unit("1/s"),
     Variable::output(CCC_KI, "ccc.Ki", "Contour PID gain Ki in use").unit("1/s2"),
     Variable::output(CCC_KD, "ccc.Kd", "Contour PID gain Kd in use"),
-    Variable::parameter(TS, "Ts", Start::Real(DEFAULT.ts), "Control period (> 0)").unit("s"),
+    Variable::parameter(
+        TS,
+        "Ts",
+        Start::Real(DEFAULT.ts),
+        "Control period (at least 1 us)",
+    )
+    .unit("s"),
     real(
         AXIS_GAINS,
         "axis.x.Kp",
@@ -295,6 +301,7 @@ fn estimator(values: &Values) -> Result<Estimator, String> {
 
 impl Model for ContourCcc2D {
     fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult {
+        check_period("Ts", values.real(TS))?;
         let config = config(values);
         let controller =
             CrossCoupledController::new(config, estimator(values)?).map_err(|e| e.to_string())?;

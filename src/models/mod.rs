@@ -89,7 +89,7 @@ impl ModelInfo {
         hash.update(b"fmi2-cs\0");
         hash.update(self.identifier.as_bytes());
         for v in self.variables {
-            hash.update(format!("\0{v:?}").as_bytes());
+            hash.update(canonical_interface(v).as_bytes());
         }
         let d = hash.finalize();
         let hex: String = d.iter().take(16).map(|b| format!("{b:02x}")).collect();
@@ -106,6 +106,43 @@ impl ModelInfo {
     pub fn variable(&self, vr: Vr) -> Option<&'static Variable> {
         self.variables.get(vr)
     }
+}
+
+/// One variable's attributes as a fixed text, for the GUID: explicit fields (numbers by
+/// their bits, units with their definitions) rather than `Debug`, whose format Rust does
+/// not promise to keep.
+fn canonical_interface(v: &Variable) -> String {
+    let bits = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{:016x}", x.to_bits()));
+    let start = match v.start {
+        Start::Real(x) => format!("Real={}", bits(Some(x))),
+        Start::Integer(x) => format!("Integer={x}"),
+        Start::Boolean(x) => format!("Boolean={x}"),
+        Start::String(x) => format!("String={x}"),
+    };
+    let unit = v
+        .unit
+        .map_or("-".to_string(), |name| match units::find(name) {
+            Some(u) => format!(
+                "{name}:kg{},m{},s{},A{},rad{},{}",
+                u.kg,
+                u.m,
+                u.s,
+                u.a,
+                u.rad,
+                bits(Some(u.factor))
+            ),
+            None => format!("{name}:undefined"),
+        });
+    format!(
+        "\0{}\0{}\0{}\0{}\0{start}\0{unit}\0{}\0{}\0{}",
+        v.vr,
+        v.name,
+        v.causality.name(),
+        v.variability.name(),
+        bits(v.min),
+        bits(v.max),
+        v.description
+    )
 }
 
 /// Every model this library serves (the packager builds one FMU per entry).

@@ -4,7 +4,7 @@
 
 use std::f64::consts::PI;
 
-use super::sample_clock::SampleClock;
+use super::sample_clock::{check_period, SampleClock};
 use super::variables::{Start, Values, Variable, Vr};
 use super::{
     decode_state, encode_state, geometry, DefaultExperiment, Environment, Model, ModelInfo,
@@ -45,7 +45,13 @@ static VARIABLES: [Variable; 6 + geometry::COUNT] = [
         "Feed rate along the path (> 0)",
     )
     .unit("mm/s"),
-    Variable::parameter(TS, "Ts", Start::Real(1e-3), "Interpolation period (> 0)").unit("s"),
+    Variable::parameter(
+        TS,
+        "Ts",
+        Start::Real(1e-3),
+        "Interpolation period (at least 1 us)",
+    )
+    .unit("s"),
     G[0],
     G[1],
     G[2],
@@ -122,7 +128,7 @@ impl PathInterpolator2D {
 impl Model for PathInterpolator2D {
     fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult {
         let feed = positive(values, FEED, "feed")?;
-        let ts = positive(values, TS, "Ts")?;
+        let ts = check_period("Ts", values.real(TS))?;
         let interpolator = Interpolator::new(path(values, &self.environment)?, feed, ts)
             .map_err(|e| e.to_string())?;
         self.state = Some(State {

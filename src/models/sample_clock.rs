@@ -7,6 +7,21 @@
 
 use serde::{Deserialize, Serialize};
 
+/// The shortest sample period a model accepts, s. A communication step costs one sample
+/// per period, so a vanishing `Ts` would make a single `fmi2DoStep` run for hours.
+pub const MIN_PERIOD: f64 = 1e-6;
+
+/// Checks a sample period parameter; the error names it.
+pub fn check_period(name: &str, period: f64) -> Result<f64, String> {
+    if period >= MIN_PERIOD && period.is_finite() {
+        Ok(period)
+    } else {
+        Err(format!(
+            "parameter '{name}' must be at least {MIN_PERIOD:e} s (got {period})"
+        ))
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SampleClock {
     start: f64,

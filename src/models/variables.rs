@@ -17,6 +17,17 @@ pub enum Causality {
     Output,
 }
 
+impl Causality {
+    /// The name FMI uses in `modelDescription.xml`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Causality::Parameter => "parameter",
+            Causality::Input => "input",
+            Causality::Output => "output",
+        }
+    }
+}
+
 /// FMI variability, restricted to what our models use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Variability {
@@ -28,6 +39,18 @@ pub enum Variability {
     Discrete,
     /// Real input or output.
     Continuous,
+}
+
+impl Variability {
+    /// The name FMI uses in `modelDescription.xml`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Variability::Fixed => "fixed",
+            Variability::Tunable => "tunable",
+            Variability::Discrete => "discrete",
+            Variability::Continuous => "continuous",
+        }
+    }
 }
 
 /// The FMI base type of a variable.

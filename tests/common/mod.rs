@@ -50,6 +50,9 @@ pub struct Record {
 #[derive(Default)]
 pub struct Log {
     pub records: Mutex<Vec<Record>>,
+    /// When set, the logger calls `fmi2GetReal` on this instance from inside the callback
+    /// (as a debugging importer may) and records the status it got.
+    pub reenter: std::sync::atomic::AtomicPtr<c_void>,
 }
 
 unsafe fn text(p: *const c_char) -> String {
@@ -80,6 +83,20 @@ unsafe extern "C" fn capture(
     } else {
         String::new()
     };
+    let reenter = log
+        .reenter
+        .swap(std::ptr::null_mut(), std::sync::atomic::Ordering::SeqCst);
+    if !reenter.is_null() {
+        let (vr, mut value) = (0u32, 0.0);
+        let status = lib().fmi2GetReal(reenter, &vr, 1, &mut value);
+        log.records.lock().unwrap().push(Record {
+            status,
+            category: "reentered".into(),
+            format: String::new(),
+            message: format!("fmi2GetReal from the logger returned {status}"),
+            instance: text(instance),
+        });
+    }
     log.records.lock().unwrap().push(Record {
         status,
         category: text(category),

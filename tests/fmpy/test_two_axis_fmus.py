@@ -175,13 +175,16 @@ def test_nan_input_is_refused_and_outputs_stay(controller):
 
 
 @pytest.mark.parametrize("fixture, values, words", [
-    ("controller", {"Ts": 0.0}, "parameter Ts = 0 is invalid"),
-    ("controller", {"Ts": -0.001}, "parameter Ts = -0.001 is invalid"),
+    ("controller", {"Ts": 0.0}, "parameter 'Ts' must be at least 1e-6 s (got 0)"),
+    ("controller", {"Ts": -0.001}, "parameter 'Ts' must be at least 1e-6 s (got -0.001)"),
+    ("controller", {"Ts": 1e-10}, "parameter 'Ts' must be at least 1e-6 s"),
+    ("controller", {"fuzzy__enable": True, "ccc__limit": 0.0}, "parameter ccc.limit = 0 is invalid"),
     ("controller", {"estimator": "kalman"}, "parameter 'estimator': unknown contour estimator 'kalman'"),
     ("controller", {"estimator": "arc", "arc__r": 0.0}, "parameters 'arc.*'"),
     ("interpolator", {"feed": 0.0}, "parameter 'feed' must be > 0"),
     ("interpolator", {"feed": -5.0}, "parameter 'feed' must be > 0"),
-    ("interpolator", {"Ts": 0.0}, "parameter 'Ts' must be > 0"),
+    ("interpolator", {"Ts": 0.0}, "parameter 'Ts' must be at least 1e-6 s"),
+    ("interpolator", {"Ts": 1e-9}, "parameter 'Ts' must be at least 1e-6 s"),
     ("interpolator", {"path": "spiral"}, "unknown path 'spiral'"),
 ])
 def test_bad_parameters_are_refused_when_initialization_ends(request, fixture, values, words):

@@ -2,8 +2,9 @@
 //! controller is built: they run inside `fmi2DoStep`, where allocation means unbounded
 //! latency. The same for the other per-sample work: an interpolator step, a free-curve
 //! estimate, a true-error query and one closed-loop sample of `sim` (the PSO runs that
-//! thousands of times). A counting global allocator (this test binary only) counts the
-//! allocations made by the current thread.
+//! thousands of times), and the whole `fmi2DoStep`/`fmi2GetReal`/`fmi2SetReal` round of
+//! every FMU, called through the C functions linked from the library. A counting global
+//! allocator (this test binary only) counts the allocations made by the current thread.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -52,6 +53,117 @@ unsafe impl GlobalAlloc for Counting {
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
+
+mod common;
+
+use common::{callbacks, cstr, fmi2Component, fmi2Status, fmi2ValueReference, Log};
+use contour_fmu::models;
+
+// The library's exported functions, linked statically from the rlib (not dlopened), so
+// the counting allocator sees their allocations.
+extern "C" {
+    fn fmi2Instantiate(
+        name: *const std::ffi::c_char,
+        fmu_type: u32,
+        guid: *const std::ffi::c_char,
+        resources: *const std::ffi::c_char,
+        functions: *const common::fmi2CallbackFunctions,
+        visible: i32,
+        logging_on: i32,
+    ) -> fmi2Component;
+    fn fmi2SetupExperiment(
+        c: fmi2Component,
+        tol_def: i32,
+        tol: f64,
+        start: f64,
+        stop_def: i32,
+        stop: f64,
+    ) -> fmi2Status;
+    fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status;
+    fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status;
+    fn fmi2DoStep(c: fmi2Component, t: f64, h: f64, no_prior: i32) -> fmi2Status;
+    fn fmi2GetReal(
+        c: fmi2Component,
+        vr: *const fmi2ValueReference,
+        n: usize,
+        v: *mut f64,
+    ) -> fmi2Status;
+    fn fmi2SetReal(
+        c: fmi2Component,
+        vr: *const fmi2ValueReference,
+        n: usize,
+        v: *const f64,
+    ) -> fmi2Status;
+    fn fmi2FreeInstance(c: fmi2Component);
+}
+
+#[test]
+fn an_fmi_step_round_allocates_nothing_with_logging_off() {
+    for model in models::all() {
+        let log = Log::default();
+        let functions = callbacks(&log);
+        let (name, guid) = (cstr("no-alloc"), cstr(&model.guid()));
+        // SAFETY: valid strings and callbacks that outlive the instance.
+        let c = unsafe {
+            fmi2Instantiate(
+                name.as_ptr(),
+                1,
+                guid.as_ptr(),
+                std::ptr::null(),
+                &*functions,
+                0,
+                0,
+            )
+        };
+        assert!(!c.is_null());
+        let inputs: Vec<fmi2ValueReference> = model
+            .variables
+            .iter()
+            .filter(|v| {
+                v.causality == models::Causality::Input && v.var_type() == models::VarType::Real
+            })
+            .map(|v| v.vr as u32)
+            .collect();
+        let outputs: Vec<fmi2ValueReference> = model
+            .variables
+            .iter()
+            .filter(|v| {
+                v.causality == models::Causality::Output && v.var_type() == models::VarType::Real
+            })
+            .map(|v| v.vr as u32)
+            .collect();
+        let mut read = vec![0.0; outputs.len()];
+        let write: Vec<f64> = (0..inputs.len()).map(|i| 0.1 * i as f64).collect();
+        // SAFETY: a live instance and arrays of the stated lengths.
+        unsafe {
+            assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
+            assert_eq!(fmi2EnterInitializationMode(c), 0);
+            assert_eq!(fmi2ExitInitializationMode(c), 0);
+            let mut round = |k: usize| {
+                let t = k as f64 * 1e-3;
+                assert_eq!(
+                    fmi2SetReal(c, inputs.as_ptr(), inputs.len(), write.as_ptr()),
+                    0
+                );
+                assert_eq!(fmi2DoStep(c, t, 1e-3, 1), 0);
+                assert_eq!(
+                    fmi2GetReal(c, outputs.as_ptr(), outputs.len(), read.as_mut_ptr()),
+                    0
+                );
+            };
+            round(0);
+            round(1);
+            let n = allocations_during(|| (2..200).for_each(&mut round));
+            assert_eq!(
+                n, 0,
+                "{}: {n} allocations in 198 step rounds",
+                model.identifier
+            );
+            fmi2FreeInstance(c);
+        }
+        assert!(log.records.lock().unwrap().is_empty());
+    }
+}
 
 fn allocations_during(f: impl FnOnce()) -> u64 {
     let before = ALLOCATIONS.with(Cell::get);
