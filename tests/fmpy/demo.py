@@ -151,7 +151,8 @@ def main(argv=None):
                 document = tune(args.ccc_tune, args.out, path, feed, algorithm)
                 histories[algorithm] = json.loads(document.read_text())["history_mm"]
             plot_histories(args.out, path, histories)
-            variants.append(("PSO-tuned CCC", start_values(args.out / f"tuned_{path}_improved.json")))
+            for algorithm in ("improved", "standard"):
+                variants.append((f"PSO {algorithm}", start_values(args.out / f"tuned_{path}_{algorithm}.json")))
         elif args.params:
             variants.append(("PSO-tuned CCC", start_values(args.params)))
         runs = []
