@@ -10,9 +10,10 @@ CARGO  ?= cargo
 
 setup: libclang $(VENV)/.installed
 
-# fmi-sys generates its FMI bindings with bindgen, which needs libclang.
+# fmi-sys generates its FMI bindings with bindgen, which needs libclang (the C API in
+# libclang-dev; Debian images often carry only libclang-cpp, which bindgen cannot use).
 libclang:
-	@if ! ls /usr/lib/llvm-*/lib/libclang*.so* >/dev/null 2>&1 && ! ldconfig -p | grep -q libclang; then \
+	@if ! dpkg -s libclang-dev >/dev/null 2>&1; then \
 		echo "installing libclang-dev (needed by bindgen)"; \
 		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libclang-dev; \
 	fi
