@@ -5,6 +5,7 @@ cross-check files."""
 import json
 import math
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -255,3 +256,15 @@ def test_cross_check_files_reproduce_through_simulate_fmu(fmu_dir, tmp_path):
     for name in reference.dtype.names[1:]:
         assert np.max(np.abs(result[name] - reference[name])) < 1e-9, name
     assert np.max(np.abs(reference["u.x"])) > 1.0
+
+
+def test_a_path_file_in_the_fmus_resources_folder_is_found_by_its_relative_name(interpolator):
+    resources = Path(interpolator.dir) / "resources"
+    resources.mkdir(exist_ok=True)
+    (resources / "diagonal.json").write_text(
+        json.dumps({"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[1, 1], [7, 9]]}))
+    interpolator.set(path="diagonal.json", feed=10.0)
+    interpolator.fmu.exitInitializationMode()
+    assert np.allclose(interpolator.reals(["ref.x", "ref.y"]), [1.0, 1.0])
+    interpolator.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.5)
+    assert np.allclose(interpolator.reals(["ref.x", "ref.y"]), [4.0, 5.0], atol=1e-9)
