@@ -29,7 +29,7 @@ from fmpy.container_fmu.config import Component, Connection
 from fmpy.model_description import (CoSimulation, DefaultExperiment, ModelDescription,
                                     ModelVariable, Unknown)
 
-from master import CLOSED_LOOP_CONNECTIONS
+from wiring import CLOSED_LOOP_CONNECTIONS
 
 _FMI3_TYPES = {"Real": "Float64", "Integer": "Int32", "Enumeration": "Int32"}
 

@@ -23,20 +23,14 @@ from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 from libcosimpy.CosimObserver import CosimObserver
 from libcosimpy.CosimSlave import CosimLocalSlave
 
+from wiring import CLOSED_LOOP_CONNECTIONS
+
 UNITS = {  # instance name -> FMU file, as in master.closed_loop
     "interpolator": "PathInterpolator2D.fmu",
     "controller": "ContourCCC2D.fmu",
     "plant": "XYServoPlant.fmu",
 }
-# master.CLOSED_LOOP_CONNECTIONS; repeated here so that this process loads libcosim only.
-CONNECTIONS = [
-    ("interpolator", "ref.x", "controller", "ref.x"),
-    ("interpolator", "ref.y", "controller", "ref.y"),
-    ("plant", "pos.x", "controller", "pos.x"),
-    ("plant", "pos.y", "controller", "pos.y"),
-    ("controller", "u.x", "plant", "u.x"),
-    ("controller", "u.y", "plant", "u.y"),
-]
+CONNECTIONS = CLOSED_LOOP_CONNECTIONS
 SERIES = [
     ("interpolator", "ref.x"), ("interpolator", "ref.y"),
     ("controller", "u.x"), ("controller", "u.y"), ("controller", "contourError"),

@@ -19,6 +19,8 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
+from wiring import CLOSED_LOOP_CONNECTIONS, PATH_START
+
 SCHEMES = ("gauss-seidel", "jacobi")
 
 
@@ -122,22 +124,6 @@ class Master:
         dtype = [("time", float)] + [(n, float) for n in names]
         return np.array(before, dtype=dtype), np.array(after, dtype=dtype)
 
-
-# The paper's closed loop: interpolator -> controller <- plant.
-CLOSED_LOOP_CONNECTIONS = [
-    ("interpolator", "ref.x", "controller", "ref.x"),
-    ("interpolator", "ref.y", "controller", "ref.y"),
-    ("plant", "pos.x", "controller", "pos.x"),
-    ("plant", "pos.y", "controller", "pos.y"),
-    ("controller", "u.x", "plant", "u.x"),
-    ("controller", "u.y", "plant", "u.y"),
-]
-
-# The plant starts where the path does.
-PATH_START = [
-    ("interpolator", "ref.x", "plant", "pos0.x"),
-    ("interpolator", "ref.y", "plant", "pos0.y"),
-]
 
 CLOSED_LOOP_RECORD = [
     ("interpolator", "ref.x"), ("interpolator", "ref.y"),
