@@ -44,16 +44,20 @@ pub struct FuzzyFactors {
     pub kdf: f64,
 }
 
-impl Default for FuzzyFactors {
+impl FuzzyFactors {
     /// The paper's PSO optimum (kε, kΔε, kpf, kif, kdf) = (1, 1.2, 87, 8.5, 4).
+    pub const PAPER: FuzzyFactors = FuzzyFactors {
+        ke: 1.0,
+        kde: 1.2,
+        kpf: 87.0,
+        kif: 8.5,
+        kdf: 4.0,
+    };
+}
+
+impl Default for FuzzyFactors {
     fn default() -> Self {
-        Self {
-            ke: 1.0,
-            kde: 1.2,
-            kpf: 87.0,
-            kif: 8.5,
-            kdf: 4.0,
-        }
+        Self::PAPER
     }
 }
 
@@ -74,14 +78,24 @@ pub struct CccConfig {
     pub limit: Option<f64>,
 }
 
+impl CccConfig {
+    /// The defaults documented on the fields (a constant, so FMU variable tables can use
+    /// it for their start values).
+    pub const DEFAULT: CccConfig = CccConfig {
+        mode: CccMode::Fuzzy,
+        gains0: PidGains {
+            kp: 100.0,
+            ki: 5000.0,
+            kd: 0.0,
+        },
+        fuzzy: FuzzyFactors::PAPER,
+        limit: Some(100.0),
+    };
+}
+
 impl Default for CccConfig {
     fn default() -> Self {
-        Self {
-            mode: CccMode::Fuzzy,
-            gains0: PidGains::new(100.0, 5000.0, 0.0),
-            fuzzy: FuzzyFactors::default(),
-            limit: Some(100.0),
-        }
+        Self::DEFAULT
     }
 }
 
@@ -100,14 +114,24 @@ pub struct ControllerConfig {
     pub ccc: CccConfig,
 }
 
+impl ControllerConfig {
+    /// The defaults documented on the fields (a constant, so FMU variable tables can use
+    /// it for their start values).
+    pub const DEFAULT: ControllerConfig = ControllerConfig {
+        ts: 1e-3,
+        axis: [PidGains {
+            kp: 28.5,
+            ki: 0.0,
+            kd: 0.0,
+        }; 2],
+        axis_limit: None,
+        ccc: CccConfig::DEFAULT,
+    };
+}
+
 impl Default for ControllerConfig {
     fn default() -> Self {
-        Self {
-            ts: 1e-3,
-            axis: [PidGains::p(28.5); 2],
-            axis_limit: None,
-            ccc: CccConfig::default(),
-        }
+        Self::DEFAULT
     }
 }
 

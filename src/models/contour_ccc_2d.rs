@@ -39,31 +39,8 @@ pub const FUZZY_FACTORS: Vr = 25;
 pub const ESTIMATOR: Vr = 30;
 pub const GEOMETRY: Vr = 31;
 
-const DEFAULT: ControllerConfig = ControllerConfig {
-    ts: 1e-3,
-    axis: [PidGains {
-        kp: 28.5,
-        ki: 0.0,
-        kd: 0.0,
-    }; 2],
-    axis_limit: None,
-    ccc: CccConfig {
-        mode: CccMode::Fuzzy,
-        gains0: PidGains {
-            kp: 100.0,
-            ki: 5000.0,
-            kd: 0.0,
-        },
-        fuzzy: FuzzyFactors {
-            ke: 1.0,
-            kde: 1.2,
-            kpf: 87.0,
-            kif: 8.5,
-            kdf: 4.0,
-        },
-        limit: Some(100.0),
-    },
-};
+/// Start values: the controller library's documented defaults.
+const DEFAULT: ControllerConfig = ControllerConfig::DEFAULT;
 
 const fn real(vr: Vr, name: &'static str, start: f64, description: &'static str) -> Variable {
     Variable::parameter(vr, name, Start::Real(start), description).min(0.0)
