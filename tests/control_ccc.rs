@@ -5,7 +5,7 @@
 
 use contour_fmu::contour::{ContourEstimate, ContourEstimator};
 use contour_fmu::control::{
-    CccConfig, CccMode, ConfigError, ControllerConfig, CrossCoupledController, FuzzyEngine,
+    CccConfig, CccLaw, CccMode, ConfigError, ControllerConfig, CrossCoupledController, FuzzyEngine,
     FuzzyFactors, PidGains,
 };
 use serde::{Deserialize, Serialize};
@@ -154,8 +154,16 @@ fn fuzzy_gains_follow_the_engine() {
         let deps = prev.map_or(0.0, |q| eps - q);
         prev = Some(eps);
         sum += eps;
-        // ε and Δε in µm (per sample), the engine clamps at ±3 itself.
-        let d = engine.evaluate(f.ke * eps * 1000.0, f.kde * deps * 1000.0);
+        // ε and Δε in µm (per sample), folded onto E ≤ 0 (the sign of ε, or of Δε at
+        // ε = 0, moves to EC); the engine clamps at ±3 itself.
+        let sign = if eps != 0.0 {
+            eps.signum()
+        } else {
+            deps.signum()
+        };
+        let e_in = -(f.ke * eps * 1000.0).abs();
+        let ec_in = -sign * f.kde * deps * 1000.0;
+        let d = engine.evaluate(e_in, ec_in);
         let kp = (g0.kp + f.kpf * d.dkp).max(0.0);
         let ki = (g0.ki + f.kif * d.dki).max(0.0);
         let kd = (g0.kd + f.kdf * d.dkd).max(0.0);
@@ -181,6 +189,48 @@ fn fuzzy_gains_are_plain_at_zero_error() {
     assert!(close(out.gains.0, g0.kp));
     assert!(close(out.gains.1, g0.ki));
     assert!(close(out.gains.2, (g0.kd - 4.0).max(0.0)));
+}
+
+/// The scheduled gains depend on |ε| and on whether |ε| grows, never on the sign of ε:
+/// (ε, Δε) and (−ε, −Δε) give bit-identical gains, on a grid that crosses ε = 0 and
+/// Δε = 0 and reaches past the ±3 clamp, for the paper's factors and a large-kp set.
+#[test]
+fn fuzzy_gains_are_the_same_for_mirrored_errors() {
+    let large_kp = FuzzyFactors {
+        ke: 4.0,
+        kde: 0.3,
+        kpf: 900.0,
+        kif: 40.0,
+        kdf: 2.0,
+    };
+    let mut checked = 0;
+    for factors in [FuzzyFactors::PAPER, large_kp] {
+        let config = CccConfig {
+            fuzzy: factors,
+            ..CccConfig::default()
+        };
+        let law = CccLaw::new(config, 1e-3).unwrap();
+        let steps = [
+            -5e-3, -2.4e-3, -1e-3, -3.3e-4, -1e-6, 0.0, 1e-6, 3.3e-4, 1e-3, 2.4e-3, 5e-3,
+        ];
+        let mut distinct = std::collections::BTreeSet::new();
+        for &eps in &steps {
+            for &deps in &steps {
+                let (g, _) = law.schedule(eps, deps);
+                let (m, _) = law.schedule(-eps, -deps);
+                assert_eq!(g, m, "eps {eps} deps {deps}");
+                // Only |ε| and the sign of ε·Δε (of Δε at ε = 0) matter.
+                let grows = if eps != 0.0 { eps * deps } else { deps.abs() };
+                let (a, _) = law.schedule(eps.abs(), grows.signum() * deps.abs());
+                assert_eq!(g, a, "eps {eps} deps {deps}");
+                distinct.insert(format!("{g:?}"));
+                checked += 1;
+            }
+        }
+        // The schedule is not constant, so the equalities above carry information.
+        assert!(distinct.len() > 20, "{} distinct gain sets", distinct.len());
+    }
+    assert_eq!(checked, 2 * 11 * 11);
 }
 
 #[test]

@@ -219,6 +219,28 @@ impl ControllerConfig {
     }
 }
 
+/// The normalised fuzzy inputs (E′, EC′) for contour error `error` (mm) and its change
+/// `delta` (mm per sample), before the engine's ±3 clamp:
+/// E′ = −|kε·ε|, EC′ = −s·kΔε·Δε with ε, Δε in µm and s = sgn(ε) (sgn(Δε) when ε = 0).
+///
+/// The rule tables are not odd in (E, EC); read at the signed ε they would give a path
+/// and its mirror image different gains. Folded, the gains depend only on |ε| and on
+/// whether |ε| grows (EC′ < 0) or shrinks (EC′ > 0), read from the half of the tables
+/// where Kp grows and Ki shrinks as |ε| grows. The increments stay unsigned: the PID's
+/// product with ε carries the sign of the correction (DESIGN 4.3).
+pub fn folded_inputs(factors: &FuzzyFactors, error: f64, delta: f64) -> (f64, f64) {
+    // Compare with 0 rather than use `signum`, which gives ±1 for ±0.
+    let s = if error > 0.0 || (error == 0.0 && delta > 0.0) {
+        1.0
+    } else {
+        -1.0
+    };
+    (
+        -(factors.ke * error * 1e3).abs(),
+        -s * factors.kde * delta * 1e3,
+    )
+}
+
 /// The scalar contour law ε → U_c with optional fuzzy gain scheduling. Separate from the
 /// two-axis controller so other CCCs (e.g. five-axis, one law per contour error) can
 /// reuse it.
@@ -271,8 +293,10 @@ impl CccLaw {
 
     /// Gains for contour error `error` (mm) and its change `delta` (mm per sample).
     ///
-    /// Fixed mode returns `gains0`; fuzzy mode `gains0 + k·ΔK′` with
-    /// E = clamp(kε·1000·ε, ±3), EC = clamp(kΔε·1000·Δε, ±3), each gain clamped at ≥ 0.
+    /// Fixed mode returns `gains0`; fuzzy mode `gains0 + k·ΔK′` with the rule tables read
+    /// at the folded inputs of [`folded_inputs`], each gain clamped at ≥ 0. The gains are
+    /// the same for (ε, Δε) and (−ε, −Δε), so a path and its mirror image get the same
+    /// control (DESIGN 4.3, direction symmetry).
     pub fn schedule(&self, error: f64, delta: f64) -> (PidGains, FuzzyOutput) {
         let g0 = self.config.gains0;
         match self.config.mode {
@@ -280,10 +304,9 @@ impl CccLaw {
             CccMode::Fixed => (g0, FuzzyOutput::default()),
             CccMode::Fuzzy => {
                 let f = &self.config.fuzzy;
+                let (e, ec) = folded_inputs(f, error, delta);
                 // The engine clamps its inputs to ±3.
-                let out = self
-                    .engine
-                    .evaluate(f.ke * error * 1e3, f.kde * delta * 1e3);
+                let out = self.engine.evaluate(e, ec);
                 let gains = PidGains::new(
                     (g0.kp + f.kpf * out.dkp).max(0.0),
                     (g0.ki + f.kif * out.dki).max(0.0),

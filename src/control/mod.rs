@@ -7,8 +7,8 @@ pub mod pid;
 pub mod rules;
 
 pub use ccc::{
-    CccConfig, CccLaw, CccMode, CccStep, ConfigError, ControlOutput, ControllerConfig,
-    CrossCoupledController, FuzzyFactors,
+    folded_inputs, CccConfig, CccLaw, CccMode, CccStep, ConfigError, ControlOutput,
+    ControllerConfig, CrossCoupledController, FuzzyFactors,
 };
 pub use fuzzy::{FuzzyEngine, FuzzyOutput};
 pub use pid::{Pid, PidGains};

@@ -165,6 +165,29 @@ impl Path {
     pub fn end_point(&self) -> [f64; 2] {
         self.point(self.param_range().1)
     }
+
+    /// The mirror image about the x axis (y → −y), travelled in the mirrored sense: a
+    /// counter-clockwise circle becomes a clockwise one. The controller must give the
+    /// mirrored run exactly (the contour error negated sample by sample), which is how the
+    /// tests and the demo check that it does not depend on the direction of travel.
+    pub fn mirrored(&self) -> Path {
+        let flip = |p: [f64; 2]| [p[0], -p[1]];
+        let rebuilt = match self {
+            Path::Line(l) => Line::new(flip(l.start()), flip(l.end())).map(Path::Line),
+            Path::Arc(a) => {
+                Arc::new(flip(a.center()), a.radius(), -a.start_angle(), -a.sweep()).map(Path::Arc)
+            }
+            Path::Nurbs(n) => Nurbs::new(
+                n.degree(),
+                n.knots().to_vec(),
+                n.control_points().iter().map(|&p| flip(p)).collect(),
+                Some(n.weights().to_vec()),
+            )
+            .map(Path::Nurbs),
+        };
+        // Mirroring keeps every property the constructors check.
+        rebuilt.expect("the mirror image of a valid path is valid")
+    }
 }
 
 impl Curve for Path {
