@@ -24,7 +24,8 @@ sys.path.insert(0, str(REPO / "tests" / "fmpy"))
 from master import closed_loop  # noqa: E402
 from reference_paths import ContourReference  # noqa: E402
 
-SWARM, ITERATIONS, LOWER, UPPER = 50, 100, [0.0] * 5, [10.0, 10.0, 1000.0, 3000.0, 50.0]
+# The default search box of ccc-tune (src/tuning/objective.rs, docs/design.md §4.4).
+SWARM, ITERATIONS, LOWER, UPPER = 50, 100, [0.0] * 5, [10.0, 10.0, 340.0, 6800.0, 3.8]
 
 
 def main():

@@ -1,6 +1,6 @@
 //! Runs the standard and the improved PSO on the classic benchmark functions (D = 5)
-//! for a range of seeds and prints the final fitness of every run as JSON, for the
-//! comparison with pyswarms in tests/reference/test_pso_pyswarms.py.
+//! for a range of seeds and prints the final fitness and position of every run as JSON,
+//! for tests/reference/test_pso_benchmarks.py and benches/pso_tables.py.
 //!
 //! Usage: `pso_benchmarks [SEEDS] [SWARM] [ITERATIONS]` (20, 30, 200).
 
@@ -46,7 +46,7 @@ fn main() {
             ("standard", Algorithm::Standard),
             ("improved", Algorithm::Improved),
         ] {
-            let finals: Vec<f64> = (0..seeds as u64)
+            let finals: Vec<serde_json::Value> = (0..seeds as u64)
                 .map(|seed| {
                     let settings = PsoSettings {
                         algorithm,
@@ -57,9 +57,8 @@ fn main() {
                         velocity_fraction: 0.2,
                         seed,
                     };
-                    minimize(settings, f, |_, _| {})
-                        .expect("valid settings")
-                        .fitness
+                    let result = minimize(settings, f, |_, _| {}).expect("valid settings");
+                    json!({"fitness": result.fitness, "best": result.best})
                 })
                 .collect();
             by_algorithm.insert(label.into(), json!(finals));

@@ -52,6 +52,17 @@ pub const PAPER_CIRCLE_FEED: f64 = 10.0 * std::f64::consts::PI;
 /// the test plant does linearly, yet fast enough that the curvature makes contour error.
 pub const FREE_CURVE_FEED: f64 = 50.0;
 
+/// The feed a path is run at unless one is given: [`PAPER_CIRCLE_FEED`] for a full
+/// circle (the paper's experiment), [`FREE_CURVE_FEED`] for anything else. Decided on the
+/// path itself, not on how it was named, so `circle`, `Circle` and its mirror agree.
+pub fn preset_feed(path: &Path) -> f64 {
+    if matches!(path, Path::Arc(a) if a.is_full_circle()) {
+        PAPER_CIRCLE_FEED
+    } else {
+        FREE_CURVE_FEED
+    }
+}
+
 /// Refuses runs longer than this many samples (a feed too small for the path).
 pub const MAX_SAMPLES: usize = 50_000_000;
 
@@ -108,15 +119,10 @@ impl SimConfig {
         Self::new(Path::Arc(builtin::circle()), PAPER_CIRCLE_FEED)
     }
 
-    /// A built-in path by name at its preset feed: [`PAPER_CIRCLE_FEED`] for `circle`,
-    /// [`FREE_CURVE_FEED`] for the others.
+    /// A built-in path by name at its [`preset_feed`].
     pub fn builtin(name: &str) -> Result<Self, PathError> {
         let path = builtin::by_name(name)?;
-        let feed = if matches!(&path, Path::Arc(a) if a.is_full_circle()) {
-            PAPER_CIRCLE_FEED
-        } else {
-            FREE_CURVE_FEED
-        };
+        let feed = preset_feed(&path);
         Ok(Self::new(path, feed))
     }
 

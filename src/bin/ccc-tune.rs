@@ -10,6 +10,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use contour_fmu::path::Path;
+use contour_fmu::sim::preset_feed;
 use contour_fmu::tuning::objective::{ContourObjective, Fitness, FACTOR_NAMES, LOWER, UPPER};
 use contour_fmu::tuning::{minimize, Algorithm, PsoSettings};
 use serde_json::json;
@@ -121,11 +122,7 @@ fn run(o: Options) -> Result<(), String> {
         return Err("--lower: the fuzzy factors cannot be negative".into());
     }
     let path = Path::from_spec(&o.path, None).map_err(|e| format!("--path: {e}"))?;
-    let feed = o.feed.unwrap_or(if o.path == "circle" {
-        10.0 * std::f64::consts::PI
-    } else {
-        50.0
-    });
+    let feed = o.feed.unwrap_or_else(|| preset_feed(&path));
     let objective = ContourObjective::new(path, feed, &o.plant, o.fitness)?;
     let settings = PsoSettings {
         algorithm: o.algorithm,

@@ -14,11 +14,17 @@ use crate::sim::{Metrics, SimConfig, Simulator};
 /// (`fuzzy.<name>`).
 pub const FACTOR_NAMES: [&str; 5] = ["ke", "kde", "kp", "ki", "kd"];
 
-/// Default search box. The paper's optimum (1, 1.2, 87, 8.5, 4) lies well inside; kε and
-/// kΔε of 10 per µm saturate the fuzzy inputs at 0.3 µm, and kpf = 1000 swings Kp by
-/// ±3000 1/s around Kp0 = 100 (tuning runs on the trident pushed against a narrower box).
+/// Default search box (docs/design.md §4.4), from the physics of the contour loop
+/// rather than from where earlier optima fell:
+/// - kε, kΔε ≤ 10 per µm (per µm and sample): the fuzzy inputs saturate no finer than
+///   0.3 µm, three counts of a 0.1 µm linear scale; finer would schedule on encoder noise.
+/// - kpf ≤ 340, kif ≤ 6800, kdf ≤ 3.8: the largest Kp, Ki, Kd the folded tables can
+///   schedule (Kp0 + 8/3·kpf, Ki0 + 2·kif, Kd0 + kdf) stay below half the gain at which
+///   the sampled contour loop (test plant, Ts = 1 ms, the other gains at Kp0, Ki0, Kd0)
+///   goes unstable: 2063 1/s, 37 500 1/s², 7.7 (a 6 dB gain margin each).
+/// - 0 for every lower bound: a zero factor switches that adaptation off.
 pub const LOWER: [f64; 5] = [0.0; 5];
-pub const UPPER: [f64; 5] = [10.0, 10.0, 1000.0, 3000.0, 50.0];
+pub const UPPER: [f64; 5] = [10.0, 10.0, 340.0, 6800.0, 3.8];
 
 /// Fitness of a run that diverged: above any stable run's (those abort at 10 mm), and
 /// lower the later the divergence, so the swarm still sees a slope.

@@ -3,8 +3,10 @@ XYServoPlant, stepped by the fixed-step master in master.py (fmpy's FMU2Slave), 
 circle, the infinity curve and the trident: without CCC, with the fuzzy-PID CCC and the
 paper's factors, and with factors tuned by PSO (`ccc-tune`, applied as start values).
 
-Prints a table like the paper's Tables 4-5 (max and mean |true contour error|, the
-reduction), and writes to out/: one CSV time series per run, one PNG per path (path
+Every controller also runs on the mirror image of each path (about the x axis, so the
+circle turns clockwise): a controller must not care about the direction of travel, and
+the table shows both. Prints a table like the paper's Tables 4-5 (max and mean |true
+contour error| on the path and on its mirror, the reduction), and writes to out/: one CSV time series per run, one PNG per path (path
 tracking and contour error vs time), the PSO fitness histories (standard vs improved,
 like the paper's Figures 10 and 13), and the FMI cross-check files of ContourCCC2D
 (out/cross-check/ContourCCC2D/: _in.csv, _ref.csv, _ref.opt) from the fuzzy circle run.
@@ -30,6 +32,9 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 from master import closed_loop  # noqa: E402
 from reference_paths import ContourReference  # noqa: E402
+
+sys.path.insert(0, str(HERE.parent / "reference"))
+from test_nurbs_geomdl import INFINITY, TRIDENT, clamped_uniform  # noqa: E402
 from tuned import start_values  # noqa: E402
 
 REPO = HERE.parents[1]
@@ -76,11 +81,31 @@ def plot_histories(out, path, histories):
     plt.close(fig)
 
 
-def run_path(fmu_dir, path, feed, controller):
-    reference = ContourReference(path)
+def mirrored_interpolator(path, out):
+    """PathInterpolator2D start values for the mirror image of a built-in path about the
+    x axis: the circle as a clockwise arc, a NURBS as a JSON file with (x, -y) control
+    points (written to out/paths/)."""
+    if path == "circle":
+        return {"path": "arc", "arc.cx": -10.0, "arc.cy": 0.0, "arc.r": 10.0,
+                "arc.start": 0.0, "arc.sweep": -2 * math.pi}
+    ctrl = {"infinity": INFINITY, "trident": TRIDENT}[path]
+    document = {"degree": 3, "knots": clamped_uniform(len(ctrl), 3),
+                "control_points": [[float(x), -float(y)] for x, y in ctrl]}
+    target = out / "paths" / f"{path}_mirrored.json"
+    target.parent.mkdir(parents=True, exist_ok=True)
+    target.write_text(json.dumps(document))
+    return {"path": str(target)}
+
+
+def run_path(fmu_dir, path, feed, controller, mirrored=None):
+    """The closed loop on `path`, or on its mirror image when `mirrored` holds the
+    interpolator start values of mirrored_interpolator(); returns (before, after,
+    |true contour error| per sample)."""
+    reference = ContourReference(path, mirrored=mirrored is not None)
     length = np.sum(np.hypot(*np.diff(reference.points, axis=0).T))
     stop = round(math.ceil(length / feed / STEP - 1e-6) * STEP, 9)
-    before, after = closed_loop(fmu_dir, path=path, feed=feed, stop=stop, controller=controller)
+    before, after = closed_loop(fmu_dir, path=path, feed=feed, stop=stop, controller=controller,
+                                interpolator=mirrored)
     error = reference.distance(np.column_stack([before["plant.pos.x"], before["plant.pos.y"]]))
     return before, after, error
 
@@ -155,7 +180,8 @@ def main(argv=None):
                 variants.append((f"PSO {algorithm}", start_values(args.out / f"tuned_{path}_{algorithm}.json")))
         elif args.params:
             variants.append(("PSO-tuned CCC", start_values(args.params)))
-        runs = []
+        mirror = mirrored_interpolator(path, args.out)
+        runs, mirrored_runs = [], []
         for label, controller in variants:
             before, after, error = run_path(args.fmu_dir, path, feed, controller)
             runs.append((label, before, error))
@@ -164,17 +190,22 @@ def main(argv=None):
             write_csv(args.out / f"{path}_{label.replace(' ', '_')}.csv", columns)
             if path == "circle" and controller == {}:
                 write_cross_check(args.out, before, after)
+            _, _, mirrored_error = run_path(args.fmu_dir, path, feed, controller, mirror)
+            mirrored_runs.append(mirrored_error)
         plot(args.out, path, runs)
         base_max, base_mean = runs[0][2].max(), runs[0][2].mean()
-        for label, _, error in runs:
-            rows.append((path, feed, label, error.max(), error.mean(),
-                         100 * (1 - error.max() / base_max), 100 * (1 - error.mean() / base_mean)))
+        for (label, _, error), mirrored_error in zip(runs, mirrored_runs):
+            rows.append((path, feed, label, error.max(), error.mean(), mirrored_error.max(),
+                         mirrored_error.mean(), 100 * (1 - error.max() / base_max),
+                         100 * (1 - error.mean() / base_mean)))
 
-    print("Closed loop through the FMUs (PathInterpolator2D -> ContourCCC2D <- XYServoPlant), Ts = 1 ms")
-    print(f"{'path':9} {'feed mm/s':>9}  {'controller':15} {'max |e| um':>11} {'mean |e| um':>12} "
-          f"{'max red. %':>10} {'mean red. %':>11}")
-    for path, feed, label, emax, emean, rmax, rmean in rows:
-        print(f"{path:9} {feed:9.2f}  {label:15} {emax * 1e3:11.3f} {emean * 1e3:12.3f} {rmax:10.1f} {rmean:11.1f}")
+    print("Closed loop through the FMUs (PathInterpolator2D -> ContourCCC2D <- XYServoPlant), Ts = 1 ms;")
+    print("|true contour error| in um on the path and on its mirror image (y -> -y, reversed turning sense)")
+    print(f"{'path':9} {'feed mm/s':>9}  {'controller':15} {'max':>8} {'mean':>8} {'max mir.':>9} "
+          f"{'mean mir.':>9} {'max red. %':>10} {'mean red. %':>11}")
+    for path, feed, label, emax, emean, mmax, mmean, rmax, rmean in rows:
+        print(f"{path:9} {feed:9.2f}  {label:15} {emax * 1e3:8.3f} {emean * 1e3:8.3f} {mmax * 1e3:9.3f} "
+              f"{mmean * 1e3:9.3f} {rmax:10.1f} {rmean:11.1f}")
     print(f"wrote CSV, PNG and cross-check files to {args.out}")
     return rows
 

@@ -135,9 +135,10 @@ CLOSED_LOOP_RECORD = [
 
 
 def closed_loop(fmu_dir, path="circle", feed=None, stop=2.0, step=1e-3, controller=None,
-                plant=None, scheme="gauss-seidel"):
-    """Runs PathInterpolator2D -> ContourCCC2D <- XYServoPlant; returns (before, after)."""
-    interpolator = {"path": path}
+                plant=None, scheme="gauss-seidel", interpolator=None):
+    """Runs PathInterpolator2D -> ContourCCC2D <- XYServoPlant; returns (before, after).
+    `interpolator` holds further PathInterpolator2D start values (they override `path`)."""
+    interpolator = {"path": path, **(interpolator or {})}
     if feed is not None:
         interpolator["feed"] = feed
     # Stepping order controller -> plant -> interpolator: with Gauss-Seidel the controller

@@ -37,10 +37,13 @@ def polyline(name, n=SAMPLES):
 
 
 class ContourReference:
-    """Distance from points to one built-in path."""
+    """Distance from points to one built-in path, or to its mirror image about the x axis
+    (y -> -y) when `mirrored`."""
 
-    def __init__(self, name, n=SAMPLES):
+    def __init__(self, name, n=SAMPLES, mirrored=False):
         self.points = polyline(name, n)
+        if mirrored:
+            self.points[:, 1] *= -1.0
         self.tree = cKDTree(self.points)
 
     def distance(self, xy):

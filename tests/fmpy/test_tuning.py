@@ -88,3 +88,12 @@ def test_tuned_factors_beat_the_papers_through_the_fmu(ccc_tune, fmu_dir, tmp_pa
     assert tuned.max() < 0.85 * paper.max(), (tuned.max(), paper.max())
     history = document["history_mm"]
     assert all(later <= earlier for earlier, later in zip(history, history[1:]))
+
+
+@pytest.mark.parametrize("spelling", ["circle", "Circle", " CIRCLE "])
+def test_the_circle_tunes_at_the_papers_feed_however_it_is_spelled(ccc_tune, tmp_path, spelling):
+    out = tmp_path / "tuned.json"
+    done = tune(ccc_tune, out, "--path", spelling, "--swarm", 1, "--iters", 1)
+    assert done.returncode == 0, done.stderr
+    # The paper's circle: 10 mm radius, one turn in 2 s.
+    assert json.loads(out.read_text())["settings"]["feed_mm_per_s"] == 10 * np.pi
