@@ -1,5 +1,5 @@
 //! In-process closed loop: interpolator → cross-coupled controller → XY table, sampled
-//! every `Ts` (DESIGN 4.2, 4.5, 4.6). The reference for everything the FMUs must match in
+//! every `Ts` (docs/design.md §4.2, 4.5, 4.6). The reference for everything the FMUs must match in
 //! co-simulation, and the fitness evaluator of the PSO tuner.
 //!
 //! # The sample sequence (the FMU co-simulation reproduces it, keep it exactly so)
@@ -214,7 +214,7 @@ pub struct Metrics {
     pub samples: usize,
     /// Maximum over all samples.
     pub max_abs_error: f64,
-    /// Mean over all samples (the PSO fitness of DESIGN 4.4).
+    /// Mean over all samples (the PSO fitness of docs/design.md §4.4).
     pub mean_abs_error: f64,
     /// Samples with t ≥ `transient`.
     pub settled_samples: usize,

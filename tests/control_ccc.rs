@@ -1,5 +1,5 @@
 //! Two-axis cross-coupled controller (src/control/ccc.rs): the correction is n·U_c with
-//! U_c recomputed here from the DESIGN 4.2 formula, Off mode is the bare axis loops, fuzzy
+//! U_c recomputed here from the docs/design.md §4.2 formula, Off mode is the bare axis loops, fuzzy
 //! gains follow Kp0 + kpf·ΔKp′ from the engine, configuration errors name the parameter,
 //! state survives serde, and on a closed loop the CCC actually removes contour error.
 
@@ -10,7 +10,7 @@ use contour_fmu::control::{
 };
 use serde::{Deserialize, Serialize};
 
-/// Exact contour error of a circle (DESIGN 4.1), computed here independently.
+/// Exact contour error of a circle (docs/design.md §4.1), computed here independently.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 struct CircleEstimator {
     centre: [f64; 2],

@@ -1,17 +1,22 @@
-//! `cargo run --release -p fmu-build [-- --bless] [--out DIR]`: builds the library in
-//! release mode and writes one `.fmu` per model to `target/fmu/` (or DIR).
-//! `--bless` rewrites the committed `modelDescription/<Model>.xml` files from the code.
+//! `cargo run --release -p fmu-build [-- --bless] [--out DIR] [--resource MODEL=FILE]…`:
+//! builds the library in release mode and writes one `.fmu` per model to `target/fmu/`
+//! (or DIR). `--bless` rewrites the committed `modelDescription/<Model>.xml` files from
+//! the code; each `--resource` puts FILE into MODEL's `resources/` folder.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
 use contour_fmu::models;
-use fmu_build::{model_description, package};
+use fmu_build::model_description;
+use fmu_build::package::{self, Resource};
 
-const USAGE: &str = "usage: fmu-build [--bless] [--out DIR]\n\
+const USAGE: &str = "usage: fmu-build [--bless] [--out DIR] [--resource MODEL=FILE]...\n\
   builds the contour-fmu library (release) and packages target/fmu/<Model>.fmu\n\
-  --bless    rewrite modelDescription/<Model>.xml from the variable tables\n\
-  --out DIR  write the .fmu files to DIR instead of <target>/fmu";
+  --bless                rewrite modelDescription/<Model>.xml from the variable tables\n\
+  --out DIR              write the .fmu files to DIR instead of <target>/fmu\n\
+  --resource MODEL=FILE  put FILE into MODEL's resources/ folder under its own name\n\
+                         (repeatable; e.g. PathInterpolator2D=part.json, then set the\n\
+                         FMU's parameter path = \"part.json\")";
 
 fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -45,18 +50,28 @@ fn build_library(root: &Path) -> Result<PathBuf, String> {
 fn run(args: &[String]) -> Result<(), String> {
     let mut bless = false;
     let mut out = None;
+    let mut resources = Vec::new();
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
         match arg.as_str() {
             "--bless" => bless = true,
             "--out" => out = Some(PathBuf::from(rest.next().ok_or("--out needs a directory")?)),
+            "--resource" => {
+                let spec = rest.next().ok_or("--resource needs MODEL=FILE")?;
+                resources.push(Resource::parse(spec)?);
+            }
             "-h" | "--help" => {
                 println!("{USAGE}");
                 return Ok(());
             }
-            other => return Err(format!("unknown argument '{other}'\n{USAGE}")),
+            other => match other.strip_prefix("--resource=") {
+                Some(spec) => resources.push(Resource::parse(spec)?),
+                None => return Err(format!("unknown argument '{other}'\n{USAGE}")),
+            },
         }
     }
+    // Refused before the (slow) build, so a typo costs nothing.
+    package::check_unique(&resources)?;
     let root = workspace_root();
     let out = out.unwrap_or_else(|| target_dir(&root).join("fmu"));
 
@@ -77,8 +92,11 @@ fn run(args: &[String]) -> Result<(), String> {
 
     let library = build_library(&root)?;
     for model in models::all() {
-        let fmu = package::write_fmu(model, &library, &out)?;
+        let fmu = package::write_fmu_with_resources(model, &library, &out, &resources)?;
         println!("wrote {}", fmu.display());
+        for r in resources.iter().filter(|r| r.model == model.identifier) {
+            println!("  resources/{} <- {}", r.name, r.source.display());
+        }
     }
     if !stale.is_empty() {
         eprintln!(

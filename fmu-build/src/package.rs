@@ -1,26 +1,137 @@
-//! Zips one FMU: `modelDescription.xml`, `binaries/linux64/<id>.so` and
-//! `documentation/index.html`.
+//! Zips one FMU: `modelDescription.xml`, `binaries/linux64/<id>.so`,
+//! `documentation/index.html` and, on request, files under `resources/`.
 
 use std::fs::File;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use zip::write::SimpleFileOptions;
 use zip::CompressionMethod;
 
-use contour_fmu::models::ModelInfo;
+use contour_fmu::models::{self, ModelInfo};
 
 use crate::{documentation, model_description};
 
+/// The model that reads path files from its `resources/` folder (its `path` parameter
+/// takes a file name relative to it).
+const PATH_MODEL: &str = "PathInterpolator2D";
+
+/// A file to put into a model's `resources/` folder.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Resource {
+    /// `modelIdentifier` of the FMU that receives the file.
+    pub model: String,
+    /// The file on disk.
+    pub source: PathBuf,
+    /// Its name inside the FMU: `resources/<name>`.
+    pub name: String,
+}
+
+impl Resource {
+    /// A resource for `model` from the file `source`, stored under its own file name.
+    ///
+    /// Refused, with a message naming the file or the model: an unknown model, a file
+    /// that does not exist or is not a regular file, and a `.json` file for
+    /// `PathInterpolator2D` that is not a valid NURBS path file (the FMU would otherwise
+    /// only fail when an importer initializes it).
+    pub fn new(model: &str, source: impl Into<PathBuf>) -> Result<Self, String> {
+        let source = source.into();
+        let known: Vec<&str> = models::all().iter().map(|m| m.identifier).collect();
+        if !known.contains(&model) {
+            return Err(format!(
+                "--resource {model}={}: unknown model '{model}' (the models are {})",
+                source.display(),
+                known.join(", ")
+            ));
+        }
+        let metadata = std::fs::metadata(&source).map_err(|e| {
+            format!(
+                "--resource {model}={}: cannot read the file: {e}",
+                source.display()
+            )
+        })?;
+        if !metadata.is_file() {
+            return Err(format!(
+                "--resource {model}={}: not a regular file",
+                source.display()
+            ));
+        }
+        let name = source
+            .file_name()
+            .and_then(|n| n.to_str())
+            .ok_or_else(|| {
+                format!(
+                    "--resource {model}={}: the file name is not valid UTF-8",
+                    source.display()
+                )
+            })?
+            .to_string();
+        if model == PATH_MODEL && name.to_ascii_lowercase().ends_with(".json") {
+            contour_fmu::path::file::load_nurbs(&source)
+                .map_err(|e| format!("--resource {model}={}: {e}", source.display()))?;
+        }
+        Ok(Resource {
+            model: model.to_string(),
+            source,
+            name,
+        })
+    }
+
+    /// Parses the command-line form `Model=FILE` (see [`Resource::new`]).
+    pub fn parse(arg: &str) -> Result<Self, String> {
+        match arg.split_once('=') {
+            Some((model, file)) if !model.is_empty() && !file.is_empty() => {
+                Resource::new(model, file)
+            }
+            _ => Err(format!(
+                "--resource needs MODEL=FILE, e.g. {PATH_MODEL}=path.json (got '{arg}')"
+            )),
+        }
+    }
+}
+
+/// Checks that no model receives two resources under the same name.
+pub fn check_unique(resources: &[Resource]) -> Result<(), String> {
+    for (i, a) in resources.iter().enumerate() {
+        if let Some(b) = resources[..i]
+            .iter()
+            .find(|b| b.model == a.model && b.name == a.name)
+        {
+            return Err(format!(
+                "--resource: {} and {} would both be {}'s resources/{}",
+                b.source.display(),
+                a.source.display(),
+                a.model,
+                a.name
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Writes `<out_dir>/<id>.fmu` holding `library` (the built cdylib) under the name FMI
-/// requires: `binaries/linux64/<modelIdentifier>.so`.
-pub fn write_fmu(
+/// requires: `binaries/linux64/<modelIdentifier>.so`. No resources.
+pub fn write_fmu(model: &ModelInfo, library: &Path, out_dir: &Path) -> Result<PathBuf, String> {
+    write_fmu_with_resources(model, library, out_dir, &[])
+}
+
+/// As [`write_fmu`], plus every entry of `resources` whose `model` is this model's
+/// identifier as `resources/<name>` (entries for other models are skipped).
+pub fn write_fmu_with_resources(
     model: &ModelInfo,
     library: &Path,
     out_dir: &Path,
-) -> Result<std::path::PathBuf, String> {
+    resources: &[Resource],
+) -> Result<PathBuf, String> {
+    check_unique(resources)?;
     let binary =
         std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
+    let mut files = Vec::new();
+    for r in resources.iter().filter(|r| r.model == model.identifier) {
+        let bytes = std::fs::read(&r.source)
+            .map_err(|e| format!("cannot read {}: {e}", r.source.display()))?;
+        files.push((format!("resources/{}", r.name), bytes));
+    }
     std::fs::create_dir_all(out_dir)
         .map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
     let path = out_dir.join(format!("{}.fmu", model.identifier));
@@ -33,11 +144,12 @@ pub fn write_fmu(
     let options = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated);
     let xml = model_description::render(model);
     let html = documentation::render(model);
-    let entries: [(String, &[u8]); 3] = [
+    let mut entries: Vec<(String, &[u8])> = vec![
         ("modelDescription.xml".into(), xml.as_bytes()),
         (format!("binaries/linux64/{}.so", model.identifier), &binary),
         ("documentation/index.html".into(), html.as_bytes()),
     ];
+    entries.extend(files.iter().map(|(n, b)| (n.clone(), b.as_slice())));
     let write_err = |e: &dyn std::fmt::Display| format!("cannot write {}: {e}", partial.display());
     for (name, bytes) in entries {
         zip.start_file(name, options).map_err(|e| write_err(&e))?;

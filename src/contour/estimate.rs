@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Signed contour error and the direction to correct along (DESIGN 4.1).
+/// Signed contour error and the direction to correct along (docs/design.md §4.1).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ContourEstimate {
     /// Signed distance from the actual point to the path, mm; positive when the actual

@@ -1,10 +1,10 @@
 //! Free-curve contour-error estimator: the two-circle method of the paper (after Chen et
-//! al.), DESIGN 4.1.
+//! al.), docs/design.md §4.1.
 //!
 //! Recent reference samples are kept in a fixed-capacity ring buffer. From the newest
 //! command point the search walks back while the distance to P decreases; the last point
 //! is Rε. Circles C1 through (Rε+1, Rε, Rε−1) and C2 through (Rε, Rε−1, Rε−2) approximate
-//! the path around it. Combination (DESIGN): C1 alone when P is ahead of Rε
+//! the path around it. Combination (docs/design.md §4.1): C1 alone when P is ahead of Rε
 //! ((P − Rε)·(Rε+1 − Rε) > 0, so the foot lies between Rε and Rε+1, inside C1's span),
 //! otherwise the mean of the C1 and C2 estimates (the foot lies between Rε−1 and Rε, which
 //! both circles span; their leading interpolation errors have opposite signs). Near the

@@ -1,5 +1,5 @@
-//! Two-axis cross-coupled contour controller (DESIGN 4.2) with optional fuzzy gain
-//! adaptation (DESIGN 4.3).
+//! Two-axis cross-coupled contour controller (docs/design.md §4.2) with optional fuzzy gain
+//! adaptation (docs/design.md §4.3).
 //!
 //! Per sample: following errors `e = R − P`; per-axis position controllers give velocity
 //! commands `G(e)` (mm/s); the contour estimator gives the signed contour error ε and the
@@ -66,7 +66,7 @@ impl Default for FuzzyFactors {
 pub struct CccConfig {
     /// Off / fixed gains / fuzzy-adapted gains. Default: `Fuzzy`.
     pub mode: CccMode,
-    /// Kp0 (1/s), Ki0 (1/s²), Kd0 (–). Default (100, 5000, 0): the PI CCC that DESIGN 4.2
+    /// Kp0 (1/s), Ki0 (1/s²), Kd0 (–). Default (100, 5000, 0): the PI CCC that docs/design.md §4.2
     /// measured at 0.08 µm on the paper's circle; near ε = 0 the fuzzy adjustments of Kp
     /// and Ki are zero, so the fuzzy mode keeps that accuracy in steady state.
     pub gains0: PidGains,
@@ -105,7 +105,7 @@ pub struct ControllerConfig {
     /// Sample period, s. Default 1 ms.
     pub ts: f64,
     /// Position controllers G of X and Y (output mm/s per mm). Default P with
-    /// Kpp = 28.5 1/s (DESIGN 4.2).
+    /// Kpp = 28.5 1/s (docs/design.md §4.2).
     pub axis: [PidGains; 2],
     /// |G| bound in mm/s (enables the axis anti-windup). Default `None`: the plant has no
     /// limit by default.
@@ -135,7 +135,7 @@ impl Default for ControllerConfig {
     }
 }
 
-/// A rejected configuration value. `parameter` uses the FMI parameter names of DESIGN 1
+/// A rejected configuration value. `parameter` uses the FMI parameter names of docs/design.md §1
 /// (`Ts`, `ccc.Kp0`, `fuzzy.ke`, …) so the FMU can report it verbatim.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ConfigError {
@@ -227,7 +227,7 @@ impl ControllerConfig {
 /// and its mirror image different gains. Folded, the gains depend only on |ε| and on
 /// whether |ε| grows (EC′ < 0) or shrinks (EC′ > 0), read from the half of the tables
 /// where Kp grows and Ki shrinks as |ε| grows. The increments stay unsigned: the PID's
-/// product with ε carries the sign of the correction (DESIGN 4.3).
+/// product with ε carries the sign of the correction (docs/design.md §4.3).
 pub fn folded_inputs(factors: &FuzzyFactors, error: f64, delta: f64) -> (f64, f64) {
     // Compare with 0 rather than use `signum`, which gives ±1 for ±0.
     let s = if error > 0.0 || (error == 0.0 && delta > 0.0) {
@@ -296,7 +296,7 @@ impl CccLaw {
     /// Fixed mode returns `gains0`; fuzzy mode `gains0 + k·ΔK′` with the rule tables read
     /// at the folded inputs of [`folded_inputs`], each gain clamped at ≥ 0. The gains are
     /// the same for (ε, Δε) and (−ε, −Δε), so a path and its mirror image get the same
-    /// control (DESIGN 4.3, direction symmetry).
+    /// control (docs/design.md §4.3, direction symmetry).
     pub fn schedule(&self, error: f64, delta: f64) -> (PidGains, FuzzyOutput) {
         let g0 = self.config.gains0;
         match self.config.mode {

@@ -1,5 +1,5 @@
 //! Control laws: discrete PID, the Mamdani fuzzy gain scheduler with its rule tables, and
-//! the two-axis cross-coupled contour controller (DESIGN 4.2, 4.3).
+//! the two-axis cross-coupled contour controller (docs/design.md §4.2, 4.3).
 
 pub mod ccc;
 pub mod fuzzy;

@@ -39,7 +39,7 @@ impl Line {
         v2::scale(d, 1.0 / v2::norm(d))
     }
 
-    /// Direction angle θ of travel, rad (DESIGN 4.1).
+    /// Direction angle θ of travel, rad (docs/design.md §4.1).
     pub fn angle(&self) -> f64 {
         let d = v2::sub(self.b, self.a);
         d[1].atan2(d[0])

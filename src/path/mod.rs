@@ -1,5 +1,5 @@
 //! Two-axis reference paths (lines, arcs, NURBS), the built-in shapes and the feed-rate
-//! interpolator that samples them every `Ts` (DESIGN 4.6). Units: mm, s.
+//! interpolator that samples them every `Ts` (docs/design.md §4.6). Units: mm, s.
 //!
 //! Every geometric type implements [`Curve`], and [`Path`] is the closed set the FMUs
 //! choose from by name ([`builtin::by_name`]) or by file ([`file::load_nurbs`]).

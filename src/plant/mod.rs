@@ -1,4 +1,4 @@
-//! Test plants: the servo axis of DESIGN 4.5 and the XY table built from two of them.
+//! Test plants: the servo axis of docs/design.md §4.5 and the XY table built from two of them.
 
 pub mod servo_axis;
 pub mod xy_table;

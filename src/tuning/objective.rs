@@ -1,4 +1,4 @@
-//! The tuner's objective (DESIGN 4.4): a closed-loop run of the in-process simulator
+//! The tuner's objective (docs/design.md §4.4): a closed-loop run of the in-process simulator
 //! with candidate fuzzy factors, scored by the true contour error (against the exact
 //! path, not the controller's estimate). Diverging runs get a large finite penalty, so
 //! the swarm is steered away from them instead of crashing on NaN.
@@ -34,7 +34,7 @@ const PENALTY_MM: f64 = 1000.0;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Fitness {
-    /// Mean |true contour error| over the run (DESIGN 4.4, the paper's).
+    /// Mean |true contour error| over the run (docs/design.md §4.4, the paper's).
     Mean,
     /// Maximum |true contour error| over the run.
     Max,

@@ -1,6 +1,6 @@
 """True contour error for the demo and the closed-loop tests, computed independently of
 the Rust code: the built-in paths are rebuilt here (closed forms for circle, line and
-arc; geomdl for the NURBS of DESIGN 4.6), sampled densely, and each point is projected
+arc; geomdl for the NURBS of docs/design.md §4.6), sampled densely, and each point is projected
 onto the segments next to its nearest sample (about 1e-9 mm from the exact distance at 200 001 samples).
 """
 

@@ -1,8 +1,8 @@
 """The Rust NURBS evaluator (point, first and second derivative) against geomdl.
 
-The built-in curves are rebuilt here from the control points listed in DESIGN 4.6 (not from
+The built-in curves are rebuilt here from the control points listed in docs/design.md §4.6 (not from
 the Rust output), so the test also checks the Rust data entry. Rational evaluation is
-checked on DESIGN's exact 9-point unit circle and on a random degree-4 NURBS with random
+checked on the exact 9-point unit circle and on a random degree-4 NURBS with random
 weights and a non-uniform knot vector, written to a JSON file and loaded by the Rust file
 loader.
 """
