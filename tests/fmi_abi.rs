@@ -40,17 +40,36 @@ const MODES: [Mode; 6] = [
     Fatal,
 ];
 
-fn probe_in(mode: Mode) -> Instance {
+/// A FaultProbe instance driven into a mode, with an FMU state of it (saved before it got
+/// there, in Instantiated or StepComplete) and that state's serialized bytes, so the FMU
+/// state functions have real work to do in every mode.
+struct Probe {
+    i: Instance,
+    saved: fmi2FMUstate,
+    bytes: Vec<u8>,
+}
+
+fn probe_in(mode: Mode) -> Probe {
     let i = Instance::new(&probe::INFO);
+    let save = |i: &Instance| {
+        let (s, saved) = i.get_state();
+        assert_eq!(s, OK);
+        let (s, bytes) = i.serialize(saved);
+        assert_eq!(s, OK);
+        (saved, bytes)
+    };
     if mode == Instantiated {
-        return i;
+        let (saved, bytes) = save(&i);
+        return Probe { i, saved, bytes };
     }
     assert_eq!(i.setup(0.0, None), OK);
     assert_eq!(i.enter_init(), OK);
     if mode == Initialization {
-        return i;
+        let (saved, bytes) = save(&i);
+        return Probe { i, saved, bytes };
     }
     assert_eq!(i.exit_init(), OK);
+    let (saved, bytes) = save(&i);
     match mode {
         StepComplete => {}
         Terminated => assert_eq!(i.terminate(), OK),
@@ -65,15 +84,23 @@ fn probe_in(mode: Mode) -> Instance {
         _ => unreachable!(),
     }
     i.clear_log();
-    i
+    Probe { i, saved, bytes }
 }
 
-type Probe = fn(&mut Instance) -> fmi2Status;
+type Call = fn(&mut Probe) -> fmi2Status;
 
-/// Every instance function, called with well-formed arguments, and the modes in which
-/// FMI 2.0 (section 4.3.3, Co-Simulation) allows it. Written from the standard, not from
-/// the library's own table.
-fn functions() -> Vec<(&'static str, Probe, &'static [Mode])> {
+/// What a function answers where it is allowed: the status, and for anything but fmi2OK
+/// the start of the logged reason (the documented behaviour).
+#[derive(Clone, Copy, Debug)]
+enum Answer {
+    Ok,
+    Documented(fmi2Status, &'static str),
+}
+
+/// Every instance function, called with well-formed arguments, the modes in which FMI 2.0
+/// (section 4.3.3, Co-Simulation; the Reference FMUs' masks) allows it, and its answer
+/// there. Written from the standard, not from the library's own table.
+fn functions() -> Vec<(&'static str, Call, &'static [Mode], Answer)> {
     const ALIVE: &[Mode] = &[
         Instantiated,
         Initialization,
@@ -84,224 +111,329 @@ fn functions() -> Vec<(&'static str, Probe, &'static [Mode])> {
     const GET: &[Mode] = &[Initialization, StepComplete, Terminated, Error];
     const SET: &[Mode] = &[Instantiated, Initialization, StepComplete];
     const STATUS: &[Mode] = &[StepComplete, Terminated];
+    const EVERY: &[Mode] = &[
+        Instantiated,
+        Initialization,
+        StepComplete,
+        Terminated,
+        Error,
+        Fatal,
+    ];
+    use Answer::{Documented, Ok as Fine};
     vec![
         (
             "fmi2SetDebugLogging",
-            |i| i.set_debug_logging(true, &[]),
+            |p| p.i.set_debug_logging(true, &[]),
             ALIVE,
+            Fine,
         ),
         (
             "fmi2SetupExperiment",
-            |i| i.setup(0.0, None),
+            |p| p.i.setup(0.0, None),
             &[Instantiated],
+            Fine,
         ),
         (
             "fmi2EnterInitializationMode",
-            |i| i.enter_init(),
+            |p| p.i.enter_init(),
             &[Instantiated],
+            Fine,
         ),
         (
             "fmi2ExitInitializationMode",
-            |i| i.exit_init(),
+            |p| p.i.exit_init(),
             &[Initialization],
+            Fine,
         ),
-        ("fmi2Terminate", |i| i.terminate(), &[StepComplete]),
-        ("fmi2Reset", |i| i.reset(), ALIVE),
-        ("fmi2GetReal", |i| i.get_reals(&[probe::GAIN as u32]).0, GET),
+        ("fmi2Terminate", |p| p.i.terminate(), &[StepComplete], Fine),
+        ("fmi2Reset", |p| p.i.reset(), ALIVE, Fine),
+        (
+            "fmi2GetReal",
+            |p| p.i.get_reals(&[probe::GAIN as u32]).0,
+            GET,
+            Fine,
+        ),
         (
             "fmi2GetInteger",
-            |i| i.get_integer(probe::STEPS as u32).0,
+            |p| p.i.get_integer(probe::STEPS as u32).0,
             GET,
+            Fine,
         ),
         (
             "fmi2GetBoolean",
-            |i| i.get_boolean(probe::FAIL as u32).0,
+            |p| p.i.get_boolean(probe::FAIL as u32).0,
             GET,
+            Fine,
         ),
         (
             "fmi2GetString",
-            |i| i.get_string(probe::LABEL as u32).0,
+            |p| p.i.get_string(probe::LABEL as u32).0,
             GET,
+            Fine,
         ),
         (
             "fmi2SetReal",
-            move |i| i.set_reals(&[probe::GAIN as u32], &[2.0]),
+            // A tunable parameter: settable in all three modes.
+            |p| p.i.set_reals(&[probe::GAIN as u32], &[2.0]),
             SET,
+            Fine,
         ),
         (
             "fmi2SetInteger",
-            |i| i.set_integer(probe::STEPS as u32, 1),
+            |p| p.i.set_integer(probe::LEVEL as u32, 3),
             SET,
+            Fine,
         ),
         (
             "fmi2SetBoolean",
-            |i| i.set_boolean(probe::FAIL as u32, false),
+            |p| p.i.set_boolean(probe::FAIL as u32, false),
             SET,
+            Fine,
         ),
         (
             "fmi2SetString",
-            |i| i.set_string(probe::LABEL as u32, "x"),
+            |p| p.i.set_string(probe::NOTE as u32, "x"),
             SET,
+            Fine,
         ),
         (
             "fmi2GetFMUstate",
-            |i| {
-                let (s, mut state) = i.get_state();
+            |p| {
+                let (s, mut state) = p.i.get_state();
                 if !state.is_null() {
-                    i.free_state(&mut state);
+                    assert_eq!(p.i.free_state(&mut state), OK);
                 }
                 s
             },
             ALIVE,
+            Fine,
         ),
-        (
-            "fmi2SetFMUstate",
-            |i| i.set_state(std::ptr::null_mut()),
-            ALIVE,
-        ),
+        ("fmi2SetFMUstate", |p| p.i.set_state(p.saved), ALIVE, Fine),
         (
             "fmi2FreeFMUstate",
-            |i| i.free_state(&mut std::ptr::null_mut()),
-            ALIVE,
+            |p| {
+                let mut state = p.saved;
+                let s = p.i.free_state(&mut state);
+                if s == OK {
+                    assert!(state.is_null(), "the variable is set to NULL");
+                }
+                s
+            },
+            // Also after a fatal error, so that stored states can be released.
+            EVERY,
+            Fine,
         ),
         (
             "fmi2SerializedFMUstateSize",
-            |i| {
-                let mut size = 0;
-                unsafe { lib().fmi2SerializedFMUstateSize(i.c, std::ptr::null_mut(), &mut size) }
+            |p| {
+                let (s, size) = p.i.state_size(p.saved);
+                if s == OK {
+                    assert_eq!(size, p.bytes.len());
+                }
+                s
             },
             ALIVE,
+            Fine,
         ),
         (
             "fmi2SerializeFMUstate",
-            |i| {
-                let mut buffer = [0 as fmi2Byte; 8];
-                unsafe {
-                    lib().fmi2SerializeFMUstate(i.c, std::ptr::null_mut(), buffer.as_mut_ptr(), 8)
+            |p| {
+                let mut buffer = vec![0 as fmi2Byte; p.bytes.len()];
+                let s = unsafe {
+                    lib().fmi2SerializeFMUstate(p.i.c, p.saved, buffer.as_mut_ptr(), buffer.len())
+                };
+                if s == OK {
+                    let bytes: Vec<u8> = buffer.iter().map(|&b| b as u8).collect();
+                    assert_eq!(bytes, p.bytes);
                 }
+                s
             },
             ALIVE,
+            Fine,
         ),
         (
             "fmi2DeSerializeFMUstate",
-            |i| i.deserialize(&[1, 2, 3]).0,
+            |p| {
+                let bytes = p.bytes.clone();
+                let (s, mut state) = p.i.deserialize(&bytes);
+                if s == OK {
+                    assert!(!state.is_null());
+                    assert_eq!(p.i.free_state(&mut state), OK);
+                }
+                s
+            },
             ALIVE,
+            Fine,
         ),
         (
             "fmi2GetDirectionalDerivative",
-            |i| {
+            |p| {
                 let (vr, dv, mut out) = (0u32, 1.0, 0.0);
-                unsafe { lib().fmi2GetDirectionalDerivative(i.c, &vr, 1, &vr, 1, &dv, &mut out) }
+                unsafe { lib().fmi2GetDirectionalDerivative(p.i.c, &vr, 1, &vr, 1, &dv, &mut out) }
             },
             GET,
+            Documented(
+                ERROR,
+                "not supported (providesDirectionalDerivative=\"false\")",
+            ),
         ),
         (
             "fmi2SetRealInputDerivatives",
-            |i| {
+            |p| {
                 let (vr, order, v) = (0u32, 1, 0.0);
-                unsafe { lib().fmi2SetRealInputDerivatives(i.c, &vr, 1, &order, &v) }
+                unsafe { lib().fmi2SetRealInputDerivatives(p.i.c, &vr, 1, &order, &v) }
             },
             SET,
+            Documented(ERROR, "not supported (canInterpolateInputs=\"false\")"),
         ),
         (
             "fmi2GetRealOutputDerivatives",
-            |i| {
+            |p| {
                 let (vr, order, mut v) = (0u32, 1, 0.0);
-                unsafe { lib().fmi2GetRealOutputDerivatives(i.c, &vr, 1, &order, &mut v) }
+                unsafe { lib().fmi2GetRealOutputDerivatives(p.i.c, &vr, 1, &order, &mut v) }
             },
             &[StepComplete, Terminated, Error],
+            Documented(ERROR, "not supported (maxOutputDerivativeOrder=\"0\")"),
         ),
-        ("fmi2DoStep", |i| i.step(0.0, 0.01), &[StepComplete]),
+        ("fmi2DoStep", |p| p.i.step(0.0, 0.01), &[StepComplete], Fine),
         (
             "fmi2CancelStep",
-            |i| unsafe { lib().fmi2CancelStep(i.c) },
+            |p| unsafe { lib().fmi2CancelStep(p.i.c) },
             &[],
+            Fine,
         ),
         (
             "fmi2GetStatus",
-            |i| {
+            |p| {
                 let mut v = 0;
-                unsafe { lib().fmi2GetStatus(i.c, fmi2StatusKind_fmi2DoStepStatus, &mut v) }
+                unsafe { lib().fmi2GetStatus(p.i.c, fmi2StatusKind_fmi2DoStepStatus, &mut v) }
             },
             STATUS,
+            Documented(DISCARD, "no asynchronous step status"),
         ),
         (
             "fmi2GetRealStatus",
-            |i| {
-                let mut v = 0.0;
-                unsafe {
-                    lib().fmi2GetRealStatus(i.c, fmi2StatusKind_fmi2LastSuccessfulTime, &mut v)
+            |p| {
+                let mut v = f64::NAN;
+                let s = unsafe {
+                    lib().fmi2GetRealStatus(p.i.c, fmi2StatusKind_fmi2LastSuccessfulTime, &mut v)
+                };
+                if s == OK {
+                    assert_eq!(v, 0.0, "no step was taken");
                 }
+                s
             },
             STATUS,
+            Fine,
         ),
         (
             "fmi2GetIntegerStatus",
-            |i| {
+            |p| {
                 let mut v = 0;
-                unsafe { lib().fmi2GetIntegerStatus(i.c, fmi2StatusKind_fmi2DoStepStatus, &mut v) }
+                unsafe {
+                    lib().fmi2GetIntegerStatus(p.i.c, fmi2StatusKind_fmi2DoStepStatus, &mut v)
+                }
             },
             STATUS,
+            Documented(DISCARD, "status kind 0 has no Integer value"),
         ),
         (
             "fmi2GetBooleanStatus",
-            |i| {
-                let mut v = 0;
-                unsafe { lib().fmi2GetBooleanStatus(i.c, fmi2StatusKind_fmi2Terminated, &mut v) }
+            |p| {
+                let mut v = 7;
+                let s = unsafe {
+                    lib().fmi2GetBooleanStatus(p.i.c, fmi2StatusKind_fmi2Terminated, &mut v)
+                };
+                if s == OK {
+                    assert_eq!(v, 0);
+                }
+                s
             },
             STATUS,
+            Fine,
         ),
         (
             "fmi2GetStringStatus",
-            |i| {
+            |p| {
                 let mut v: fmi2String = std::ptr::null();
-                unsafe { lib().fmi2GetStringStatus(i.c, fmi2StatusKind_fmi2PendingStatus, &mut v) }
+                unsafe {
+                    lib().fmi2GetStringStatus(p.i.c, fmi2StatusKind_fmi2PendingStatus, &mut v)
+                }
             },
             STATUS,
+            Documented(DISCARD, "status kind 1 has no String value"),
         ),
         (
             "fmi2FreeInstance",
-            |i| {
-                i.free();
+            |p| {
+                p.i.free();
+                // No status (void): the instance must be gone, so a call on it is refused.
+                let (s, _) = p.i.get_reals(&[probe::GAIN as u32]);
+                assert_eq!(s, ERROR);
                 OK
             },
-            &[
-                Instantiated,
-                Initialization,
-                StepComplete,
-                Terminated,
-                Error,
-                Fatal,
-            ],
+            EVERY,
+            Fine,
         ),
     ]
 }
 
 #[test]
-fn every_function_in_every_state_is_allowed_or_an_illegal_call_sequence() {
+fn every_function_answers_as_documented_where_allowed_and_is_refused_elsewhere() {
     let mut checked = 0;
-    for (name, call, allowed) in functions() {
+    for (name, call, allowed, answer) in functions() {
         for mode in MODES {
-            let mut i = probe_in(mode);
-            let status = call(&mut i);
-            let illegal = i
-                .messages(ERROR)
+            let mut p = probe_in(mode);
+            let status = call(&mut p);
+            let messages: Vec<(fmi2Status, String)> =
+                p.i.records()
+                    .into_iter()
+                    .map(|r| (r.status, r.message))
+                    .collect();
+            let illegal = messages
                 .iter()
-                .any(|m| m.starts_with(&format!("{name}: illegal call sequence")));
+                .any(|(_, m)| m.starts_with(&format!("{name}: illegal call sequence")));
             if allowed.contains(&mode) {
-                assert!(!illegal, "{name} refused in {mode:?}: {:?}", i.records());
+                assert!(!illegal, "{name} refused in {mode:?}: {messages:?}");
+                match answer {
+                    Answer::Ok => assert_eq!(status, OK, "{name} in {mode:?}: {messages:?}"),
+                    Answer::Documented(expected, reason) => {
+                        assert_eq!(status, expected, "{name} in {mode:?}: {messages:?}");
+                        // Errors are always logged; a Discard only with logging on.
+                        if expected == ERROR {
+                            let logged = format!("{name}: {reason}");
+                            assert!(
+                                messages.iter().any(|(s, m)| *s == expected && m == &logged),
+                                "{name} in {mode:?}: {messages:?}"
+                            );
+                        }
+                    }
+                }
             } else {
                 assert_eq!(status, ERROR, "{name} in {mode:?}");
                 assert!(
                     illegal,
-                    "{name} in {mode:?} did not log an illegal call sequence: {:?}",
-                    i.records()
+                    "{name} in {mode:?} did not log an illegal call sequence: {messages:?}"
                 );
             }
             checked += 1;
         }
     }
     assert_eq!(checked, 31 * MODES.len());
+}
+
+/// The Discard answers give their reason in the log when warnings are logged.
+#[test]
+fn discarded_status_requests_say_why() {
+    let p = probe_in(StepComplete);
+    assert_eq!(p.i.set_debug_logging(true, &["logStatusWarning"]), OK);
+    let mut v = 0;
+    let s = unsafe { lib().fmi2GetStatus(p.i.c, fmi2StatusKind_fmi2DoStepStatus, &mut v) };
+    assert_eq!(s, DISCARD);
+    assert!(p
+        .i
+        .messages(DISCARD)
+        .contains(&"fmi2GetStatus: no asynchronous step status: steps are synchronous".into()));
 }
 
 #[test]
@@ -895,26 +1027,49 @@ fn corrupt_truncated_and_foreign_state_bytes_are_refused() {
     probe.free_state(&mut probe_state);
 }
 
+/// fmi2SetFMUstate restores the mode the state was saved in, whatever the mode now (as
+/// the Reference FMUs do): the instance then behaves exactly like the one that saved it.
 #[test]
-fn restoring_a_state_keeps_the_mode_and_refuses_mixing_before_and_after_initialization() {
+fn restoring_a_state_brings_back_the_mode_it_was_saved_in() {
     let i = Instance::new(&plant::INFO);
     let (_, mut early) = i.get_state();
     i.start();
     run_plant(&i, 0, 10);
     let (_, mut running) = i.get_state();
-    // Saved before initialization: refused now, and the instance carries on.
-    assert_eq!(i.set_state(early), ERROR);
-    assert!(i.last_error().contains("saved before initialization"));
-    run_plant(&i, 10, 20);
-    // After termination a running state restores the values but not the ability to step.
-    assert_eq!(i.terminate(), OK);
-    assert_eq!(i.set_state(running), OK);
+    let reference = run_plant(&i, 10, 30);
+
+    // Saved before initialization: the instance is back in Instantiated with start values.
+    assert_eq!(i.set_state(early), OK);
     assert_eq!(i.step(0.01, 0.001), ERROR);
     assert!(i
         .last_error()
-        .contains("illegal call sequence (state Terminated)"));
-    i.free_state(&mut early);
-    i.free_state(&mut running);
+        .contains("illegal call sequence (state Instantiated)"));
+    assert_eq!(
+        i.get_reals(&[POS0_X]).0,
+        ERROR,
+        "no fmi2GetReal before initialization"
+    );
+    assert_eq!(i.setup(0.0, None), OK);
+    assert_eq!(i.enter_init(), OK);
+    assert_eq!(i.get_reals(&[U_X, POS_X]), (OK, vec![0.0, 0.0]));
+
+    // Terminated, then a state saved while stepping: stepping again, bit for bit.
+    assert_eq!(i.exit_init(), OK);
+    assert_eq!(i.terminate(), OK);
+    assert_eq!(i.set_state(running), OK);
+    assert_eq!(run_plant(&i, 10, 30), reference);
+
+    // A state set into a freshly instantiated instance: no initialization needed.
+    let fresh = Instance::new(&plant::INFO);
+    let (_, bytes) = i.serialize(running);
+    let (s, mut restored) = fresh.deserialize(&bytes);
+    assert_eq!(s, OK);
+    assert_eq!(fresh.set_state(restored), OK);
+    assert_eq!(run_plant(&fresh, 10, 30), reference);
+
+    assert_eq!(i.free_state(&mut early), OK);
+    assert_eq!(i.free_state(&mut running), OK);
+    assert_eq!(fresh.free_state(&mut restored), OK);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -25,10 +25,18 @@ pub fn render(model: &ModelInfo) -> String {
             (Causality::Input, _) => "input",
             (Causality::Output, _) => "output",
         };
-        let start = if v.causality == Causality::Output {
-            String::new()
-        } else {
-            start_text(v.start)
+        let start = match (v.causality, v.enumeration, v.start) {
+            (Causality::Output, _, _) => String::new(),
+            (_, Some(e), Start::Integer(x)) => match e.item(x) {
+                Some(item) => format!("{x} ({})", item.name),
+                None => x.to_string(),
+            },
+            _ => start_text(v.start),
+        };
+        let type_name = match v.enumeration {
+            // Set and read with fmi2SetInteger / fmi2GetInteger.
+            Some(e) => format!("Enumeration {} ({})", e.name, e.listing()),
+            None => v.var_type().name().to_string(),
         };
         let range = match (v.min, v.max) {
             (None, None) => String::new(),
@@ -43,7 +51,7 @@ pub fn render(model: &ModelInfo) -> String {
             "<tr><td><code>{}</code></td><td>{}</td><td>{kind}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             escape(v.name),
             v.vr,
-            v.var_type().name(),
+            escape(&type_name),
             escape(&start),
             escape(v.unit.unwrap_or("")),
             escape(&range),
@@ -94,9 +102,9 @@ print(result.dtype.names)</pre>
 <h2>Behaviour at the FMI boundary</h2>
 <ul>
 <li>Calls in the wrong state return <code>fmi2Error</code> and log <code>&lt;function&gt;: illegal call sequence</code>.</li>
-<li>Non-finite or out-of-range values are refused with <code>fmi2Error</code>; the previous value stays.</li>
+<li>Non-finite or out-of-range values are refused with <code>fmi2Error</code>; the previous value stays. Enumerations are set with <code>fmi2SetInteger</code>; a value that is not one of the items is refused.</li>
 <li>Parameters are checked again in <code>fmi2ExitInitializationMode</code>; on error the instance stays in initialization mode so they can be corrected.</li>
-<li>FMU states can be saved, restored and serialized (a versioned, checksummed byte format).</li>
+<li>FMU states can be saved, restored and serialized (a versioned, checksummed byte format); a restored state brings its mode with it, so it can be set right after instantiation. Restored bytes are validated like parameters; handles that are not live FMU states of the instance are refused.</li>
 <li>Log categories: logEvents, logStatusWarning, logStatusError, logStatusFatal, logAll. Errors are always logged.</li>
 </ul>
 </body>

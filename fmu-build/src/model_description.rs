@@ -6,7 +6,7 @@ use std::fmt::Write;
 
 use contour_fmu::fmi2::LogCategory;
 use contour_fmu::models::units::{self, UnitDefinition};
-use contour_fmu::models::{Causality, ModelInfo, Start, Variable};
+use contour_fmu::models::{Causality, EnumType, ModelInfo, Start, Variable};
 
 use crate::escape;
 
@@ -37,7 +37,41 @@ fn type_element(v: &Variable) -> String {
             write!(attributes, " {name}=\"{text}\"").unwrap();
         }
     }
-    format!("<{}{attributes}/>", v.var_type().name())
+    match v.enumeration {
+        // An Integer with a declared enumeration type is an FMI Enumeration variable.
+        Some(e) => format!(
+            "<Enumeration declaredType=\"{}\"{attributes}/>",
+            escape(e.name)
+        ),
+        None => format!("<{}{attributes}/>", v.var_type().name()),
+    }
+}
+
+fn type_definition(e: &EnumType) -> String {
+    let mut xml = format!(
+        "    <SimpleType name=\"{}\" description=\"{}\">\n      <Enumeration>\n",
+        escape(e.name),
+        escape(e.description)
+    );
+    for (i, item) in e.items.iter().enumerate() {
+        writeln!(
+            xml,
+            "        <Item name=\"{}\" value=\"{}\" description=\"{}\"/>",
+            escape(item.name),
+            i + 1,
+            escape(item.description)
+        )
+        .unwrap();
+    }
+    xml.push_str("      </Enumeration>\n    </SimpleType>\n");
+    xml
+}
+
+/// A `dependencies` attribute: ScalarVariable indices (1-based, ascending), or the empty
+/// list for "depends on none of the Knowns".
+fn dependencies(indices: &[usize]) -> String {
+    let list: Vec<String> = indices.iter().map(|i| i.to_string()).collect();
+    format!(" dependencies=\"{}\"", list.join(" "))
 }
 
 fn unit_element(u: &UnitDefinition) -> String {
@@ -108,6 +142,20 @@ pub fn render(model: &ModelInfo) -> String {
         writeln!(w, "  </UnitDefinitions>").unwrap();
     }
 
+    let mut types: Vec<&'static EnumType> = Vec::new();
+    for e in model.variables.iter().filter_map(|v| v.enumeration) {
+        if !types.iter().any(|t| t.name == e.name) {
+            types.push(e);
+        }
+    }
+    if !types.is_empty() {
+        writeln!(w, "  <TypeDefinitions>").unwrap();
+        for e in types {
+            w.push_str(&type_definition(e));
+        }
+        writeln!(w, "  </TypeDefinitions>").unwrap();
+    }
+
     writeln!(w, "  <LogCategories>").unwrap();
     for c in LogCategory::ALL {
         writeln!(
@@ -153,25 +201,56 @@ pub fn render(model: &ModelInfo) -> String {
     }
     writeln!(w, "  </ModelVariables>").unwrap();
 
-    // Outputs only change inside fmi2DoStep (no direct feedthrough), hence the empty
-    // dependency lists; initial values may depend on any parameter.
-    let outputs: Vec<usize> = model
+    // Dependencies are always written, also when empty: an importer (syssimx) fails on a
+    // missing attribute, which FMI 2.0 reads as "depends on every Known".
+    //
+    // Outputs (FMI 2.0 ModelStructure/Outputs; for Co-Simulation the dependency "at
+    // communication points" on the Knowns: inputs, continuous states, time): these FMUs
+    // compute their outputs only inside fmi2DoStep, from the inputs held over the step,
+    // and keep them until the next one. Setting an input at a communication point changes
+    // no output before the next step: there is no direct feedthrough, and FMI 2.0 writes
+    // that as the empty list, "depends on none of the Knowns". Listing the inputs instead
+    // would be false and would make masters see an algebraic loop in the closed loop
+    // controller -> plant -> controller that does not exist.
+    //
+    // InitialUnknowns (the outputs again; Knowns in Initialization Mode: inputs and
+    // variables with initial="exact", i.e. our parameters): the initial value of an output
+    // is computed from a few parameters (the plant's position from pos0.*, the
+    // interpolator's first sample from the path); the model lists them
+    // (`ModelInfo::initial_dependencies`, tested by perturbing every variable).
+    let outputs: Vec<&Variable> = model
         .variables
         .iter()
-        .enumerate()
-        .filter(|(_, v)| v.causality == Causality::Output)
-        .map(|(i, _)| i + 1)
+        .filter(|v| v.causality == Causality::Output)
         .collect();
+    let index = |v: &Variable| v.vr + 1; // the value reference is the table index
     writeln!(w, "  <ModelStructure>").unwrap();
     if !outputs.is_empty() {
         writeln!(w, "    <Outputs>").unwrap();
-        for i in &outputs {
-            writeln!(w, "      <Unknown index=\"{i}\" dependencies=\"\"/>").unwrap();
+        for v in &outputs {
+            writeln!(
+                w,
+                "      <Unknown index=\"{}\"{}/>",
+                index(v),
+                dependencies(&[])
+            )
+            .unwrap();
         }
         writeln!(w, "    </Outputs>").unwrap();
         writeln!(w, "    <InitialUnknowns>").unwrap();
-        for i in &outputs {
-            writeln!(w, "      <Unknown index=\"{i}\"/>").unwrap();
+        for v in &outputs {
+            let knowns: Vec<usize> = model
+                .initial_dependencies_of(v.vr)
+                .into_iter()
+                .map(|vr| index(&model.variables[vr]))
+                .collect();
+            writeln!(
+                w,
+                "      <Unknown index=\"{}\"{}/>",
+                index(v),
+                dependencies(&knowns)
+            )
+            .unwrap();
         }
         writeln!(w, "    </InitialUnknowns>").unwrap();
     }

@@ -34,8 +34,27 @@ fn every_output_is_listed_once_in_outputs_and_initial_unknowns() {
             .iter()
             .filter(|v| v.causality == models::Causality::Output)
             .count();
-        assert_eq!(xml.matches("dependencies=\"\"/>").count(), outputs);
+        // Every Unknown states its dependencies explicitly; outputs have no direct
+        // feedthrough (empty list), initial values depend on the listed parameters.
         assert_eq!(xml.matches("<Unknown index=").count(), 2 * outputs);
+        let with_dependencies = xml
+            .split("<Unknown index=\"")
+            .skip(1)
+            .filter(|rest| {
+                rest.split_once('"')
+                    .is_some_and(|(_, attrs)| attrs.starts_with(" dependencies=\""))
+            })
+            .count();
+        assert_eq!(with_dependencies, 2 * outputs);
+        let section = |name: &str| {
+            let start = xml.find(&format!("<{name}>")).expect(name);
+            let end = xml.find(&format!("</{name}>")).expect(name);
+            xml[start..end].to_string()
+        };
+        assert_eq!(
+            section("Outputs").matches("dependencies=\"\"/>").count(),
+            outputs
+        );
         assert!(xml.contains(&format!("guid=\"{}\"", model.guid())));
     }
 }

@@ -1,55 +1,28 @@
 //! The 34 exported `fmi2*` functions of FMI 2.0 Co-Simulation. Each one only converts C
 //! arguments and hands over to [`Instance`]; [`dispatch`] supplies what all share: the
-//! instance pointer check, the lock, the state machine, logging and panic capture.
+//! instance lookup in the registry, the lock, the state machine, logging and panic capture.
 
 #![allow(non_snake_case)]
 
 use std::ffi::{c_char, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::ptr;
-use std::sync::{Mutex, MutexGuard};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use fmi_sys::fmi2::*;
 
 use super::instance::Instance;
 use super::logger::{Category, Logger};
+use super::registry::{self, InstanceCell};
 use super::resource_uri::resource_dir;
 use super::state_machine::{Call, Mode};
 use super::status::{Failure, Outcome, Status};
 use crate::models::{self, Environment, Value, VarType};
 
-/// What an `fmi2Component` points to. The tag lets us refuse pointers that are not (or
-/// no longer) our instances instead of reading garbage.
-struct InstanceCell {
-    tag: u64,
-    instance: Mutex<Instance>,
-}
-
-const LIVE_TAG: u64 = 0x4343_4346_4d55_3201; // "CCCFMU2" + 1
-const FMU_STATE_TAG: u64 = 0x4343_4346_4d55_5354;
-
-/// What an `fmi2FMUstate` points to: a serialized snapshot.
-struct StateBox {
-    tag: u64,
-    bytes: Vec<u8>,
-}
-
-/// The instance behind `c`, or `None` for NULL or a pointer we did not hand out.
-///
-/// # Safety
-/// `c` must be NULL or a pointer returned by `fmi2Instantiate` (possibly freed: the tag
-/// is cleared on free, which catches the common double-free).
-unsafe fn cell<'a>(c: fmi2Component) -> Option<&'a InstanceCell> {
-    let cell = (c as *const InstanceCell).as_ref()?;
-    (cell.tag == LIVE_TAG).then_some(cell)
-}
-
 fn lock(cell: &InstanceCell) -> MutexGuard<'_, Instance> {
     // A poisoned lock means an earlier call panicked: the instance is already marked
-    // Fatal (see `dispatch`), so handing it out again is safe and lets us answer.
-    cell.instance
-        .lock()
-        .unwrap_or_else(|poison| poison.into_inner())
+    // Fatal (see `run`), so handing it out again is safe and lets us answer.
+    cell.instance.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
 fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
@@ -60,17 +33,27 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "unknown panic".into())
 }
 
-/// Runs one instance function: checks the pointer and the mode, runs `body`, logs a
-/// failure, and turns a panic into `fmi2Fatal` (the instance then only accepts
-/// `fmi2FreeInstance`).
-unsafe fn dispatch(
+/// Runs one instance function: looks `c` up in the registry (a NULL, freed or foreign
+/// pointer is `fmi2Error` without touching it; there is no instance to log to), then
+/// [`run`]s `body` on it.
+fn dispatch(
     c: fmi2Component,
     call: Call,
     body: impl FnOnce(&mut Instance) -> Outcome,
 ) -> fmi2Status {
-    let Some(cell) = cell(c) else {
-        return Status::Error.code();
-    };
+    match registry::instance(c as usize) {
+        Some(cell) => run(&cell, call, body),
+        None => Status::Error.code(),
+    }
+}
+
+/// Checks the mode, runs `body`, logs a failure, and turns a panic into `fmi2Fatal` (the
+/// instance then only accepts `fmi2FreeInstance` and `fmi2FreeFMUstate`).
+fn run(
+    cell: &Arc<InstanceCell>,
+    call: Call,
+    body: impl FnOnce(&mut Instance) -> Outcome,
+) -> fmi2Status {
     let result = catch_unwind(AssertUnwindSafe(|| {
         let mut instance = lock(cell);
         let status = if !call.is_allowed_in(instance.mode) {
@@ -239,11 +222,13 @@ pub unsafe extern "C" fn fmi2Instantiate(
         let instance = Instance::new(info, environment, logger);
         instance.log_event(&format!("instantiated {} (GUID {guid})", info.identifier));
         instance.logger.flush();
-        let cell = Box::new(InstanceCell {
-            tag: LIVE_TAG,
+        let cell = Arc::new(InstanceCell {
+            name: name.to_owned(),
             instance: Mutex::new(instance),
         });
-        Some(Box::into_raw(cell) as fmi2Component)
+        lock(&cell).address = registry::address_of(&cell);
+        let address = registry::add_instance(Arc::clone(&cell));
+        Some(address as fmi2Component)
     }));
     match result {
         Ok(Some(c)) => c,
@@ -252,19 +237,26 @@ pub unsafe extern "C" fn fmi2Instantiate(
 }
 
 /// # Safety
-/// `c` as returned by `fmi2Instantiate`; it is invalid afterwards.
+/// `c` as returned by `fmi2Instantiate`; it is invalid afterwards. A NULL, freed or
+/// foreign `c` is ignored.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-    let mut free = false;
-    dispatch(c, Call::FreeInstance, |instance| {
+    let address = c as usize;
+    let Some(cell) = registry::instance(address) else {
+        return;
+    };
+    let status = run(&cell, Call::FreeInstance, |instance| {
         instance.log_event("freed");
-        free = true;
         Ok(())
     });
-    if free {
-        let cell = c as *mut InstanceCell;
-        (*cell).tag = 0;
-        let _ = catch_unwind(AssertUnwindSafe(|| drop(Box::from_raw(cell))));
+    if status == Status::Ok.code() {
+        // The instance (with its FMU states) is dropped with the last `Arc`: here, or at
+        // the end of a call still running on another thread.
+        let removed = registry::remove_instance(address);
+        let _ = catch_unwind(AssertUnwindSafe(move || {
+            drop(removed);
+            drop(cell);
+        }));
     }
 }
 
@@ -525,89 +517,126 @@ pub unsafe extern "C" fn fmi2SetString(
 // ---------------------------------------------------------------------------------------
 // FMU state
 
+/// The variable behind an `fmi2FMUstate*` argument. The argument must be the address of
+/// the importer's variable; if it is the value of one of our FMU states instead (see
+/// `fmi2FreeFMUstate`), reading through it would read our own state object as a pointer,
+/// so it is refused before it is dereferenced.
+///
 /// # Safety
-/// `state` points to NULL or to a state this instance returned earlier.
+/// `slot` is NULL, one of our FMU states, or points to a writable `fmi2FMUstate`.
+unsafe fn state_slot<'a>(
+    instance: &Instance,
+    slot: *mut fmi2FMUstate,
+) -> Outcome<&'a mut fmi2FMUstate> {
+    if instance.is_any_state(slot as usize) {
+        return Err(Failure::error(
+            "the FMUstate* argument is an FMU state, not the address of a variable holding one",
+        ));
+    }
+    slot.as_mut()
+        .ok_or_else(|| Failure::error("FMUstate (the address of the variable) is NULL"))
+}
+
+/// # Safety
+/// `state` points to a variable holding NULL or a state this instance returned earlier.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
     dispatch(c, Call::FmuState("fmi2GetFMUstate"), |instance| {
-        let slot = state
-            .as_mut()
-            .ok_or_else(|| Failure::error("FMUstate is NULL"))?;
+        let slot = state_slot(instance, state)?;
+        let existing = *slot as usize;
+        // FMI 2.0: a non-NULL *FMUstate is an earlier state to be overwritten.
+        if existing != 0 && !instance.owns_state(existing) {
+            return Err(instance.unknown_state(existing));
+        }
         let bytes = instance.snapshot()?;
-        match (*slot as *mut StateBox).as_mut() {
-            // The importer hands back an earlier state to be overwritten.
-            Some(existing) if existing.tag == FMU_STATE_TAG => existing.bytes = bytes,
-            Some(_) => return Err(Failure::error("*FMUstate is not a state of this library")),
-            None => {
-                *slot = Box::into_raw(Box::new(StateBox {
-                    tag: FMU_STATE_TAG,
-                    bytes,
-                })) as fmi2FMUstate
-            }
+        if existing == 0 {
+            *slot = instance.new_state(bytes) as fmi2FMUstate;
+        } else {
+            instance.overwrite_state(existing, bytes)?;
         }
         Ok(())
     })
 }
 
-unsafe fn state_bytes<'a>(state: fmi2FMUstate) -> Outcome<&'a [u8]> {
-    match (state as *const StateBox).as_ref() {
-        Some(b) if b.tag == FMU_STATE_TAG => Ok(&b.bytes),
-        Some(_) => Err(Failure::error("FMUstate is not a state of this library")),
-        None => Err(Failure::error("FMUstate is NULL")),
-    }
-}
-
 /// # Safety
-/// `state` as returned by `fmi2GetFMUstate` or `fmi2DeSerializeFMUstate`.
+/// `c` as returned by `fmi2Instantiate`; `state` is only looked up, never dereferenced.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status {
     dispatch(c, Call::FmuState("fmi2SetFMUstate"), |instance| {
-        instance.restore(state_bytes(state)?)
+        instance.restore_state(state as usize)
     })
 }
 
 /// # Safety
-/// `state` points to NULL or to a state this library returned.
+/// `state` is NULL, points to a variable holding NULL or a state of this instance, or (the
+/// importer bug handled below) is a state of this instance itself.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeFMUstate(
     c: fmi2Component,
     state: *mut fmi2FMUstate,
 ) -> fmi2Status {
-    dispatch(c, Call::FmuState("fmi2FreeFMUstate"), |_| {
+    dispatch(c, Call::FreeFmuState, |instance| {
+        let handle = state as usize;
+        // fmusim 0.0.39 calls fmi2FreeFMUstate(c, FMUState): the state instead of the
+        // address of the variable holding it. Dereferencing it (as the standard signature
+        // asks) would read our own state object as a pointer and then free whatever that
+        // points to: the SIGSEGV this used to be. The address of an importer variable can
+        // never equal that of a live state object, so the misuse is recognised exactly.
+        // We free the state and answer fmi2OK (with a warning in the log):
+        // - memory stays safe either way: the importer's variable keeps the stale value,
+        //   but every later use of it is looked up here first and refused, never read;
+        // - refusing would leak the state until fmi2FreeInstance and, worse, end fmusim's
+        //   run (it aborts on any status above fmi2OK), although the intent is clear.
+        if instance.owns_state(handle) {
+            instance.free_state(handle)?;
+            instance.log_warning(&format!(
+                "fmi2FreeFMUstate: the argument is the FMU state {handle:#x} itself, not the \
+                 address of a variable holding it (an importer bug); the state was freed, \
+                 the importer's variable could not be set to NULL"
+            ));
+            return Ok(());
+        }
+        if instance.is_any_state(handle) {
+            // The same misuse with another instance's state: not ours to free here.
+            return Err(instance.unknown_state(handle));
+        }
+        // FMI 2.0: a NULL pointer (or a variable holding NULL) is ignored.
         let Some(slot) = state.as_mut() else {
             return Ok(());
         };
         if slot.is_null() {
             return Ok(());
         }
-        state_bytes(*slot)?;
-        let boxed = *slot as *mut StateBox;
-        (*boxed).tag = 0;
-        drop(Box::from_raw(boxed));
+        instance.free_state(*slot as usize)?;
         *slot = ptr::null_mut();
         Ok(())
     })
 }
 
 /// # Safety
-/// `state` as returned by this library; `size` writable.
+/// `state` as returned by this instance (only looked up); `size` writable.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     c: fmi2Component,
     state: fmi2FMUstate,
     size: *mut usize,
 ) -> fmi2Status {
-    dispatch(c, Call::FmuState("fmi2SerializedFMUstateSize"), |_| {
-        let bytes = state_bytes(state)?;
-        *size
-            .as_mut()
-            .ok_or_else(|| Failure::error("size is NULL"))? = bytes.len();
-        Ok(())
-    })
+    dispatch(
+        c,
+        Call::FmuState("fmi2SerializedFMUstateSize"),
+        |instance| {
+            let bytes = instance.state_bytes(state as usize)?;
+            *size
+                .as_mut()
+                .ok_or_else(|| Failure::error("size is NULL"))? = bytes.len();
+            Ok(())
+        },
+    )
 }
 
 /// # Safety
-/// `serializedState` has room for `size` bytes.
+/// `state` as returned by this instance (only looked up); `serializedState` has room for
+/// `size` bytes.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SerializeFMUstate(
     c: fmi2Component,
@@ -615,8 +644,8 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     serializedState: *mut fmi2Byte,
     size: usize,
 ) -> fmi2Status {
-    dispatch(c, Call::FmuState("fmi2SerializeFMUstate"), |_| {
-        let bytes = state_bytes(state)?;
+    dispatch(c, Call::FmuState("fmi2SerializeFMUstate"), |instance| {
+        let bytes = instance.state_bytes(state as usize)?;
         if size < bytes.len() {
             return Err(Failure::error(format!(
                 "buffer of {size} bytes is too small for the state's {} bytes",
@@ -630,7 +659,7 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
 }
 
 /// # Safety
-/// `serializedState` holds `size` readable bytes; `state` is writable.
+/// `serializedState` holds `size` readable bytes; `state` points to a writable variable.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     c: fmi2Component,
@@ -639,15 +668,17 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     state: *mut fmi2FMUstate,
 ) -> fmi2Status {
     dispatch(c, Call::FmuState("fmi2DeSerializeFMUstate"), |instance| {
+        let slot = state_slot(instance, state)?;
         let bytes = slice(serializedState as *const u8, size, "serializedState")?;
-        let slot = state
-            .as_mut()
-            .ok_or_else(|| Failure::error("FMUstate is NULL"))?;
         instance.check_snapshot(bytes)?;
-        *slot = Box::into_raw(Box::new(StateBox {
-            tag: FMU_STATE_TAG,
-            bytes: bytes.to_vec(),
-        })) as fmi2FMUstate;
+        let existing = *slot as usize;
+        // A state of this instance is reused; anything else in the variable (NULL, or
+        // whatever an importer left there) is replaced by a new state, never read.
+        if instance.owns_state(existing) {
+            instance.overwrite_state(existing, bytes.to_vec())?;
+        } else {
+            *slot = instance.new_state(bytes.to_vec()) as fmi2FMUstate;
+        }
         Ok(())
     })
 }

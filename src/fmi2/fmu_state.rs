@@ -2,7 +2,10 @@
 //! serialized state can be stored, sent elsewhere and checked when it comes back.
 //!
 //! Layout: `MAGIC` (8 bytes) · format version (u16 LE) · postcard payload · CRC-32 of
-//! everything before it (u32 LE).
+//! everything before it (u32 LE). The payload's model part starts with the model's own
+//! state layout version (`crate::models::StateLayout`), checked by the model.
+//!
+//! Format versions: 1 had model bytes without a layout version; 2 adds it.
 
 use serde::{Deserialize, Serialize};
 
@@ -10,16 +13,17 @@ use super::state_machine::Mode;
 use crate::models::Values;
 
 const MAGIC: &[u8; 8] = b"CCCFMUst";
-/// The library that wrote a state; models' internal layouts may change between versions.
+/// The library that wrote a state, for messages (each model's state layout version, not
+/// the library version, decides whether a state can be read).
 pub const LIBRARY_VERSION: &str = env!("CARGO_PKG_VERSION");
-const FORMAT_VERSION: u16 = 1;
+const FORMAT_VERSION: u16 = 2;
 const HEADER: usize = MAGIC.len() + 2;
 const TRAILER: usize = 4;
 
 /// Everything needed to put an instance back where it was.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Snapshot {
-    /// [`LIBRARY_VERSION`] of the writer.
+    /// [`LIBRARY_VERSION`] of the writer (informative).
     pub library: String,
     /// GUID of the model the state belongs to; restoring into another model is refused.
     pub guid: String,
@@ -51,7 +55,13 @@ pub fn decode(bytes: &[u8]) -> Result<Snapshot, String> {
     let version = u16::from_le_bytes([bytes[8], bytes[9]]);
     if version != FORMAT_VERSION {
         return Err(format!(
-            "FMU state format version {version} is not supported (this library reads {FORMAT_VERSION})"
+            "FMU state format version {version} is not supported (this library reads \
+             {FORMAT_VERSION}): the state was saved by {} build of contour-fmu",
+            if version < FORMAT_VERSION {
+                "an older"
+            } else {
+                "a newer"
+            }
         ));
     }
     let (body, trailer) = bytes.split_at(bytes.len() - TRAILER);

@@ -2,10 +2,12 @@
 //! Every public method is one FMI function minus the C plumbing; the mode has already
 //! been checked against the state machine by the caller.
 
+use std::collections::BTreeMap;
 use std::ffi::CString;
 
 use super::fmu_state::{self, Snapshot};
 use super::logger::{to_c_string, Category, Logger};
+use super::registry;
 use super::state_machine::{Call, Mode};
 use super::status::{Failure, Outcome, Status};
 use crate::models::{Causality, Environment, Model, ModelInfo, Value, Values, Variability, Vr};
@@ -14,8 +16,17 @@ use crate::models::{Causality, Environment, Model, ModelInfo, Value, Values, Var
 /// importers accumulate time in floating point (fmpy: 0.009999999999999998).
 const TIME_TOLERANCE: f64 = 1e-9;
 
+/// An FMU state handed to the importer: the address of the box is the `fmi2FMUstate`.
+/// It holds the serialized snapshot, so serializing is a copy and every restore checks it.
+pub struct StoredState {
+    bytes: Vec<u8>,
+}
+
 pub struct Instance {
     pub info: &'static ModelInfo,
+    /// The address the importer knows this instance by (its `fmi2Component`), set at
+    /// registration; the owner recorded for its FMU states.
+    pub address: usize,
     guid: String,
     environment: Environment,
     model: Box<dyn Model>,
@@ -30,6 +41,8 @@ pub struct Instance {
     pub logger: Logger,
     /// Strings handed out by the last `fmi2GetString`, valid until the next call.
     returned_strings: Vec<CString>,
+    /// The live FMU states of this instance, by address (the registry knows them too).
+    states: BTreeMap<usize, Box<StoredState>>,
 }
 
 fn time_matches(a: f64, b: f64) -> bool {
@@ -51,11 +64,19 @@ impl Instance {
             needs_initialize: true,
             logger,
             returned_strings: Vec::new(),
+            address: 0,
+            states: BTreeMap::new(),
         }
     }
 
     pub fn log_event(&self, message: &str) {
         self.logger.log(Status::Ok, Category::Events, message);
+    }
+
+    /// A warning about a call that still succeeds (category logStatusWarning).
+    pub fn log_warning(&self, message: &str) {
+        self.logger
+            .log(Status::Warning, Category::StatusWarning, message);
     }
 
     pub fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Outcome {
@@ -269,7 +290,9 @@ impl Instance {
         .map_err(Failure::error)
     }
 
-    /// Checks that serialized bytes are a state of this model, without applying them.
+    /// Checks that serialized bytes are a state of this model, without applying them: the
+    /// envelope (magic, format, checksum), the GUID, every variable value like a `fmi2Set`
+    /// would, and the model's internal state (its layout version, then its values).
     pub fn check_snapshot(&self, bytes: &[u8]) -> Outcome<Snapshot> {
         let snapshot = fmu_state::decode(bytes).map_err(Failure::error)?;
         if snapshot.guid != self.guid {
@@ -278,69 +301,139 @@ impl Instance {
                 snapshot.guid, self.info.identifier, self.guid
             )));
         }
-        if snapshot.library != fmu_state::LIBRARY_VERSION {
-            // The GUID covers the interface, not the model's internal state layout.
-            return Err(Failure::error(format!(
-                "the FMU state was saved by contour-fmu {}, this is {}",
-                snapshot.library,
-                fmu_state::LIBRARY_VERSION
-            )));
-        }
         let table = self.info.variables;
-        let fits = snapshot.values.len() == table.len()
-            && table.iter().all(|v| {
-                let value = snapshot.values.get(v.vr);
-                value.var_type() == v.var_type()
-                    && (v.causality == Causality::Output || v.check(value).is_ok())
-            });
-        if !fits || snapshot.mode == Mode::Fatal {
+        if snapshot.values.len() != table.len() {
             return Err(Failure::error(
                 "the FMU state does not fit this model's variables",
             ));
         }
+        for v in table {
+            let value = snapshot.values.get(v.vr);
+            if value.var_type() != v.var_type() {
+                return Err(Failure::error(format!(
+                    "the FMU state does not fit this model's variables ('{}' is not a {})",
+                    v.name,
+                    v.var_type().name()
+                )));
+            }
+            if v.causality != Causality::Output {
+                v.check(value)
+                    .map_err(|e| Failure::error(format!("the FMU state is invalid: {e}")))?;
+            }
+        }
+        if snapshot.mode == Mode::Fatal {
+            return Err(Failure::error(
+                "the FMU state was saved after a fatal error",
+            ));
+        }
+        if !snapshot.time.is_finite() || snapshot.stop_time.is_some_and(|t| !t.is_finite()) {
+            return Err(Failure::error(format!(
+                "the FMU state is invalid: time {} / stop time {:?} not finite",
+                snapshot.time, snapshot.stop_time
+            )));
+        }
+        self.model.check_state(&snapshot.model).map_err(|e| {
+            Failure::error(format!(
+                "the FMU state is invalid (saved by contour-fmu {}): {e}",
+                snapshot.library
+            ))
+        })?;
         Ok(snapshot)
     }
 
-    /// The mode after restoring a snapshot taken in `saved`: the state machine has no
-    /// transition for fmi2SetFMUstate, so the mode stays, except that a snapshot is the way
-    /// out of the error state. Mixing states from before and after initialization is refused.
-    fn mode_after_restore(&self, saved: Mode) -> Outcome<Mode> {
-        let initialized = |m: Mode| !matches!(m, Mode::Instantiated | Mode::Initialization);
-        if self.mode == Mode::Error {
-            return Ok(saved);
-        }
-        if initialized(saved) != initialized(self.mode) {
-            return Err(Failure::error(format!(
-                "the FMU state was saved {} initialization and cannot be restored {} it",
-                if initialized(saved) {
-                    "after"
-                } else {
-                    "before"
-                },
-                if initialized(self.mode) {
-                    "after"
-                } else {
-                    "before"
-                },
-            )));
-        }
-        Ok(self.mode)
-    }
-
-    /// Restores a snapshot; nothing changes when it is refused.
+    /// Restores a snapshot with everything it holds, the mode included (as the Reference
+    /// FMUs do): a state saved while stepping can be set into a freshly instantiated
+    /// instance, which then steps on without initialization (fmusim's
+    /// `--initial-fmu-state-file`), and an instance that set a state continues exactly as
+    /// the one that saved it. Nothing changes when it is refused.
     pub fn restore(&mut self, bytes: &[u8]) -> Outcome {
         let snapshot = self.check_snapshot(bytes)?;
-        let mode = self.mode_after_restore(snapshot.mode)?;
         self.model
             .restore_state(&snapshot.model)
             .map_err(Failure::error)?;
         self.values = snapshot.values;
-        self.mode = mode;
+        self.mode = snapshot.mode;
         self.time = snapshot.time;
         self.last_successful_time = snapshot.time;
         self.stop_time = snapshot.stop_time;
         self.needs_initialize = snapshot.needs_initialize;
         Ok(())
+    }
+
+    // -----------------------------------------------------------------------------------
+    // FMU state handles. The importer's `fmi2FMUstate` values are only ever used as keys
+    // here, never dereferenced: a freed, foreign or made-up handle is an error, not a read.
+
+    /// Whether `handle` is a live FMU state of this instance.
+    pub fn owns_state(&self, handle: usize) -> bool {
+        self.states.contains_key(&handle)
+    }
+
+    /// Whether `handle` is a live FMU state of any instance.
+    pub fn is_any_state(&self, handle: usize) -> bool {
+        self.owns_state(handle) || registry::state_owner(handle).is_some()
+    }
+
+    /// Why `handle` is not usable as an FMU state of this instance.
+    pub fn unknown_state(&self, handle: usize) -> Failure {
+        if handle == 0 {
+            return Failure::error("FMUstate is NULL");
+        }
+        match registry::state_owner(handle) {
+            Some(owner) if owner != self.address => Failure::error(format!(
+                "FMUstate {handle:#x} belongs to instance '{}', not to this one: an FMU state \
+                 can only be used with the instance that made it (serialize it and \
+                 deserialize it here to move it)",
+                registry::instance_name(owner).unwrap_or_default()
+            )),
+            _ => Failure::error(format!(
+                "FMUstate {handle:#x} is not a live FMU state of this instance (already \
+                 freed, or not an FMU state)"
+            )),
+        }
+    }
+
+    /// The stored bytes of one of this instance's FMU states.
+    pub fn state_bytes(&self, handle: usize) -> Outcome<&[u8]> {
+        self.states
+            .get(&handle)
+            .map(|s| s.bytes.as_slice())
+            .ok_or_else(|| self.unknown_state(handle))
+    }
+
+    /// Stores a new FMU state; returns its handle.
+    pub fn new_state(&mut self, bytes: Vec<u8>) -> usize {
+        let state = Box::new(StoredState { bytes });
+        let handle = &*state as *const StoredState as usize;
+        self.states.insert(handle, state);
+        registry::add_state(handle, self.address);
+        handle
+    }
+
+    /// Replaces the bytes of one of this instance's FMU states.
+    pub fn overwrite_state(&mut self, handle: usize, bytes: Vec<u8>) -> Outcome {
+        match self.states.get_mut(&handle) {
+            Some(state) => {
+                state.bytes = bytes;
+                Ok(())
+            }
+            None => Err(self.unknown_state(handle)),
+        }
+    }
+
+    /// Frees one of this instance's FMU states.
+    pub fn free_state(&mut self, handle: usize) -> Outcome {
+        if self.states.remove(&handle).is_none() {
+            return Err(self.unknown_state(handle));
+        }
+        registry::remove_state(handle);
+        Ok(())
+    }
+
+    /// Restores one of this instance's FMU states.
+    pub fn restore_state(&mut self, handle: usize) -> Outcome {
+        let bytes = self.state_bytes(handle)?.to_vec();
+        self.restore(&bytes)
     }
 
     pub fn set_debug_logging(&mut self, on: bool, names: &[&str]) -> Outcome {

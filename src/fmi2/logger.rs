@@ -87,6 +87,15 @@ pub struct Logger {
     pending: RefCell<Vec<Message>>,
 }
 
+// SAFETY: `Logger` is not `Send` by itself only because of the importer's
+// `componentEnvironment` pointer (and the `RefCell` makes it `!Sync`, which is fine: it is
+// only ever used through `&mut Instance` behind the instance's mutex). We never dereference
+// that pointer; we only hand it back to the importer's own logger callback, as FMI 2.0
+// requires. FMI 2.0 lets an importer call an instance from any thread as long as calls on
+// one instance do not overlap, and the instance mutex serialises them, so moving the logger
+// (inside its instance) to another thread cannot create a data race on our side.
+unsafe impl Send for Logger {}
+
 struct Message {
     status: Status,
     category: Category,

@@ -5,6 +5,7 @@ mod exports;
 mod fmu_state;
 mod instance;
 mod logger;
+mod registry;
 mod resource_uri;
 mod state_machine;
 mod status;

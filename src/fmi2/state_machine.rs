@@ -36,7 +36,9 @@ pub enum Call {
     Reset,
     GetValues(&'static str),
     SetValues(&'static str),
+    /// Get, set, serialize, deserialize and the serialized size of an FMU state.
     FmuState(&'static str),
+    FreeFmuState,
     GetDirectionalDerivative,
     SetRealInputDerivatives,
     GetRealOutputDerivatives,
@@ -73,6 +75,9 @@ impl Call {
             Call::GetValues(_) => INIT | STEP | FAIL | TERM | ERR,
             Call::SetValues(_) => INST | INIT | STEP,
             Call::FmuState(_) => ALIVE,
+            // As for fmi2FreeInstance: after a fatal error the importer must still be able
+            // to release the states it holds; freeing one only drops its bytes.
+            Call::FreeFmuState => ALIVE | FATAL,
             Call::GetDirectionalDerivative => INIT | STEP | FAIL | TERM | ERR,
             Call::SetRealInputDerivatives => INST | INIT | STEP,
             Call::GetRealOutputDerivatives => STEP | FAIL | TERM | ERR,
@@ -96,6 +101,7 @@ impl Call {
             Call::ExitInitializationMode => "fmi2ExitInitializationMode",
             Call::Terminate => "fmi2Terminate",
             Call::Reset => "fmi2Reset",
+            Call::FreeFmuState => "fmi2FreeFMUstate",
             Call::GetValues(name)
             | Call::SetValues(name)
             | Call::FmuState(name)
@@ -126,6 +132,37 @@ mod tests {
         }
     }
 
+    /// The FMU state rows of FMI 2.0's table (and the Reference FMUs' masks): every mode
+    /// an instance can be in (Instantiated, InitializationMode, stepComplete, stepFailed,
+    /// terminated, error), not fatal; fmi2FreeFMUstate also in fatal (our extension, like
+    /// fmi2FreeInstance).
+    #[test]
+    fn fmu_state_functions_follow_the_standard_table() {
+        let alive = [
+            Mode::Instantiated,
+            Mode::Initialization,
+            Mode::StepComplete,
+            Mode::StepFailed,
+            Mode::Terminated,
+            Mode::Error,
+        ];
+        for name in [
+            "fmi2GetFMUstate",
+            "fmi2SetFMUstate",
+            "fmi2SerializedFMUstateSize",
+            "fmi2SerializeFMUstate",
+            "fmi2DeSerializeFMUstate",
+        ] {
+            for mode in alive {
+                assert!(Call::FmuState(name).is_allowed_in(mode), "{name} {mode:?}");
+            }
+            assert!(!Call::FmuState(name).is_allowed_in(Mode::Fatal), "{name}");
+        }
+        for mode in alive.into_iter().chain([Mode::Fatal]) {
+            assert!(Call::FreeFmuState.is_allowed_in(mode), "{mode:?}");
+        }
+    }
+
     #[test]
     fn fatal_allows_only_free() {
         let calls = [
@@ -139,5 +176,6 @@ mod tests {
             assert!(!call.is_allowed_in(Mode::Fatal), "{call:?}");
         }
         assert!(Call::FreeInstance.is_allowed_in(Mode::Fatal));
+        assert!(Call::FreeFmuState.is_allowed_in(Mode::Fatal));
     }
 }

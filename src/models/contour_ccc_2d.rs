@@ -1,17 +1,17 @@
 //! `ContourCCC2D`: the two-axis controller. Per axis a position loop on the following
 //! error, plus the cross-coupled correction along the contour normal with fixed or
-//! fuzzy-adapted PID gains (DESIGN 4.2, 4.3). The control law runs every `Ts` inside
+//! fuzzy-adapted PID gains (docs/design.md §4.2, 4.3). The control law runs every `Ts` inside
 //! `fmi2DoStep` on the inputs held over the step, whatever the communication step.
 
 use super::sample_clock::{check_period, SampleClock};
-use super::variables::{Start, Values, Variable, Vr};
+use super::variables::{EnumItem, EnumType, Start, Values, Variable, Vr};
 use super::{
-    decode_state, encode_state, geometry, DefaultExperiment, Environment, Model, ModelInfo,
-    ModelResult,
+    decode_state, encode_state, geometry, state_check, DefaultExperiment, Environment, Model,
+    ModelInfo, ModelResult, StateLayout,
 };
 use crate::contour::{ArcEstimator, Estimator, EstimatorKind, FreeCurveEstimator, LineEstimator};
 use crate::control::{
-    CccConfig, CccMode, ControllerConfig, CrossCoupledController, FuzzyFactors, PidGains,
+    CccConfig, CccMode, ControllerConfig, CrossCoupledController, FuzzyFactors, Pid, PidGains,
 };
 
 pub const REF_X: Vr = 0;
@@ -38,6 +38,27 @@ pub const CCC_LIMIT: Vr = 24;
 pub const FUZZY_FACTORS: Vr = 25;
 pub const ESTIMATOR: Vr = 30;
 pub const GEOMETRY: Vr = 31;
+
+/// The `estimator` parameter's type: an FMI Enumeration (importers show a drop-down), in
+/// the order of [`EstimatorKind::ALL`] (values 1, 2, 3).
+pub static ESTIMATOR_TYPE: EnumType = EnumType {
+    name: "ContourEstimator",
+    description: "How the controller estimates the contour error",
+    items: &[
+        EnumItem {
+            name: "free_curve",
+            description: "Free curve: two circles through the recent reference points (any path)",
+        },
+        EnumItem {
+            name: "line",
+            description: "Line: exact error to the line of the line.* parameters",
+        },
+        EnumItem {
+            name: "arc",
+            description: "Arc: exact error to the circle of the arc.* parameters",
+        },
+    ],
+};
 
 /// Start values: the controller library's documented defaults.
 const DEFAULT: ControllerConfig = ControllerConfig::DEFAULT;
@@ -189,10 +210,11 @@ static VARIABLES: [Variable; 31 + geometry::COUNT] = [
     Variable::parameter(
         ESTIMATOR,
         "estimator",
-        Start::String("free_curve"),
+        Start::Integer(1),
         "Contour estimator: free_curve (two circles through recent references), or line / arc \
          (exact, from the line.*/arc.* parameters)",
-    ),
+    )
+    .enumeration(&ESTIMATOR_TYPE),
     G[0],
     G[1],
     G[2],
@@ -215,13 +237,96 @@ pub static INFO: ModelInfo = ModelInfo {
         stop_time: 2.0,
         step_size: 1e-3,
     },
+    // Every output starts at 0: the control law first runs in fmi2DoStep.
+    initial_dependencies: &[],
     create: |_: &Environment| Box::new(ContourCcc2D { state: None }),
+};
+
+/// Version 1: `Option<State>` as below.
+const LAYOUT: StateLayout = StateLayout {
+    model: "ContourCCC2D",
+    version: 1,
 };
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct State {
     controller: CrossCoupledController<Estimator>,
     clock: SampleClock,
+}
+
+impl State {
+    /// Checks a restored state like the parameters it was built from; the error names
+    /// the offending value.
+    fn validate(&self) -> Result<(), String> {
+        self.clock.validate()?;
+        let controller = &self.controller;
+        let config = controller.config();
+        config
+            .validate()
+            .map_err(|e| format!("controller configuration: {e}"))?;
+        if self.clock.period() != config.ts {
+            return Err(format!(
+                "sample clock period {} s differs from the controller's Ts = {} s",
+                self.clock.period(),
+                config.ts
+            ));
+        }
+        let [x, y] = controller.axes();
+        for (name, pid) in [
+            ("X position loop", x),
+            ("Y position loop", y),
+            ("contour PID", controller.law().pid()),
+        ] {
+            check_pid(name, pid, config.ts)?;
+        }
+        state_check::all_positive(self, "radius").map_err(|e| format!("estimator: {e}"))?;
+        state_check::all_finite(self)
+    }
+}
+
+/// A PID restored from bytes: its period, gains, limit and memory (integral and previous
+/// error) as the configuration would have made them.
+fn check_pid(name: &str, pid: &Pid, ts: f64) -> Result<(), String> {
+    if pid.ts() != ts {
+        return Err(format!(
+            "{name}: PID sample period {} s differs from Ts = {ts} s",
+            pid.ts()
+        ));
+    }
+    if !pid.integral().is_finite() {
+        return Err(format!(
+            "{name}: PID memory (integral) = {} is not finite",
+            pid.integral()
+        ));
+    }
+    if let Some(e) = pid.previous_error().filter(|e| !e.is_finite()) {
+        return Err(format!(
+            "{name}: PID memory (previous error) = {e} is not finite"
+        ));
+    }
+    let g = pid.gains();
+    for (gain, value) in [("Kp", g.kp), ("Ki", g.ki), ("Kd", g.kd)] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(format!(
+                "{name}: PID gain {gain} = {value} must be finite and >= 0"
+            ));
+        }
+    }
+    if let Some(limit) = pid.limit().filter(|l| !(l.is_finite() && *l > 0.0)) {
+        return Err(format!(
+            "{name}: PID output limit {limit} must be finite and > 0"
+        ));
+    }
+    Ok(())
+}
+
+/// Decodes and checks a saved state.
+fn decode(bytes: &[u8]) -> Result<Option<State>, String> {
+    let state: Option<State> = decode_state(LAYOUT, bytes)?;
+    if let Some(state) = &state {
+        state.validate()?;
+    }
+    Ok(state)
 }
 
 pub struct ContourCcc2D {
@@ -262,11 +367,23 @@ fn config(values: &Values) -> ControllerConfig {
     }
 }
 
+/// The estimator kind the `estimator` value selects.
+fn estimator_kind(values: &Values) -> Result<EstimatorKind, String> {
+    let value = values.integer(ESTIMATOR);
+    usize::try_from(value)
+        .ok()
+        .and_then(|v| v.checked_sub(1))
+        .and_then(|i| EstimatorKind::ALL.get(i).copied())
+        .ok_or_else(|| {
+            format!(
+                "parameter 'estimator' = {value} is not one of {}",
+                ESTIMATOR_TYPE.listing()
+            )
+        })
+}
+
 fn estimator(values: &Values) -> Result<Estimator, String> {
-    let kind: EstimatorKind = values
-        .string(ESTIMATOR)
-        .parse()
-        .map_err(|e| format!("parameter 'estimator': {e}"))?;
+    let kind = estimator_kind(values)?;
     Ok(match kind {
         EstimatorKind::FreeCurve => Estimator::FreeCurve(FreeCurveEstimator::default()),
         EstimatorKind::Line => {
@@ -311,11 +428,15 @@ impl Model for ContourCcc2D {
     }
 
     fn save_state(&self) -> Result<Vec<u8>, String> {
-        encode_state(&self.state)
+        encode_state(LAYOUT, &self.state)
+    }
+
+    fn check_state(&self, bytes: &[u8]) -> ModelResult {
+        decode(bytes).map(drop)
     }
 
     fn restore_state(&mut self, bytes: &[u8]) -> ModelResult {
-        self.state = decode_state(bytes)?;
+        self.state = decode(bytes)?;
         Ok(())
     }
 }
@@ -330,5 +451,29 @@ mod tests {
         let values = Values::from_table(&VARIABLES);
         assert_eq!(config(&values), ControllerConfig::default());
         assert_eq!(estimator(&values).unwrap().kind(), EstimatorKind::FreeCurve);
+    }
+
+    #[test]
+    fn enumeration_items_are_the_estimator_kinds_in_order() {
+        assert_eq!(ESTIMATOR_TYPE.items.len(), EstimatorKind::ALL.len());
+        let mut values = Values::from_table(&VARIABLES);
+        for (i, (item, kind)) in ESTIMATOR_TYPE
+            .items
+            .iter()
+            .zip(EstimatorKind::ALL)
+            .enumerate()
+        {
+            assert_eq!(item.name, kind.as_str());
+            values.set(ESTIMATOR, super::super::Value::Integer(i as i32 + 1));
+            assert_eq!(estimator_kind(&values), Ok(kind));
+        }
+        for bad in [0, 4, -1] {
+            values.set(ESTIMATOR, super::super::Value::Integer(bad));
+            let message = estimator_kind(&values).unwrap_err();
+            assert!(
+                message.contains("1 = free_curve, 2 = line, 3 = arc"),
+                "{message}"
+            );
+        }
     }
 }

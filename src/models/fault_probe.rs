@@ -5,7 +5,7 @@
 use super::variables::{Start, Values, Variable, Vr};
 use super::{
     decode_state, encode_state, DefaultExperiment, Environment, Model, ModelInfo, ModelResult,
-    Value,
+    StateLayout, Value,
 };
 
 pub const PANIC: Vr = 0;
@@ -14,8 +14,10 @@ pub const LABEL: Vr = 2;
 pub const STEPS: Vr = 3;
 pub const ECHO: Vr = 4;
 pub const GAIN: Vr = 5;
+pub const LEVEL: Vr = 6;
+pub const NOTE: Vr = 7;
 
-static VARIABLES: [Variable; 6] = [
+static VARIABLES: [Variable; 8] = [
     Variable::discrete_input(
         PANIC,
         "panic",
@@ -44,6 +46,18 @@ static VARIABLES: [Variable; 6] = [
     )
     .tunable()
     .min(0.0),
+    Variable::discrete_input(
+        LEVEL,
+        "level",
+        Start::Integer(0),
+        "An Integer input (settable whenever inputs are)",
+    ),
+    Variable::discrete_input(
+        NOTE,
+        "note",
+        Start::String(""),
+        "A String input (settable whenever inputs are)",
+    ),
 ];
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -55,8 +69,23 @@ pub static INFO: ModelInfo = ModelInfo {
         stop_time: 1.0,
         step_size: 1e-3,
     },
+    // `echo` is the label as initialized; `steps` starts at 0.
+    initial_dependencies: &[(ECHO, &[LABEL])],
     create: |_: &Environment| Box::new(FaultProbe { steps: 0 }),
 };
+
+const LAYOUT: StateLayout = StateLayout {
+    model: "FaultProbe",
+    version: 1,
+};
+
+fn decode(bytes: &[u8]) -> Result<i32, String> {
+    let steps: i32 = decode_state(LAYOUT, bytes)?;
+    if steps < 0 {
+        return Err(format!("FaultProbe step count {steps} must be >= 0"));
+    }
+    Ok(steps)
+}
 
 struct FaultProbe {
     steps: i32,
@@ -92,11 +121,15 @@ impl Model for FaultProbe {
     }
 
     fn save_state(&self) -> Result<Vec<u8>, String> {
-        encode_state(&self.steps)
+        encode_state(LAYOUT, &self.steps)
+    }
+
+    fn check_state(&self, bytes: &[u8]) -> ModelResult {
+        decode(bytes).map(drop)
     }
 
     fn restore_state(&mut self, bytes: &[u8]) -> ModelResult {
-        self.steps = decode_state(bytes)?;
+        self.steps = decode(bytes)?;
         Ok(())
     }
 }

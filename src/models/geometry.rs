@@ -11,15 +11,16 @@ use crate::path::{Arc, Line};
 /// Number of variables in the block.
 pub const COUNT: usize = 9;
 
-const LINE_X0: usize = 0;
-const LINE_Y0: usize = 1;
-const LINE_X1: usize = 2;
-const LINE_Y1: usize = 3;
-const ARC_CX: usize = 4;
-const ARC_CY: usize = 5;
-const ARC_R: usize = 6;
-const ARC_START: usize = 7;
-const ARC_SWEEP: usize = 8;
+/// Offsets of the variables in the block.
+pub const LINE_X0: usize = 0;
+pub const LINE_Y0: usize = 1;
+pub const LINE_X1: usize = 2;
+pub const LINE_Y1: usize = 3;
+pub const ARC_CX: usize = 4;
+pub const ARC_CY: usize = 5;
+pub const ARC_R: usize = 6;
+pub const ARC_START: usize = 7;
+pub const ARC_SWEEP: usize = 8;
 
 const fn length(vr: Vr, name: &'static str, start: f64, description: &'static str) -> Variable {
     Variable::parameter(vr, name, Start::Real(start), description).unit("mm")

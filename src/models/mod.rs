@@ -5,6 +5,7 @@ pub mod contour_ccc_2d;
 pub mod geometry;
 pub mod path_interpolator_2d;
 pub mod sample_clock;
+pub mod state_check;
 pub mod units;
 pub mod variables;
 pub mod xy_servo_plant;
@@ -16,7 +17,9 @@ use std::path::PathBuf;
 
 use sha2::{Digest, Sha256};
 
-pub use variables::{Causality, Start, Value, Values, VarType, Variability, Variable, Vr};
+pub use variables::{
+    Causality, EnumItem, EnumType, Start, Value, Values, VarType, Variability, Variable, Vr,
+};
 
 /// What a model learns about its surroundings when it is created.
 #[derive(Clone, Debug, Default)]
@@ -45,21 +48,77 @@ pub trait Model: Send {
     /// the outputs. Must not allocate on the heap.
     fn do_step(&mut self, values: &mut Values, time: f64, step: f64) -> ModelResult;
 
-    /// The internal state as bytes (serde), for FMU state save/restore.
+    /// The internal state as bytes, for FMU state save/restore: [`encode_state`] with the
+    /// model's own [`StateLayout`].
     fn save_state(&self) -> Result<Vec<u8>, String>;
 
-    /// Restores what [`Model::save_state`] produced.
+    /// Checks bytes as [`Model::restore_state`] would, without applying them: the layout
+    /// version, then every value like a parameter (periods, radii, finite memories). The
+    /// error names the cause.
+    fn check_state(&self, bytes: &[u8]) -> ModelResult;
+
+    /// Restores what [`Model::save_state`] produced; nothing changes when it is refused.
     fn restore_state(&mut self, bytes: &[u8]) -> ModelResult;
 }
 
-/// Serialises a model's internal state with the same codec for every model.
-pub fn encode_state<T: serde::Serialize>(state: &T) -> Result<Vec<u8>, String> {
-    postcard::to_stdvec(state).map_err(|e| format!("cannot encode the model state: {e}"))
+/// The version of one model's internal state layout. Bump `version` whenever the saved
+/// state of that model changes shape or meaning (a field added, a type changed, a unit
+/// changed): states saved with another layout are then refused with a message instead of
+/// being misread. The interface GUID does not cover the internal state, so this is the
+/// only guard.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StateLayout {
+    /// The model's identifier, for messages.
+    pub model: &'static str,
+    pub version: u16,
 }
 
-/// The inverse of [`encode_state`].
-pub fn decode_state<T: serde::de::DeserializeOwned>(bytes: &[u8]) -> Result<T, String> {
-    postcard::from_bytes(bytes).map_err(|e| format!("cannot decode the model state: {e}"))
+/// Serialises a model's internal state with the same codec for every model: the layout
+/// version (u16, little endian), then the state in postcard.
+pub fn encode_state<T: serde::Serialize>(
+    layout: StateLayout,
+    state: &T,
+) -> Result<Vec<u8>, String> {
+    let mut bytes = Vec::with_capacity(256);
+    bytes.extend_from_slice(&layout.version.to_le_bytes());
+    postcard::to_extend(state, bytes).map_err(|e| format!("cannot encode the model state: {e}"))
+}
+
+/// The inverse of [`encode_state`]: refuses another layout version, truncated bytes and
+/// trailing bytes. The caller still validates the values.
+pub fn decode_state<T: serde::de::DeserializeOwned>(
+    layout: StateLayout,
+    bytes: &[u8],
+) -> Result<T, String> {
+    let Some((version, body)) = bytes.split_first_chunk::<2>() else {
+        return Err(format!(
+            "the {} state is truncated (no layout version)",
+            layout.model
+        ));
+    };
+    let version = u16::from_le_bytes(*version);
+    if version != layout.version {
+        let age = if version < layout.version {
+            "an older"
+        } else {
+            "a newer"
+        };
+        return Err(format!(
+            "the {} state has internal layout version {version}, this build reads layout \
+             version {} only: it was saved by {age} build of contour-fmu and cannot be restored",
+            layout.model, layout.version
+        ));
+    }
+    let (state, rest) = postcard::take_from_bytes(body)
+        .map_err(|e| format!("cannot decode the {} state: {e}", layout.model))?;
+    if !rest.is_empty() {
+        return Err(format!(
+            "cannot decode the {} state: {} trailing bytes",
+            layout.model,
+            rest.len()
+        ));
+    }
+    Ok(state)
 }
 
 /// `DefaultExperiment` of the model description.
@@ -77,6 +136,11 @@ pub struct ModelInfo {
     pub description: &'static str,
     pub variables: &'static [Variable],
     pub default_experiment: DefaultExperiment,
+    /// For each output whose initial value (at the end of initialization) depends on other
+    /// variables: the value references of those variables (parameters or inputs, the
+    /// "Knowns" of FMI 2.0's `InitialUnknowns`). An output not listed starts at a constant.
+    /// Checked against the model by perturbing every variable (see the tests below).
+    pub initial_dependencies: &'static [(Vr, &'static [Vr])],
     pub create: fn(&Environment) -> Box<dyn Model>,
 }
 
@@ -106,6 +170,19 @@ impl ModelInfo {
     pub fn variable(&self, vr: Vr) -> Option<&'static Variable> {
         self.variables.get(vr)
     }
+
+    /// The variables the initial value of `output` depends on, in value reference order.
+    pub fn initial_dependencies_of(&self, output: Vr) -> Vec<Vr> {
+        let mut knowns: Vec<Vr> = self
+            .initial_dependencies
+            .iter()
+            .filter(|(o, _)| *o == output)
+            .flat_map(|(_, knowns)| knowns.iter().copied())
+            .collect();
+        knowns.sort_unstable();
+        knowns.dedup();
+        knowns
+    }
 }
 
 /// One variable's attributes as a fixed text, for the GUID: explicit fields (numbers by
@@ -133,8 +210,22 @@ fn canonical_interface(v: &Variable) -> String {
             ),
             None => format!("{name}:undefined"),
         });
+    // Only enumerations add a field, so the GUIDs of other interfaces stay as they were.
+    let enumeration = v.enumeration.map_or(String::new(), |e| {
+        let items: Vec<String> = e
+            .items
+            .iter()
+            .map(|i| format!("{}:{}", i.name, i.description))
+            .collect();
+        format!(
+            "Enumeration={}:{}:{}\0",
+            e.name,
+            e.description,
+            items.join("\u{1}")
+        )
+    });
     format!(
-        "\0{}\0{}\0{}\0{}\0{start}\0{unit}\0{}\0{}\0{}",
+        "\0{}\0{}\0{}\0{}\0{start}\0{unit}\0{enumeration}{}\0{}\0{}",
         v.vr,
         v.name,
         v.causality.name(),
@@ -201,6 +292,179 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Other valid values of a variable, to perturb it with.
+    fn alternatives(v: &Variable, value: &Value) -> Vec<Value> {
+        let candidates = match value {
+            Value::Real(x) => vec![
+                Value::Real(if *x == 0.0 { 1.5 } else { x * 1.25 }),
+                Value::Real(x + 0.75),
+            ],
+            Value::Integer(x) => match v.enumeration {
+                Some(e) => (1..=e.items.len() as i32)
+                    .filter(|i| i != x)
+                    .map(Value::Integer)
+                    .collect(),
+                None => vec![Value::Integer(x + 1)],
+            },
+            Value::Boolean(b) => vec![Value::Boolean(!b)],
+            Value::String(text) => ["circle", "line", "arc", "infinity", "trident", "other"]
+                .iter()
+                .filter(|t| **t != text)
+                .map(|t| Value::String(t.to_string()))
+                .collect(),
+        };
+        candidates
+            .into_iter()
+            .filter(|c| v.check(c).is_ok())
+            .collect()
+    }
+
+    /// The outputs after initialization from `values`, or `None` if the model refuses them.
+    fn initial_outputs(model: &ModelInfo, values: &Values) -> Option<Vec<Value>> {
+        let mut values = values.clone();
+        let mut instance = (model.create)(&Environment::default());
+        instance.initialize(&mut values, 0.0).ok()?;
+        Some(
+            model
+                .variables
+                .iter()
+                .filter(|v| v.causality == Causality::Output)
+                .map(|v| values.get(v.vr).clone())
+                .collect(),
+        )
+    }
+
+    /// The `InitialUnknowns` dependencies written to the model descriptions are the true
+    /// ones: perturbing a variable that is not listed never changes an output's initial
+    /// value (in every context: each built-in path, each estimator, …), and every listed
+    /// variable does change it in some context.
+    #[test]
+    fn initial_dependencies_are_exactly_the_variables_that_change_initial_outputs() {
+        for model in instantiable() {
+            let outputs: Vec<&Variable> = model
+                .variables
+                .iter()
+                .filter(|v| v.causality == Causality::Output)
+                .collect();
+            let knowns: Vec<&Variable> = model
+                .variables
+                .iter()
+                .filter(|v| v.causality != Causality::Output)
+                .collect();
+            for (output, deps) in model.initial_dependencies {
+                assert!(outputs.iter().any(|o| o.vr == *output), "{output}");
+                assert!(deps.iter().all(|d| knowns.iter().any(|k| k.vr == *d)));
+            }
+            // Contexts: the start values and every alternative of a String or
+            // enumeration variable (they switch between whole behaviours), each also with
+            // every Real shifted off its start value (a start angle of 0 hides the radius
+            // in sin(start)).
+            let start = Values::from_table(model.variables);
+            let mut shifted = start.clone();
+            for v in &knowns {
+                if let Value::Real(x) = start.get(v.vr) {
+                    let candidate = Value::Real(x + 0.75);
+                    if v.check(&candidate).is_ok() {
+                        shifted.set(v.vr, candidate);
+                    }
+                }
+            }
+            let mut contexts = vec![start.clone(), shifted.clone()];
+            for v in &knowns {
+                if v.var_type() == VarType::String || v.enumeration.is_some() {
+                    for alt in alternatives(v, start.get(v.vr)) {
+                        for base in [&start, &shifted] {
+                            let mut c = base.clone();
+                            c.set(v.vr, alt.clone());
+                            contexts.push(c);
+                        }
+                    }
+                }
+            }
+            let mut seen = std::collections::HashSet::new();
+            let mut initialized = 0;
+            for context in &contexts {
+                let Some(base) = initial_outputs(model, context) else {
+                    continue;
+                };
+                initialized += 1;
+                for k in &knowns {
+                    for alt in alternatives(k, context.get(k.vr)) {
+                        let mut changed = context.clone();
+                        changed.set(k.vr, alt.clone());
+                        let Some(after) = initial_outputs(model, &changed) else {
+                            continue;
+                        };
+                        for (i, o) in outputs.iter().enumerate() {
+                            if after[i] == base[i] {
+                                continue;
+                            }
+                            assert!(
+                                model.initial_dependencies_of(o.vr).contains(&k.vr),
+                                "{}: initial '{}' changes with '{}' ({:?} -> {:?}) but does \
+                                 not list it",
+                                model.identifier,
+                                o.name,
+                                k.name,
+                                context.get(k.vr),
+                                alt
+                            );
+                            seen.insert((o.vr, k.vr));
+                        }
+                    }
+                }
+            }
+            assert!(initialized >= 1, "{}", model.identifier);
+            for o in &outputs {
+                for k in model.initial_dependencies_of(o.vr) {
+                    assert!(
+                        seen.contains(&(o.vr, k)),
+                        "{}: '{}' lists '{}' but never changes with it",
+                        model.identifier,
+                        o.name,
+                        model.variables[k].name
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn model_states_carry_their_layout_version() {
+        let layout = StateLayout {
+            model: "Demo",
+            version: 3,
+        };
+        let bytes = encode_state(layout, &(1.5f64, 7u32)).unwrap();
+        assert_eq!(&bytes[..2], &[3, 0]);
+        assert_eq!(decode_state::<(f64, u32)>(layout, &bytes), Ok((1.5, 7)));
+        let older = StateLayout {
+            version: 4,
+            ..layout
+        };
+        let message = decode_state::<(f64, u32)>(older, &bytes).unwrap_err();
+        assert_eq!(
+            message,
+            "the Demo state has internal layout version 3, this build reads layout version 4 \
+             only: it was saved by an older build of contour-fmu and cannot be restored"
+        );
+        let newer = StateLayout {
+            version: 2,
+            ..layout
+        };
+        assert!(decode_state::<(f64, u32)>(newer, &bytes)
+            .unwrap_err()
+            .contains("a newer build"));
+        assert!(decode_state::<(f64, u32)>(layout, &bytes[..1])
+            .unwrap_err()
+            .contains("truncated"));
+        let mut longer = bytes.clone();
+        longer.push(0);
+        assert!(decode_state::<(f64, u32)>(layout, &longer)
+            .unwrap_err()
+            .contains("1 trailing bytes"));
     }
 
     #[test]

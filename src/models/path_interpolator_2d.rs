@@ -7,10 +7,10 @@ use std::f64::consts::PI;
 use super::sample_clock::{check_period, SampleClock};
 use super::variables::{Start, Values, Variable, Vr};
 use super::{
-    decode_state, encode_state, geometry, DefaultExperiment, Environment, Model, ModelInfo,
-    ModelResult,
+    decode_state, encode_state, geometry, state_check, DefaultExperiment, Environment, Model,
+    ModelInfo, ModelResult, StateLayout,
 };
-use crate::path::{Interpolator, Path};
+use crate::path::{Arc, Curve, Interpolator, Line, Path};
 
 pub const REF_X: Vr = 0;
 pub const REF_Y: Vr = 1;
@@ -74,6 +74,31 @@ pub static INFO: ModelInfo = ModelInfo {
         stop_time: 2.0,
         step_size: 1e-3,
     },
+    // The first sample is the path's start point: for `line` the line's start, for `arc`
+    // the point at arc.start on the circle, otherwise fixed by the path name or file.
+    // Feed and Ts only matter from the first step on; `done` starts false.
+    initial_dependencies: &[
+        (
+            REF_X,
+            &[
+                PATH,
+                GEOMETRY + geometry::LINE_X0,
+                GEOMETRY + geometry::ARC_CX,
+                GEOMETRY + geometry::ARC_R,
+                GEOMETRY + geometry::ARC_START,
+            ],
+        ),
+        (
+            REF_Y,
+            &[
+                PATH,
+                GEOMETRY + geometry::LINE_Y0,
+                GEOMETRY + geometry::ARC_CY,
+                GEOMETRY + geometry::ARC_R,
+                GEOMETRY + geometry::ARC_START,
+            ],
+        ),
+    ],
     create: |environment: &Environment| {
         Box::new(PathInterpolator2D {
             environment: environment.clone(),
@@ -82,10 +107,65 @@ pub static INFO: ModelInfo = ModelInfo {
     },
 };
 
+/// Version 1: `Option<State>` as below.
+const LAYOUT: StateLayout = StateLayout {
+    model: "PathInterpolator2D",
+    version: 1,
+};
+
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct State {
     interpolator: Interpolator,
     clock: SampleClock,
+}
+
+impl State {
+    /// Checks a restored state like the parameters it was built from; the error names
+    /// the offending value. (A NURBS path is validated by its own decoder.)
+    fn validate(&self) -> Result<(), String> {
+        self.clock.validate()?;
+        let it = &self.interpolator;
+        if !(it.feed().is_finite() && it.feed() >= 0.0) {
+            return Err(format!(
+                "interpolator feed {} mm/s must be finite and >= 0",
+                it.feed()
+            ));
+        }
+        if it.ts() != self.clock.period() {
+            return Err(format!(
+                "interpolator period {} s differs from the sample clock period {} s",
+                it.ts(),
+                self.clock.period()
+            ));
+        }
+        match it.path() {
+            Path::Line(l) => Line::new(l.start(), l.end())
+                .map(drop)
+                .map_err(|e| format!("interpolator path: {e}"))?,
+            Path::Arc(a) => Arc::new(a.center(), a.radius(), a.start_angle(), a.sweep())
+                .map(drop)
+                .map_err(|e| format!("interpolator path: {e}"))?,
+            Path::Nurbs(_) => {}
+        }
+        state_check::all_finite(self)?;
+        let (u0, u1) = it.path().param_range();
+        if !(u0..=u1).contains(&it.parameter()) {
+            return Err(format!(
+                "interpolator parameter {} lies outside the path's [{u0}, {u1}]",
+                it.parameter()
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Decodes and checks a saved state.
+fn decode(bytes: &[u8]) -> Result<Option<State>, String> {
+    let state: Option<State> = decode_state(LAYOUT, bytes)?;
+    if let Some(state) = &state {
+        state.validate()?;
+    }
+    Ok(state)
 }
 
 pub struct PathInterpolator2D {
@@ -149,11 +229,15 @@ impl Model for PathInterpolator2D {
     }
 
     fn save_state(&self) -> Result<Vec<u8>, String> {
-        encode_state(&self.state)
+        encode_state(LAYOUT, &self.state)
+    }
+
+    fn check_state(&self, bytes: &[u8]) -> ModelResult {
+        decode(bytes).map(drop)
     }
 
     fn restore_state(&mut self, bytes: &[u8]) -> ModelResult {
-        self.state = decode_state(bytes)?;
+        self.state = decode(bytes)?;
         Ok(())
     }
 }

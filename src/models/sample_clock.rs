@@ -67,6 +67,29 @@ impl SampleClock {
     pub fn taken(&self) -> u64 {
         self.taken
     }
+
+    /// The sample period, s.
+    pub fn period(&self) -> f64 {
+        self.period
+    }
+
+    /// Checks a clock restored from saved bytes like the parameter it came from: a period
+    /// below [`MIN_PERIOD`] (or ≤ 0) would make one `fmi2DoStep` loop for hours or forever.
+    pub fn validate(&self) -> Result<(), String> {
+        if !self.start.is_finite() {
+            return Err(format!(
+                "sample clock start time {} is not finite",
+                self.start
+            ));
+        }
+        if !(self.period >= MIN_PERIOD && self.period.is_finite()) {
+            return Err(format!(
+                "sample clock period {} s must be at least {MIN_PERIOD:e} s",
+                self.period
+            ));
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]
@@ -93,6 +116,16 @@ mod tests {
         assert_eq!(fired_before(&[0.1, 0.2, 0.3], 0.1), vec![1, 3, 6]);
         let counts = fired_before(&[0.001; 1000], 0.001);
         assert_eq!(counts.last(), Some(&1000));
+    }
+
+    #[test]
+    fn restored_clocks_are_checked_like_the_period_parameter() {
+        assert_eq!(SampleClock::new(0.5, 1e-3).validate(), Ok(()));
+        for bad in [0.0, -1e-3, 1e-9, f64::NAN, f64::INFINITY] {
+            let message = SampleClock::new(0.0, bad).validate().unwrap_err();
+            assert!(message.starts_with("sample clock period"), "{message}");
+        }
+        assert!(SampleClock::new(f64::NAN, 1e-3).validate().is_err());
     }
 
     #[test]

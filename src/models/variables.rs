@@ -93,6 +93,45 @@ impl Start {
     }
 }
 
+/// One item of an FMI enumeration type; its value is its position in the list, from 1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnumItem {
+    /// The item's name, as importers show it in a drop-down.
+    pub name: &'static str,
+    pub description: &'static str,
+}
+
+/// An FMI `Enumeration` type (`TypeDefinitions/SimpleType`): a variable declared with it
+/// stores an Integer (set and read with `fmi2SetInteger`/`fmi2GetInteger`) that must be the
+/// value of one of the items, 1..=items.len().
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnumType {
+    /// The `SimpleType` name the variable's `declaredType` refers to.
+    pub name: &'static str,
+    pub description: &'static str,
+    pub items: &'static [EnumItem],
+}
+
+impl EnumType {
+    /// The item with FMI value `value`, if there is one.
+    pub fn item(&self, value: i32) -> Option<&'static EnumItem> {
+        usize::try_from(value)
+            .ok()
+            .and_then(|v| v.checked_sub(1))
+            .and_then(|i| self.items.get(i))
+    }
+
+    /// "1 = a, 2 = b, …", for messages.
+    pub fn listing(&self) -> String {
+        self.items
+            .iter()
+            .enumerate()
+            .map(|(i, item)| format!("{} = {}", i + 1, item.name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
 /// One row of a model's variable table.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Variable {
@@ -110,6 +149,8 @@ pub struct Variable {
     /// Inclusive bounds for Real and Integer variables, checked on every set.
     pub min: Option<f64>,
     pub max: Option<f64>,
+    /// For an Integer variable: the FMI enumeration type it is declared with.
+    pub enumeration: Option<&'static EnumType>,
 }
 
 impl Variable {
@@ -131,6 +172,7 @@ impl Variable {
             unit: None,
             min: None,
             max: None,
+            enumeration: None,
         }
     }
 
@@ -231,6 +273,16 @@ impl Variable {
         self
     }
 
+    /// Declares an Integer variable with an enumeration type (FMI `Enumeration`).
+    pub const fn enumeration(mut self, declared: &'static EnumType) -> Self {
+        assert!(
+            matches!(self.start, Start::Integer(_)),
+            "an enumeration variable stores an Integer"
+        );
+        self.enumeration = Some(declared);
+        self
+    }
+
     pub fn var_type(&self) -> VarType {
         self.start.var_type()
     }
@@ -244,6 +296,16 @@ impl Variable {
                 self.var_type().name(),
                 value.var_type().name()
             ));
+        }
+        if let (Some(declared), Value::Integer(v)) = (self.enumeration, value) {
+            if declared.item(*v).is_none() {
+                return Err(format!(
+                    "variable '{}' = {v} is not a value of its enumeration {} ({})",
+                    self.name,
+                    declared.name,
+                    declared.listing()
+                ));
+            }
         }
         let number = match *value {
             Value::Real(v) => v,

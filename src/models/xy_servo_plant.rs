@@ -1,12 +1,13 @@
-//! `XYServoPlant`: the two-axis test plant of DESIGN 4.5 as an FMU model. Velocity
+//! `XYServoPlant`: the two-axis test plant of docs/design.md §4.5 as an FMU model. Velocity
 //! commands in, positions and velocities out; integrated exactly, so the trajectory does
 //! not depend on the communication step.
 
 use super::variables::{Start, Values, Variable, Vr};
 use super::{
-    decode_state, encode_state, DefaultExperiment, Environment, Model, ModelInfo, ModelResult,
+    decode_state, encode_state, state_check, DefaultExperiment, Environment, Model, ModelInfo,
+    ModelResult, StateLayout,
 };
-use crate::plant::{AxisParams, XyTable, XyTableParams};
+use crate::plant::{AxisParams, ServoAxis, XyTable, XyTableParams};
 
 pub const U_X: Vr = 0;
 pub const U_Y: Vr = 1;
@@ -133,8 +134,71 @@ pub static INFO: ModelInfo = ModelInfo {
         stop_time: 2.0,
         step_size: 1e-3,
     },
+    // Both axes start at rest at pos0.
+    initial_dependencies: &[(POS_X, &[POS0_X]), (POS_Y, &[POS0_Y])],
     create: |_: &Environment| Box::new(XyServoPlant::default()),
 };
+
+/// Version 1: the [`XyTable`] as it serialises.
+const LAYOUT: StateLayout = StateLayout {
+    model: "XYServoPlant",
+    version: 1,
+};
+
+/// Checks a restored table like the parameters it was built from; the error names the
+/// offending value.
+fn validate(table: &XyTable) -> Result<(), String> {
+    for (name, axis) in [("x", &table.x), ("y", &table.y)] {
+        axis.params()
+            .validate()
+            .map_err(|e| format!("axis {name}: {e}"))?;
+        state_check::all_finite(axis).map_err(|e| format!("axis {name}: {e}"))?;
+        check_cached_transition(name, axis)?;
+    }
+    Ok(())
+}
+
+/// An axis keeps the transition matrices of its last step length; they must be the ones
+/// its parameters give for that length (recomputed the same way, so bit for bit), or the
+/// restored axis would follow other dynamics than its parameters say.
+fn check_cached_transition(name: &str, axis: &ServoAxis) -> Result<(), String> {
+    let cached = |a: &ServoAxis| -> Vec<(String, f64)> {
+        state_check::floats(a)
+            .into_iter()
+            .filter(|(path, _)| path.starts_with("cached"))
+            .collect()
+    };
+    let saved = cached(axis);
+    let Some(&(_, step)) = saved.iter().find(|(path, _)| path == "cached.step") else {
+        return Ok(()); // nothing cached yet
+    };
+    if !(step.is_finite() && step > 0.0) {
+        return Err(format!(
+            "axis {name}: cached step length {step} s must be finite and > 0"
+        ));
+    }
+    let mut reference = ServoAxis::new(*axis.params(), 0.0);
+    reference.step(0.0, step);
+    let expected = cached(&reference);
+    if saved.len() != expected.len()
+        || saved
+            .iter()
+            .zip(&expected)
+            .any(|(a, b)| a.0 != b.0 || a.1.to_bits() != b.1.to_bits())
+    {
+        return Err(format!(
+            "axis {name}: the cached transition for steps of {step} s does not match the \
+             axis parameters"
+        ));
+    }
+    Ok(())
+}
+
+fn decode(bytes: &[u8]) -> Result<XyTable, String> {
+    let table: XyTable = decode_state(LAYOUT, bytes)?;
+    validate(&table)?;
+    Ok(table)
+}
 
 /// The plant model; its state is the table's.
 pub struct XyServoPlant {
@@ -202,11 +266,15 @@ impl Model for XyServoPlant {
     }
 
     fn save_state(&self) -> Result<Vec<u8>, String> {
-        encode_state(&self.table)
+        encode_state(LAYOUT, &self.table)
+    }
+
+    fn check_state(&self, bytes: &[u8]) -> ModelResult {
+        decode(bytes).map(drop)
     }
 
     fn restore_state(&mut self, bytes: &[u8]) -> ModelResult {
-        self.table = decode_state(bytes)?;
+        self.table = decode(bytes)?;
         Ok(())
     }
 }

@@ -6,8 +6,9 @@ use std::ffi::{c_char, c_void, CStr, CString};
 use std::path::PathBuf;
 use std::sync::{Mutex, OnceLock};
 
-use contour_fmu::models::ModelInfo;
+use contour_fmu::models::{ModelInfo, Values};
 pub use fmi_sys::fmi2::*;
+use serde::{Deserialize, Serialize};
 
 pub const OK: fmi2Status = fmi2Status_fmi2OK;
 pub const WARNING: fmi2Status = fmi2Status_fmi2Warning;
@@ -337,6 +338,17 @@ impl Instance {
     pub fn free_state(&self, state: &mut fmi2FMUstate) -> fmi2Status {
         unsafe { lib().fmi2FreeFMUstate(self.c, state) }
     }
+    /// fmi2FreeFMUstate with an arbitrary pointer argument (fmusim 0.0.39 passes the state
+    /// itself: `free_state_raw(state as *mut fmi2FMUstate)`).
+    pub fn free_state_raw(&self, argument: *mut fmi2FMUstate) -> fmi2Status {
+        unsafe { lib().fmi2FreeFMUstate(self.c, argument) }
+    }
+    /// fmi2SerializedFMUstateSize alone.
+    pub fn state_size(&self, state: fmi2FMUstate) -> (fmi2Status, usize) {
+        let mut size = usize::MAX;
+        let s = unsafe { lib().fmi2SerializedFMUstateSize(self.c, state, &mut size) };
+        (s, size)
+    }
     pub fn serialize(&self, state: fmi2FMUstate) -> (fmi2Status, Vec<u8>) {
         let mut size = 0usize;
         let s = unsafe { lib().fmi2SerializedFMUstateSize(self.c, state, &mut size) };
@@ -374,4 +386,67 @@ impl Drop for Instance {
     fn drop(&mut self) {
         self.free();
     }
+}
+
+// ---------------------------------------------------------------------------------------
+// Serialized FMU states, opened and resealed by hand (the layout of src/fmi2/fmu_state.rs:
+// magic, format version, postcard payload, CRC-32), to hand the library bytes that pass
+// the checksum but carry a bad value inside.
+
+pub const STATE_MAGIC: &[u8; 8] = b"CCCFMUst";
+pub const STATE_FORMAT: u16 = 2;
+
+/// The payload of a serialized FMU state. `mode` is the library's mode enum as postcard
+/// writes it (the variant index); `model` is the model's own state: its layout version
+/// (u16 LE) then its fields.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StateEnvelope {
+    pub library: String,
+    pub guid: String,
+    pub mode: u32,
+    pub time: f64,
+    pub stop_time: Option<f64>,
+    pub needs_initialize: bool,
+    pub values: Values,
+    pub model: Vec<u8>,
+}
+
+/// The format version and payload of serialized state bytes (checksum verified).
+pub fn open_state(bytes: &[u8]) -> (u16, StateEnvelope) {
+    assert_eq!(&bytes[..8], STATE_MAGIC);
+    let (body, crc) = bytes.split_at(bytes.len() - 4);
+    assert_eq!(
+        crc32fast::hash(body).to_le_bytes(),
+        crc,
+        "checksum of the original bytes"
+    );
+    let format = u16::from_le_bytes([bytes[8], bytes[9]]);
+    let envelope = postcard::from_bytes(&body[10..]).expect("payload");
+    (format, envelope)
+}
+
+/// Serialized state bytes with a valid checksum.
+pub fn seal_state(format: u16, envelope: &StateEnvelope) -> Vec<u8> {
+    let mut bytes = STATE_MAGIC.to_vec();
+    bytes.extend_from_slice(&format.to_le_bytes());
+    bytes.extend_from_slice(&postcard::to_stdvec(envelope).expect("payload"));
+    let crc = crc32fast::hash(&bytes);
+    bytes.extend_from_slice(&crc.to_le_bytes());
+    bytes
+}
+
+/// Positions of the little-endian bytes of `value` in `bytes`.
+pub fn find_f64(bytes: &[u8], value: f64) -> Vec<usize> {
+    let pattern = value.to_le_bytes();
+    bytes
+        .windows(8)
+        .enumerate()
+        .filter(|(_, w)| *w == pattern)
+        .map(|(i, _)| i)
+        .collect()
+}
+
+/// Writes `value` at byte offset `at`.
+pub fn put_f64(bytes: &mut [u8], at: usize, value: f64) {
+    bytes[at..at + 8].copy_from_slice(&value.to_le_bytes());
 }

@@ -41,7 +41,8 @@ class Slave:
             name = name.replace("__", ".")
             kind = next(v.type for v in self.md.modelVariables if v.name == name)
             setter = {"Real": self.fmu.setReal, "Boolean": self.fmu.setBoolean,
-                      "String": self.fmu.setString, "Integer": self.fmu.setInteger}[kind]
+                      "String": self.fmu.setString, "Integer": self.fmu.setInteger,
+                      "Enumeration": self.fmu.setInteger}[kind]
             setter([self.vr[name]], [value])
 
     def reals(self, names):
@@ -69,6 +70,55 @@ def interpolator(fmu_dir):
 @pytest.mark.parametrize("model", ["PathInterpolator2D", "ContourCCC2D"])
 def test_validates_without_problems(fmu_dir, model):
     assert validate_fmu(str(fmu_dir / f"{model}.fmu")) == []
+
+
+ESTIMATOR = {"free_curve": 1, "line": 2, "arc": 3}
+
+
+def test_estimator_is_an_enumeration_importers_can_offer_as_a_choice(fmu_dir):
+    md = read_model_description(str(fmu_dir / "ContourCCC2D.fmu"))
+    v = next(v for v in md.modelVariables if v.name == "estimator")
+    assert v.type == "Enumeration" and v.causality == "parameter" and v.start == "1"
+    assert v.declaredType.name == "ContourEstimator"
+    assert {item.name: int(item.value) for item in v.declaredType.items} == ESTIMATOR
+    # `path` stays a String: it also takes file names.
+    md = read_model_description(str(fmu_dir / "PathInterpolator2D.fmu"))
+    assert next(v for v in md.modelVariables if v.name == "path").type == "String"
+
+
+def test_dependencies_are_explicit_no_feedthrough_and_initial_values_from_parameters(fmu_dir):
+    """As fmpy reads them: every output depends on no input at communication points (no
+    direct feedthrough), and each initial value on exactly the parameters it is computed from."""
+    expected_initial = {
+        "PathInterpolator2D": {"ref.x": ["path", "line.x0", "arc.cx", "arc.r", "arc.start"],
+                               "ref.y": ["path", "line.y0", "arc.cy", "arc.r", "arc.start"],
+                               "done": []},
+        "XYServoPlant": {"pos.x": ["pos0.x"], "pos.y": ["pos0.y"], "vel.x": [], "vel.y": []},
+        "ContourCCC2D": {name: [] for name in CONTROLLER_OUTPUTS},
+    }
+    for model, initial in expected_initial.items():
+        md = read_model_description(str(fmu_dir / f"{model}.fmu"))
+        outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+        assert sorted(u.variable.name for u in md.outputs) == sorted(outputs)
+        for unknown in md.outputs:
+            assert unknown.dependencies == [], (model, unknown.variable.name)
+        assert {u.variable.name: [d.name for d in u.dependencies] for u in md.initialUnknowns} == initial
+
+
+def test_initial_values_change_only_with_their_listed_dependencies(fmu_dir):
+    """The interpolator's first sample follows arc.r on the arc path, not the feed."""
+    def first_sample(**values):
+        s = Slave(str(fmu_dir / "PathInterpolator2D.fmu"))
+        s.set(**values)
+        s.fmu.exitInitializationMode()
+        point = s.reals(["ref.x", "ref.y"])
+        s.close()
+        return point
+
+    base = first_sample(path="arc", arc__start=0.5)
+    assert np.array_equal(first_sample(path="arc", arc__start=0.5, feed=3.0), base)
+    moved = first_sample(path="arc", arc__start=0.5, arc__r=25.0)
+    assert np.allclose(moved, [-20 + 25 * math.cos(0.5), 25 * math.sin(0.5)], atol=1e-12)
 
 
 # ---------------------------------------------------------------------------------------
@@ -159,6 +209,46 @@ def test_controller_state_restores_the_estimator_and_pid_memories(controller):
     c.fmu.freeFMUstate(restored)
 
 
+def test_a_saved_state_continues_in_a_fresh_instance_without_initialization(fmu_dir, controller):
+    """fmusim's --initial-fmu-state-file: instantiate, deserialize, set, then step on."""
+    c = controller
+    c.fmu.exitInitializationMode()
+    inputs = [c.vr[n] for n in ("ref.x", "ref.y", "pos.x", "pos.y")]
+
+    def go(slave, k0, k1):
+        out = []
+        for k in range(k0, k1):
+            slave.fmu.setReal(inputs, held_inputs(k * 0.001))
+            slave.fmu.doStep(currentCommunicationPoint=k * 0.001, communicationStepSize=0.001)
+            out.append(slave.reals(CONTROLLER_OUTPUTS))
+        return np.array(out)
+
+    go(c, 0, 30)
+    state = c.fmu.getFMUstate()
+    saved = c.fmu.serializeFMUstate(state)
+    c.fmu.freeFMUstate(state)
+    expected = go(c, 30, 70)
+
+    md = c.md
+    fresh = FMU2Slave(guid=md.guid, unzipDirectory=c.dir, modelIdentifier="ContourCCC2D",
+                      instanceName="fresh")
+    fresh.instantiate(callbacks=c.log.callbacks)
+    restored = fresh.deSerializeFMUstate(saved)
+    fresh.setFMUstate(restored)
+    fresh.freeFMUstate(restored)
+
+    class Wrapped:
+        fmu = fresh
+        vr = c.vr
+
+        @staticmethod
+        def reals(names):
+            return np.array(fresh.getReal([c.vr[n] for n in names]))
+
+    assert np.array_equal(go(Wrapped, 30, 70), expected)
+    fresh.freeInstance()
+
+
 # ---------------------------------------------------------------------------------------
 # Bad input
 
@@ -180,8 +270,8 @@ def test_nan_input_is_refused_and_outputs_stay(controller):
     ("controller", {"Ts": -0.001}, "parameter 'Ts' must be at least 1e-6 s (got -0.001)"),
     ("controller", {"Ts": 1e-10}, "parameter 'Ts' must be at least 1e-6 s"),
     ("controller", {"fuzzy__enable": True, "ccc__limit": 0.0}, "parameter ccc.limit = 0 is invalid"),
-    ("controller", {"estimator": "kalman"}, "parameter 'estimator': unknown contour estimator 'kalman'"),
-    ("controller", {"estimator": "arc", "arc__r": 0.0}, "parameters 'arc.*'"),
+    ("controller", {"estimator": ESTIMATOR["arc"], "arc__r": 0.0}, "parameters 'arc.*'"),
+    ("controller", {"estimator": ESTIMATOR["line"], "line__x1": 0.0, "line__y1": 0.0}, "parameters 'line.*'"),
     ("interpolator", {"feed": 0.0}, "parameter 'feed' must be > 0"),
     ("interpolator", {"feed": -5.0}, "parameter 'feed' must be > 0"),
     ("interpolator", {"Ts": 0.0}, "parameter 'Ts' must be at least 1e-6 s"),
@@ -194,6 +284,19 @@ def test_bad_parameters_are_refused_when_initialization_ends(request, fixture, v
     with pytest.raises(FMICallException):
         s.fmu.exitInitializationMode()
     assert any(words in m for m in s.log.errors()), s.log.errors()
+
+
+@pytest.mark.parametrize("value", [0, 4, -1])
+def test_an_estimator_value_outside_the_enumeration_is_refused_and_the_old_one_kept(controller, value):
+    estimator = controller.vr["estimator"]
+    with pytest.raises(FMICallException) as failure:
+        controller.fmu.setInteger([estimator], [value])
+    assert failure.value.status == 3  # fmi2Error
+    assert controller.log.errors()[-1] == (
+        f"fmi2SetInteger: variable 'estimator' = {value} is not a value of its enumeration "
+        "ContourEstimator (1 = free_curve, 2 = line, 3 = arc)")
+    assert controller.fmu.getInteger([estimator]) == [ESTIMATOR["free_curve"]]
+    controller.fmu.exitInitializationMode()
 
 
 def test_negative_fuzzy_factors_are_refused_with_the_parameter_named(controller):
@@ -238,7 +341,7 @@ def test_fuzzy_ccc_beats_no_ccc_through_the_fmus(fmu_dir, path, feed):
     assert fixed.max() < 0.5 * without.max()
     assert fuzzy.mean() < 0.1 * without.mean()
     if path == "circle":
-        # DESIGN 4.2: 47.7 um without CCC on the paper's circle and plant.
+        # docs/design.md §4.2: 47.7 um without CCC on the paper's circle and plant.
         assert 0.0476 < without.max() < 0.0478
 
 
