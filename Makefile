@@ -6,9 +6,9 @@ VENV   := .venv
 PYTHON := $(VENV)/bin/python
 CARGO  ?= cargo
 
-.PHONY: demo test fmus setup libclang lint bench pso-claim
+.PHONY: demo test fmus setup libclang libtbb lint bench pso-claim
 
-setup: libclang $(VENV)/.installed
+setup: libclang libtbb $(VENV)/.installed
 
 # fmi-sys generates its FMI bindings with bindgen, which needs libclang (the C API in
 # libclang-dev; Debian images often carry only libclang-cpp, which bindgen cannot use).
@@ -16,6 +16,14 @@ libclang:
 	@if ! dpkg -s libclang-dev >/dev/null 2>&1; then \
 		echo "installing libclang-dev (needed by bindgen)"; \
 		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libclang-dev; \
+	fi
+
+# ecospy's native engine (libecosc.so, the second co-simulation engine of the tests) links
+# against Intel TBB's runtime, libtbb.so.12, which the wheel does not bundle.
+libtbb:
+	@if ! dpkg -s libtbb12 >/dev/null 2>&1; then \
+		echo "installing libtbb12 (needed by ecospy)"; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libtbb12; \
 	fi
 
 $(VENV)/.installed: requirements.txt
