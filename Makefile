@@ -51,6 +51,7 @@ bench: setup
 	$(CARGO) build --release --bin ccc-tune --example fuzzy_timing
 	$(PYTHON) benches/fuzzy_vs_skfuzzy.py
 	$(PYTHON) benches/tuning_vs_pyswarms_fmu.py
+	$(PYTHON) benches/pso_tables.py
 
 # The paper's PSO claim at its full budget (about 10 minutes).
 pso-claim: setup

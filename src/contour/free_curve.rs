@@ -4,11 +4,11 @@
 //! Recent reference samples are kept in a fixed-capacity ring buffer. From the newest
 //! command point the search walks back while the distance to P decreases; the last point
 //! is Rε. Circles C1 through (Rε+1, Rε, Rε−1) and C2 through (Rε, Rε−1, Rε−2) approximate
-//! the path around it. Combination (docs/design.md §4.1): C1 alone when P is ahead of Rε
-//! ((P − Rε)·(Rε+1 − Rε) > 0, so the foot lies between Rε and Rε+1, inside C1's span),
-//! otherwise the mean of the C1 and C2 estimates (the foot lies between Rε−1 and Rε, which
-//! both circles span; their leading interpolation errors have opposite signs). Near the
-//! ends of the buffer the available circle next to Rε is used instead.
+//! the path around it. Combination (docs/design.md §4.1): the foot lies between Rε and its
+//! neighbour on P's side, and the estimate is the mean of the two circles that span that
+//! interval: C1 and C2 when P is behind Rε, C1 and C0 through (Rε+2, Rε+1, Rε) when P is
+//! ahead ((P − Rε)·(Rε+1 − Rε) > 0). Their leading interpolation errors have opposite
+//! signs. Near the ends of the buffer the one available circle is used.
 //!
 //! Each circle is evaluated by [`geom::circle_error`], which reduces continuously to the
 //! signed distance to the chord line for collinear samples, so straight parts need no
@@ -170,14 +170,20 @@ impl ContourEstimator for FreeCurveEstimator {
         }
         let re = self.get(k);
         let ahead = k >= 1 && v2::dot(v2::sub(actual, re), v2::sub(self.get(k - 1), re)) > 0.0;
-        let c1 = self.triple(actual, k, k);
-        let c2 = self.triple(actual, k + 1, k);
-        match (ahead, c1, c2) {
-            (true, Some(e1), _) => e1,
-            (false, Some(e1), Some(e2)) => geom::mean(e1, e2),
-            (_, Some(e), _) | (_, None, Some(e)) => e,
+        // The foot lies between Rε and its neighbour on P's side. Both circles whose three
+        // samples span that interval (centred on Rε and on the neighbour) are used: their
+        // leading interpolation errors have opposite signs, so their mean cancels them.
+        let centred = self.triple(actual, k, k);
+        let beside = if ahead {
+            self.triple(actual, k - 1, k)
+        } else {
+            self.triple(actual, k + 1, k)
+        };
+        match (centred, beside) {
+            (Some(a), Some(b)) => geom::mean(a, b),
+            (Some(e), None) | (None, Some(e)) => e,
             // Rε is the oldest sample: the circle (Rε, Rε+1, Rε+2); len ≥ 3 guarantees it.
-            (_, None, None) => self
+            (None, None) => self
                 .triple(actual, k.saturating_sub(1), k)
                 .unwrap_or_default(),
         }
