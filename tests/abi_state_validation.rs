@@ -134,6 +134,14 @@ fn controller_states_with_bad_clock_pid_or_radius_are_refused() {
             &format!("sample clock period {bad} s must be at least 1e-6 s"),
         );
     }
+    // A clock far behind the state's time (its start precedes its period): the first
+    // step would have to run 10⁹ samples to catch up.
+    refused(
+        &i,
+        &bytes,
+        |e| put_f64(&mut e.model, clock - 8, -1e6),
+        "sample clock: the next sample is due at",
+    );
     // The controller's own Ts (first in the configuration) out of line with the clock.
     refused(
         &i,

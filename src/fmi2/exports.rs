@@ -226,9 +226,10 @@ pub unsafe extern "C" fn fmi2Instantiate(
             name: name.to_owned(),
             instance: Mutex::new(instance),
         });
-        lock(&cell).address = registry::address_of(&cell);
-        let address = registry::add_instance(Arc::clone(&cell));
-        Some(address as fmi2Component)
+        let handle = registry::new_handle();
+        lock(&cell).handle = handle;
+        registry::add_instance(handle, Arc::clone(&cell));
+        Some(handle as fmi2Component)
     }));
     match result {
         Ok(Some(c)) => c,
@@ -241,23 +242,22 @@ pub unsafe extern "C" fn fmi2Instantiate(
 /// foreign `c` is ignored.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-    let address = c as usize;
-    let Some(cell) = registry::instance(address) else {
+    let handle = c as usize;
+    let Some(cell) = registry::instance(handle) else {
         return;
     };
-    let status = run(&cell, Call::FreeInstance, |instance| {
+    run(&cell, Call::FreeInstance, |instance| {
         instance.log_event("freed");
         Ok(())
     });
-    if status == Status::Ok.code() {
-        // The instance (with its FMU states) is dropped with the last `Arc`: here, or at
-        // the end of a call still running on another thread.
-        let removed = registry::remove_instance(address);
-        let _ = catch_unwind(AssertUnwindSafe(move || {
-            drop(removed);
-            drop(cell);
-        }));
-    }
+    // Unregistered whatever the log call did (even a panic in it must not leak the
+    // instance). The instance, with its FMU states, is dropped with the last `Arc`: here,
+    // or at the end of a call still running on another thread.
+    let removed = registry::remove_instance(handle);
+    let _ = catch_unwind(AssertUnwindSafe(move || {
+        drop(removed);
+        drop(cell);
+    }));
 }
 
 /// # Safety
@@ -518,17 +518,15 @@ pub unsafe extern "C" fn fmi2SetString(
 // FMU state
 
 /// The variable behind an `fmi2FMUstate*` argument. The argument must be the address of
-/// the importer's variable; if it is the value of one of our FMU states instead (see
-/// `fmi2FreeFMUstate`), reading through it would read our own state object as a pointer,
-/// so it is refused before it is dereferenced.
+/// the importer's variable; if it is one of our FMU state handles instead (see
+/// `fmi2FreeFMUstate`), it is no address at all, so it is refused before it is
+/// dereferenced.
 ///
 /// # Safety
-/// `slot` is NULL, one of our FMU states, or points to a writable `fmi2FMUstate`.
-unsafe fn state_slot<'a>(
-    instance: &Instance,
-    slot: *mut fmi2FMUstate,
-) -> Outcome<&'a mut fmi2FMUstate> {
-    if instance.is_any_state(slot as usize) {
+/// `slot` is NULL, one of our handles, or points to a writable `fmi2FMUstate`.
+unsafe fn state_slot<'a>(slot: *mut fmi2FMUstate) -> Outcome<&'a mut fmi2FMUstate> {
+    if registry::is_handle(slot as usize) {
+        // Live or freed, a handle of ours is not an address (see registry.rs).
         return Err(Failure::error(
             "the FMUstate* argument is an FMU state, not the address of a variable holding one",
         ));
@@ -542,7 +540,7 @@ unsafe fn state_slot<'a>(
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
     dispatch(c, Call::FmuState("fmi2GetFMUstate"), |instance| {
-        let slot = state_slot(instance, state)?;
+        let slot = state_slot(state)?;
         let existing = *slot as usize;
         // FMI 2.0: a non-NULL *FMUstate is an earlier state to be overwritten.
         if existing != 0 && !instance.owns_state(existing) {
@@ -580,8 +578,8 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
         // fmusim 0.0.39 calls fmi2FreeFMUstate(c, FMUState): the state instead of the
         // address of the variable holding it. Dereferencing it (as the standard signature
         // asks) would read our own state object as a pointer and then free whatever that
-        // points to: the SIGSEGV this used to be. The address of an importer variable can
-        // never equal that of a live state object, so the misuse is recognised exactly.
+        // points to: the SIGSEGV this used to be. Handles are never user-space addresses
+        // (registry.rs), so the misuse is recognised exactly, also with a freed state.
         // We free the state and answer fmi2OK (with a warning in the log):
         // - memory stays safe either way: the importer's variable keeps the stale value,
         //   but every later use of it is looked up here first and refused, never read;
@@ -596,8 +594,9 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
             ));
             return Ok(());
         }
-        if instance.is_any_state(handle) {
-            // The same misuse with another instance's state: not ours to free here.
+        if registry::is_handle(handle) {
+            // The same misuse with another instance's state or a freed one: refused, and
+            // never dereferenced (a handle is not an address).
             return Err(instance.unknown_state(handle));
         }
         // FMI 2.0: a NULL pointer (or a variable holding NULL) is ignored.
@@ -668,7 +667,7 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     state: *mut fmi2FMUstate,
 ) -> fmi2Status {
     dispatch(c, Call::FmuState("fmi2DeSerializeFMUstate"), |instance| {
-        let slot = state_slot(instance, state)?;
+        let slot = state_slot(state)?;
         let bytes = slice(serializedState as *const u8, size, "serializedState")?;
         instance.check_snapshot(bytes)?;
         let existing = *slot as usize;

@@ -16,7 +16,7 @@ use crate::models::{Causality, Environment, Model, ModelInfo, Value, Values, Var
 /// importers accumulate time in floating point (fmpy: 0.009999999999999998).
 const TIME_TOLERANCE: f64 = 1e-9;
 
-/// An FMU state handed to the importer: the address of the box is the `fmi2FMUstate`.
+/// An FMU state handed to the importer (its `fmi2FMUstate` is a registry handle).
 /// It holds the serialized snapshot, so serializing is a copy and every restore checks it.
 pub struct StoredState {
     bytes: Vec<u8>,
@@ -24,9 +24,9 @@ pub struct StoredState {
 
 pub struct Instance {
     pub info: &'static ModelInfo,
-    /// The address the importer knows this instance by (its `fmi2Component`), set at
+    /// The handle the importer knows this instance by (its `fmi2Component`), set at
     /// registration; the owner recorded for its FMU states.
-    pub address: usize,
+    pub handle: usize,
     guid: String,
     environment: Environment,
     model: Box<dyn Model>,
@@ -41,8 +41,18 @@ pub struct Instance {
     pub logger: Logger,
     /// Strings handed out by the last `fmi2GetString`, valid until the next call.
     returned_strings: Vec<CString>,
-    /// The live FMU states of this instance, by address (the registry knows them too).
+    /// The live FMU states of this instance, by handle (the registry knows them too).
     states: BTreeMap<usize, Box<StoredState>>,
+}
+
+impl Drop for Instance {
+    /// The FMU states die with their instance: unregister them, also one created by a
+    /// call that was still running when another thread freed the instance.
+    fn drop(&mut self) {
+        for &handle in self.states.keys() {
+            registry::remove_state(handle);
+        }
+    }
 }
 
 fn time_matches(a: f64, b: f64) -> bool {
@@ -64,7 +74,7 @@ impl Instance {
             needs_initialize: true,
             logger,
             returned_strings: Vec::new(),
-            address: 0,
+            handle: 0,
             states: BTreeMap::new(),
         }
     }
@@ -332,12 +342,14 @@ impl Instance {
                 snapshot.time, snapshot.stop_time
             )));
         }
-        self.model.check_state(&snapshot.model).map_err(|e| {
-            Failure::error(format!(
-                "the FMU state is invalid (saved by contour-fmu {}): {e}",
-                snapshot.library
-            ))
-        })?;
+        self.model
+            .check_state(&snapshot.model, snapshot.time)
+            .map_err(|e| {
+                Failure::error(format!(
+                    "the FMU state is invalid (saved by contour-fmu {}): {e}",
+                    snapshot.library
+                ))
+            })?;
         Ok(snapshot)
     }
 
@@ -349,7 +361,7 @@ impl Instance {
     pub fn restore(&mut self, bytes: &[u8]) -> Outcome {
         let snapshot = self.check_snapshot(bytes)?;
         self.model
-            .restore_state(&snapshot.model)
+            .restore_state(&snapshot.model, snapshot.time)
             .map_err(Failure::error)?;
         self.values = snapshot.values;
         self.mode = snapshot.mode;
@@ -369,18 +381,13 @@ impl Instance {
         self.states.contains_key(&handle)
     }
 
-    /// Whether `handle` is a live FMU state of any instance.
-    pub fn is_any_state(&self, handle: usize) -> bool {
-        self.owns_state(handle) || registry::state_owner(handle).is_some()
-    }
-
     /// Why `handle` is not usable as an FMU state of this instance.
     pub fn unknown_state(&self, handle: usize) -> Failure {
         if handle == 0 {
             return Failure::error("FMUstate is NULL");
         }
         match registry::state_owner(handle) {
-            Some(owner) if owner != self.address => Failure::error(format!(
+            Some(owner) if owner != self.handle => Failure::error(format!(
                 "FMUstate {handle:#x} belongs to instance '{}', not to this one: an FMU state \
                  can only be used with the instance that made it (serialize it and \
                  deserialize it here to move it)",
@@ -403,10 +410,9 @@ impl Instance {
 
     /// Stores a new FMU state; returns its handle.
     pub fn new_state(&mut self, bytes: Vec<u8>) -> usize {
-        let state = Box::new(StoredState { bytes });
-        let handle = &*state as *const StoredState as usize;
-        self.states.insert(handle, state);
-        registry::add_state(handle, self.address);
+        let handle = registry::new_handle();
+        self.states.insert(handle, Box::new(StoredState { bytes }));
+        registry::add_state(handle, self.handle);
         handle
     }
 

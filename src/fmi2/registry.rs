@@ -3,9 +3,16 @@
 //! An importer may pass anything: a freed instance, another library's instance, one of our
 //! FMU states in place of its address (fmusim 0.0.39's `fmi2FreeFMUstate(c, state)`).
 //! Pointers are therefore never dereferenced to find out what they are; they are looked
-//! up here by their address first. Instances live in an `Arc`, so a call that found its
-//! instance keeps it alive even if another thread frees it meanwhile (an importer bug, but
-//! not a use-after-free).
+//! up here first. Instances live in an `Arc`, so a call that found its instance keeps it
+//! alive even if another thread frees it meanwhile (an importer bug, but not a
+//! use-after-free).
+//!
+//! Handles are not addresses: the allocator hands freed addresses out again, and a stale
+//! handle would then name a new instance or state (of another model, even). They are
+//! numbers from one counter that never repeats, with the top bit set so that no handle is
+//! a user-space address on x86-64 Linux: a handle can never be mistaken for the address
+//! of an importer's variable (see `state_slot` in exports.rs). Importers treat both
+//! `fmi2Component` and `fmi2FMUstate` as opaque.
 //!
 //! The registry is the library's only global mutable state. A lookup takes a read lock and
 //! walks a `BTreeMap`: no allocation, so `fmi2DoStep` stays allocation-free.
@@ -14,6 +21,7 @@
 //! remove its FMU states), never the other way round: nothing here locks an instance.
 
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
 use super::instance::Instance;
@@ -37,9 +45,9 @@ const _: () = {
 };
 
 struct Registry {
-    /// Live instances by address.
+    /// Live instances by handle.
     instances: BTreeMap<usize, Arc<InstanceCell>>,
-    /// Live FMU states by address, with the address of the instance that owns them (the
+    /// Live FMU states by handle, with the handle of the instance that owns them (the
     /// states themselves live in their instance).
     states: BTreeMap<usize, usize>,
 }
@@ -59,32 +67,42 @@ fn write() -> RwLockWriteGuard<'static, Registry> {
     REGISTRY.write().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// The address an instance is known by (and the `fmi2Component` the importer gets).
-pub fn address_of(cell: &Arc<InstanceCell>) -> usize {
-    Arc::as_ptr(cell) as usize
+/// Top bit of every handle: above the 47-bit user address space of x86-64 Linux.
+const HANDLE_TAG: usize = 1 << (usize::BITS - 1);
+
+static NEXT_HANDLE: AtomicUsize = AtomicUsize::new(1);
+
+/// A handle never handed out before (for an instance or an FMU state).
+pub fn new_handle() -> usize {
+    // 2^63 handles: a process cannot exhaust them.
+    HANDLE_TAG | NEXT_HANDLE.fetch_add(1, Ordering::Relaxed)
 }
 
-/// Registers a new instance; returns its address.
-pub fn add_instance(cell: Arc<InstanceCell>) -> usize {
-    let address = address_of(&cell);
-    write().instances.insert(address, cell);
-    address
+/// Whether `value` has the form of one of our handles (live or not). Such a value is never
+/// a user-space address, so it must not be dereferenced as one.
+pub fn is_handle(value: usize) -> bool {
+    value & HANDLE_TAG != 0
 }
 
-/// The live instance at `address`, if there is one.
-pub fn instance(address: usize) -> Option<Arc<InstanceCell>> {
-    read().instances.get(&address).cloned()
+/// Registers a new instance under `handle` (from [`new_handle`]).
+pub fn add_instance(handle: usize, cell: Arc<InstanceCell>) {
+    write().instances.insert(handle, cell);
+}
+
+/// The live instance with `handle`, if there is one.
+pub fn instance(handle: usize) -> Option<Arc<InstanceCell>> {
+    read().instances.get(&handle).cloned()
 }
 
 /// Unregisters an instance and its FMU states; the caller drops the returned cell (outside
 /// the registry lock), which frees the instance once no call uses it any more.
-pub fn remove_instance(address: usize) -> Option<Arc<InstanceCell>> {
+pub fn remove_instance(handle: usize) -> Option<Arc<InstanceCell>> {
     let mut registry = write();
-    registry.states.retain(|_, owner| *owner != address);
-    registry.instances.remove(&address)
+    registry.states.retain(|_, owner| *owner != handle);
+    registry.instances.remove(&handle)
 }
 
-/// Records that the FMU state at `state` belongs to the instance at `owner`.
+/// Records that the FMU state `state` belongs to the instance `owner` (both handles).
 pub fn add_state(state: usize, owner: usize) {
     write().states.insert(state, owner);
 }
@@ -98,7 +116,7 @@ pub fn state_owner(state: usize) -> Option<usize> {
     read().states.get(&state).copied()
 }
 
-/// The name of the live instance at `address`.
-pub fn instance_name(address: usize) -> Option<String> {
-    read().instances.get(&address).map(|cell| cell.name.clone())
+/// The name of the live instance with `handle`.
+pub fn instance_name(handle: usize) -> Option<String> {
+    read().instances.get(&handle).map(|cell| cell.name.clone())
 }

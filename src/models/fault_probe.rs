@@ -124,11 +124,11 @@ impl Model for FaultProbe {
         encode_state(LAYOUT, &self.steps)
     }
 
-    fn check_state(&self, bytes: &[u8]) -> ModelResult {
+    fn check_state(&self, bytes: &[u8], _time: f64) -> ModelResult {
         decode(bytes).map(drop)
     }
 
-    fn restore_state(&mut self, bytes: &[u8]) -> ModelResult {
+    fn restore_state(&mut self, bytes: &[u8], _time: f64) -> ModelResult {
         self.steps = decode(bytes)?;
         Ok(())
     }

@@ -53,12 +53,14 @@ pub trait Model: Send {
     fn save_state(&self) -> Result<Vec<u8>, String>;
 
     /// Checks bytes as [`Model::restore_state`] would, without applying them: the layout
-    /// version, then every value like a parameter (periods, radii, finite memories). The
-    /// error names the cause.
-    fn check_state(&self, bytes: &[u8]) -> ModelResult;
+    /// version, then every value like a parameter (periods, radii, finite memories) and,
+    /// for a sampled model, that its sample clock is at `time`, the instance time saved
+    /// with the state. The error names the cause.
+    fn check_state(&self, bytes: &[u8], time: f64) -> ModelResult;
 
-    /// Restores what [`Model::save_state`] produced; nothing changes when it is refused.
-    fn restore_state(&mut self, bytes: &[u8]) -> ModelResult;
+    /// Restores what [`Model::save_state`] produced at instance time `time`; nothing
+    /// changes when it is refused.
+    fn restore_state(&mut self, bytes: &[u8], time: f64) -> ModelResult;
 }
 
 /// The version of one model's internal state layout. Bump `version` whenever the saved

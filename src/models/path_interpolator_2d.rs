@@ -122,8 +122,8 @@ struct State {
 impl State {
     /// Checks a restored state like the parameters it was built from; the error names
     /// the offending value. (A NURBS path is validated by its own decoder.)
-    fn validate(&self) -> Result<(), String> {
-        self.clock.validate()?;
+    fn validate(&self, time: f64) -> Result<(), String> {
+        self.clock.validate_at(time)?;
         let it = &self.interpolator;
         if !(it.feed().is_finite() && it.feed() >= 0.0) {
             return Err(format!(
@@ -160,10 +160,10 @@ impl State {
 }
 
 /// Decodes and checks a saved state.
-fn decode(bytes: &[u8]) -> Result<Option<State>, String> {
+fn decode(bytes: &[u8], time: f64) -> Result<Option<State>, String> {
     let state: Option<State> = decode_state(LAYOUT, bytes)?;
     if let Some(state) = &state {
-        state.validate()?;
+        state.validate(time)?;
     }
     Ok(state)
 }
@@ -232,12 +232,12 @@ impl Model for PathInterpolator2D {
         encode_state(LAYOUT, &self.state)
     }
 
-    fn check_state(&self, bytes: &[u8]) -> ModelResult {
-        decode(bytes).map(drop)
+    fn check_state(&self, bytes: &[u8], time: f64) -> ModelResult {
+        decode(bytes, time).map(drop)
     }
 
-    fn restore_state(&mut self, bytes: &[u8]) -> ModelResult {
-        self.state = decode(bytes)?;
+    fn restore_state(&mut self, bytes: &[u8], time: f64) -> ModelResult {
+        self.state = decode(bytes, time)?;
         Ok(())
     }
 }

@@ -73,9 +73,12 @@ impl SampleClock {
         self.period
     }
 
-    /// Checks a clock restored from saved bytes like the parameter it came from: a period
-    /// below [`MIN_PERIOD`] (or ≤ 0) would make one `fmi2DoStep` loop for hours or forever.
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks a clock restored from saved bytes at instance time `time` like the
+    /// parameter it came from: a period below [`MIN_PERIOD`] (or ≤ 0) would make one
+    /// `fmi2DoStep` loop for hours or forever, and so would a clock far behind the time
+    /// (a start of −1e6 s is 10⁹ samples to catch up). Whichever way it is stepped, the
+    /// next sample of a live clock is due within one period of the instance time.
+    pub fn validate_at(&self, time: f64) -> Result<(), String> {
         if !self.start.is_finite() {
             return Err(format!(
                 "sample clock start time {} is not finite",
@@ -85,6 +88,16 @@ impl SampleClock {
         if !(self.period >= MIN_PERIOD && self.period.is_finite()) {
             return Err(format!(
                 "sample clock period {} s must be at least {MIN_PERIOD:e} s",
+                self.period
+            ));
+        }
+        let next = self.due(self.taken);
+        // False for a NaN time too.
+        let within = (next - time).abs() <= self.period + self.tolerance();
+        if !within {
+            return Err(format!(
+                "sample clock: the next sample is due at {next} s, more than one period \
+                 ({} s) from the state's time {time} s",
                 self.period
             ));
         }
@@ -120,12 +133,37 @@ mod tests {
 
     #[test]
     fn restored_clocks_are_checked_like_the_period_parameter() {
-        assert_eq!(SampleClock::new(0.5, 1e-3).validate(), Ok(()));
+        assert_eq!(SampleClock::new(0.5, 1e-3).validate_at(0.5), Ok(()));
         for bad in [0.0, -1e-3, 1e-9, f64::NAN, f64::INFINITY] {
-            let message = SampleClock::new(0.0, bad).validate().unwrap_err();
+            let message = SampleClock::new(0.0, bad).validate_at(0.0).unwrap_err();
             assert!(message.starts_with("sample clock period"), "{message}");
         }
-        assert!(SampleClock::new(f64::NAN, 1e-3).validate().is_err());
+        assert!(SampleClock::new(f64::NAN, 1e-3).validate_at(0.0).is_err());
+        // A clock far from the state's time would loop through the gap in one step.
+        let message = SampleClock::new(-1e6, 1e-3).validate_at(0.0).unwrap_err();
+        assert!(
+            message.starts_with("sample clock: the next sample"),
+            "{message}"
+        );
+        assert!(SampleClock::new(0.0, 1e-3).validate_at(0.5).is_err());
+    }
+
+    /// Every clock a run can produce passes: after any sequence of steps, controller-style
+    /// and interpolator-style, the next sample is within one period of the time reached.
+    #[test]
+    fn every_reachable_clock_is_valid_at_its_time() {
+        for ts in [1e-3, 2.5e-3, 0.1] {
+            let (mut before, mut until) = (SampleClock::new(0.3, ts), SampleClock::new(0.3, ts));
+            let mut t = 0.3;
+            assert_eq!(before.validate_at(t), Ok(()));
+            for k in 0..2000 {
+                t += [0.001, 0.0025, 0.004, 0.0007][k % 4];
+                while before.take_before(t) {}
+                while until.take_until(t) {}
+                assert_eq!(before.validate_at(t), Ok(()), "take_before at {t}");
+                assert_eq!(until.validate_at(t), Ok(()), "take_until at {t}");
+            }
+        }
     }
 
     #[test]

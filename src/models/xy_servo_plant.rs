@@ -269,11 +269,11 @@ impl Model for XyServoPlant {
         encode_state(LAYOUT, &self.table)
     }
 
-    fn check_state(&self, bytes: &[u8]) -> ModelResult {
+    fn check_state(&self, bytes: &[u8], _time: f64) -> ModelResult {
         decode(bytes).map(drop)
     }
 
-    fn restore_state(&mut self, bytes: &[u8]) -> ModelResult {
+    fn restore_state(&mut self, bytes: &[u8], _time: f64) -> ModelResult {
         self.table = decode(bytes)?;
         Ok(())
     }

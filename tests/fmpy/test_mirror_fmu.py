@@ -31,7 +31,7 @@ def assert_mirrored(a, b):
     assert np.abs(before_a["plant.pos.x"] - before_b["plant.pos.x"]).max() <= 1e-12
     assert np.abs(before_a["plant.pos.y"] + before_b["plant.pos.y"]).max() <= 1e-12
     for gain in ("ccc.Kp", "ccc.Ki", "ccc.Kd"):
-        # Same gains; not bit-identical where ε differs in its last bits (see above).
+        # Same gains; not bit-identical where ε differs in its last bits (1e-12 mm above).
         np.testing.assert_allclose(after_a[f"controller.{gain}"], after_b[f"controller.{gain}"],
                                    rtol=1e-9, atol=1e-9, err_msg=gain)
 
