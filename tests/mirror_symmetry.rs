@@ -97,6 +97,7 @@ fn mirrored_paths_give_mirrored_runs() {
                         ta.estimated_error[k] + tb.estimated_error[k],
                         ta.actual[k][0] - tb.actual[k][0],
                         ta.actual[k][1] + tb.actual[k][1],
+                        ta.reference[k][0] - tb.reference[k][0],
                         ta.reference[k][1] + tb.reference[k][1],
                     ];
                     for d in deviations {

@@ -193,7 +193,11 @@ fn compare(name: &str, mode: CccMode) -> Trace {
 
 fn both_modes(name: &str) {
     let fuzzy = compare(name, CccMode::Fuzzy);
+    let fixed = compare(name, CccMode::Fixed);
     let off = compare(name, CccMode::Off);
+    // Fixed gains are the base gains at every sample; fuzzy ones move.
+    assert!(fixed.gains.iter().all(|g| *g == fixed.gains[0]) && fixed.gains[0][0] > 0.0);
+    assert!(fuzzy.gains.iter().any(|g| *g != fixed.gains[0]));
     // The CCC mode reached the model: with it the gains are non-zero and the path differs.
     assert!(fuzzy.gains.iter().any(|g| g[0] > 0.0));
     assert!(off.gains.iter().all(|g| *g == [0.0; 3]));

@@ -218,6 +218,26 @@ mod tests {
         assert_eq!(e.len(), 16);
     }
 
+    /// With a lag longer than the buffer the walk stops at the oldest sample, where only
+    /// the circle on the newer side exists; on a circle that circle is still the path, so
+    /// the estimate stays exact (the fallback branch of `estimate`).
+    #[test]
+    fn a_lag_beyond_the_buffer_uses_the_oldest_circle() {
+        let c = |t: f64| [20.0 * t.cos(), 20.0 * t.sin()];
+        let mut e = FreeCurveEstimator::new(MIN_CAPACITY);
+        for i in 0..30 {
+            let t = i as f64 * 0.01;
+            let lag = t - 0.2; // 20 samples behind, the buffer holds 4
+            let p = [19.95 * lag.cos(), 19.95 * lag.sin()];
+            let r = e.estimate(c(t), p);
+            if i >= 3 {
+                assert!((r.error + 0.05).abs() < 1e-12, "i={i}: {}", r.error);
+                let n = [-lag.cos(), -lag.sin()]; // inward: the left normal of a CCW circle
+                assert!((r.normal[0] - n[0]).abs() < 1e-9 && (r.normal[1] - n[1]).abs() < 1e-9);
+            }
+        }
+    }
+
     #[test]
     fn collinear_and_held_reference() {
         let mut e = FreeCurveEstimator::new(8);
