@@ -6,8 +6,8 @@
 use super::sample_clock::{check_period, SampleClock};
 use super::variables::{EnumItem, EnumType, Start, Values, Variable, Vr};
 use super::{
-    decode_state, encode_state, geometry, state_check, DefaultExperiment, Environment, Model,
-    ModelInfo, ModelResult, StateLayout,
+    decode_checked, encode_state, geometry, state_check, DefaultExperiment, Environment, Model,
+    ModelInfo, ModelResult, SavedState, StateLayout,
 };
 use crate::contour::{ArcEstimator, Estimator, EstimatorKind, FreeCurveEstimator, LineEstimator};
 use crate::control::{
@@ -254,7 +254,7 @@ struct State {
     clock: SampleClock,
 }
 
-impl State {
+impl SavedState for State {
     /// Checks a restored state like the parameters it was built from; the error names
     /// the offending value.
     fn validate(&self, time: f64) -> Result<(), String> {
@@ -318,15 +318,6 @@ fn check_pid(name: &str, pid: &Pid, ts: f64) -> Result<(), String> {
         ));
     }
     Ok(())
-}
-
-/// Decodes and checks a saved state.
-fn decode(bytes: &[u8], time: f64) -> Result<Option<State>, String> {
-    let state: Option<State> = decode_state(LAYOUT, bytes)?;
-    if let Some(state) = &state {
-        state.validate(time)?;
-    }
-    Ok(state)
 }
 
 pub struct ContourCcc2D {
@@ -432,11 +423,11 @@ impl Model for ContourCcc2D {
     }
 
     fn check_state(&self, bytes: &[u8], time: f64) -> ModelResult {
-        decode(bytes, time).map(drop)
+        decode_checked::<State>(LAYOUT, bytes, time).map(drop)
     }
 
     fn restore_state(&mut self, bytes: &[u8], time: f64) -> ModelResult {
-        self.state = decode(bytes, time)?;
+        self.state = decode_checked(LAYOUT, bytes, time)?;
         Ok(())
     }
 }

@@ -75,6 +75,26 @@ pub struct StateLayout {
     pub version: u16,
 }
 
+/// A model's internal state that checks itself once restored, like the parameters it was
+/// built from, at the instance time `time` saved with it; the error names the cause.
+pub trait SavedState: serde::de::DeserializeOwned {
+    fn validate(&self, time: f64) -> Result<(), String>;
+}
+
+/// [`decode_state`] of a sampled model's optional state (`None` before initialization),
+/// then its [`SavedState::validate`].
+pub fn decode_checked<S: SavedState>(
+    layout: StateLayout,
+    bytes: &[u8],
+    time: f64,
+) -> Result<Option<S>, String> {
+    let state: Option<S> = decode_state(layout, bytes)?;
+    if let Some(state) = &state {
+        state.validate(time)?;
+    }
+    Ok(state)
+}
+
 /// Serialises a model's internal state with the same codec for every model: the layout
 /// version (u16, little endian), then the state in postcard.
 pub fn encode_state<T: serde::Serialize>(

@@ -7,8 +7,8 @@ use std::f64::consts::PI;
 use super::sample_clock::{check_period, SampleClock};
 use super::variables::{Start, Values, Variable, Vr};
 use super::{
-    decode_state, encode_state, geometry, state_check, DefaultExperiment, Environment, Model,
-    ModelInfo, ModelResult, StateLayout,
+    decode_checked, encode_state, geometry, state_check, DefaultExperiment, Environment, Model,
+    ModelInfo, ModelResult, SavedState, StateLayout,
 };
 use crate::path::{Arc, Curve, Interpolator, Line, Path};
 
@@ -119,7 +119,7 @@ struct State {
     clock: SampleClock,
 }
 
-impl State {
+impl SavedState for State {
     /// Checks a restored state like the parameters it was built from; the error names
     /// the offending value. (A NURBS path is validated by its own decoder.)
     fn validate(&self, time: f64) -> Result<(), String> {
@@ -157,15 +157,6 @@ impl State {
         }
         Ok(())
     }
-}
-
-/// Decodes and checks a saved state.
-fn decode(bytes: &[u8], time: f64) -> Result<Option<State>, String> {
-    let state: Option<State> = decode_state(LAYOUT, bytes)?;
-    if let Some(state) = &state {
-        state.validate(time)?;
-    }
-    Ok(state)
 }
 
 pub struct PathInterpolator2D {
@@ -233,11 +224,11 @@ impl Model for PathInterpolator2D {
     }
 
     fn check_state(&self, bytes: &[u8], time: f64) -> ModelResult {
-        decode(bytes, time).map(drop)
+        decode_checked::<State>(LAYOUT, bytes, time).map(drop)
     }
 
     fn restore_state(&mut self, bytes: &[u8], time: f64) -> ModelResult {
-        self.state = decode(bytes, time)?;
+        self.state = decode_checked(LAYOUT, bytes, time)?;
         Ok(())
     }
 }

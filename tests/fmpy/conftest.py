@@ -1,6 +1,7 @@
 """Fixtures for the FMU tests: the packaged FMUs, built once per session by fmu-build."""
 
 import os
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -30,3 +31,13 @@ def fmu_dir():
 @pytest.fixture(scope="session")
 def xy_plant_fmu(fmu_dir):
     return str(fmu_dir / "XYServoPlant.fmu")
+
+
+@pytest.fixture(scope="module")
+def fmus(fmu_dir, tmp_path_factory):
+    """A private copy of the three FMUs, so that an outside engine (libcosim, ecos) and the
+    fmpy master run the same build even if fmu-build rewrites target/fmu meanwhile."""
+    directory = tmp_path_factory.mktemp("fmus")
+    for file in ("PathInterpolator2D.fmu", "ContourCCC2D.fmu", "XYServoPlant.fmu"):
+        shutil.copy2(fmu_dir / file, directory / file)
+    return directory

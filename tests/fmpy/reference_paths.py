@@ -59,3 +59,8 @@ class ContourReference:
             foot = a + t[:, None] * ab
             best = np.minimum(best, np.hypot(*(xy - foot).T))
         return best
+
+
+def paper_circle_distance(x, y):
+    """Distance (mm) of points from the paper's circle x = 10 cos(pi t) - 10, y = 10 sin(pi t)."""
+    return np.abs(np.hypot(np.asarray(x) + 10.0, y) - 10.0)

@@ -23,7 +23,6 @@ apart.
 
 import json
 import math
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -32,10 +31,10 @@ import numpy as np
 import pytest
 
 from master import closed_loop
+from reference_paths import paper_circle_distance as circle_error
 
 HERE = Path(__file__).resolve().parent
 STEP = 1e-3
-FILES = ("PathInterpolator2D.fmu", "ContourCCC2D.fmu", "XYServoPlant.fmu")
 TOL = 1e-9  # mm, mm/s
 POSITIONS = ("plant.pos.x", "plant.pos.y")
 
@@ -46,21 +45,6 @@ CASES = {
     "circle-no-ccc": ("circle", None, 2.0, {"ccc.enable": False}),
     "trident-fuzzy": ("trident", 50.0, 5.35, {}),
 }
-
-
-def circle_error(x, y):
-    """Distance (mm) of the points from the paper's circle x = 10 cos(pi t) - 10, y = 10 sin(pi t)."""
-    return np.abs(np.hypot(np.asarray(x) + 10.0, y) - 10.0)
-
-
-@pytest.fixture(scope="module")
-def fmus(fmu_dir, tmp_path_factory):
-    """A private copy of the FMUs, so that ecos and the master run the same build even if
-    fmu-build rewrites target/fmu while the tests run."""
-    directory = tmp_path_factory.mktemp("fmus")
-    for file in FILES:
-        shutil.copy2(fmu_dir / file, directory / file)
-    return directory
 
 
 def text(value):

@@ -16,7 +16,6 @@ master.py always passes k * step and step)."""
 
 import json
 import math
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -25,28 +24,13 @@ import numpy as np
 import pytest
 
 from master import closed_loop
+from reference_paths import paper_circle_distance as circle_error
 
 HERE = Path(__file__).resolve().parent
 STEP_NS, STEPS = 1_000_000, 2000  # 1 ms for 2 s
 STEP, STOP = STEP_NS * 1e-9, STEPS * STEP_NS * 1e-9
-FILES = ("PathInterpolator2D.fmu", "ContourCCC2D.fmu", "XYServoPlant.fmu")
 POSITIONS = ("plant.pos.x", "plant.pos.y")
 TOL = 1e-6  # mm
-
-
-def circle_error(x, y):
-    """Distance (mm) of the points from the paper's circle x = 10 cos(pi t) - 10, y = 10 sin(pi t)."""
-    return np.abs(np.hypot(np.asarray(x) + 10.0, y) - 10.0)
-
-
-@pytest.fixture(scope="module")
-def fmus(fmu_dir, tmp_path_factory):
-    """A private copy of the FMUs, so that libcosim and the master run the same build even if
-    fmu-build rewrites target/fmu while the tests run."""
-    directory = tmp_path_factory.mktemp("fmus")
-    for file in FILES:
-        shutil.copy2(fmu_dir / file, directory / file)
-    return directory
 
 
 def run_libcosim(fmus, assignments=()):
