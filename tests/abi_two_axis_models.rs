@@ -10,7 +10,9 @@ use std::collections::BTreeMap;
 use common::*;
 use contour_fmu::contour::{Estimator, FreeCurveEstimator};
 use contour_fmu::control::{ControllerConfig, CrossCoupledController};
-use contour_fmu::models::{contour_ccc_2d as ccc, geometry, path_interpolator_2d as interp, Start};
+use contour_fmu::models::{
+    contour_ccc_2d as ccc, geometry, path_interpolator_2d as interp, ModelInfo, Start,
+};
 use contour_fmu::path::{builtin, Interpolator};
 
 const INPUTS: [u32; 4] = [
@@ -282,37 +284,41 @@ fn interpolator_state_restores_bit_for_bit_in_place_and_in_a_fresh_instance() {
 #[test]
 fn fmusim_initial_state_file_sequence_continues_bit_for_bit() {
     let h = 0.001;
-    // Controller.
     let saver = Instance::new(&ccc::INFO);
     saver.start();
-    drive_controller(&saver, h, 0, 25);
+    fmusim_sequence(&ccc::INFO, saver, 25, 60, |i, from, to| {
+        drive_controller(i, h, from, to)
+    });
+    let saver = start_interpolator("trident", 45.0);
+    fmusim_sequence(&interp::INFO, saver, 120, 400, |i, from, to| {
+        drive_interpolator(i, h, from, to)
+    });
+}
+
+/// `saver`, initialised, is driven to sample `saved`, its state serialized (the file) and
+/// then driven on to `end`; a fresh instance of `info` that deserializes and sets the file
+/// (and frees the state fmusim's way) must produce the same samples from `saved` on.
+fn fmusim_sequence<T: PartialEq + std::fmt::Debug>(
+    info: &'static ModelInfo,
+    saver: Instance,
+    saved: usize,
+    end: usize,
+    drive: impl Fn(&Instance, usize, usize) -> T,
+) {
+    drive(&saver, 0, saved);
     let (_, mut state) = saver.get_state();
     let (_, file) = saver.serialize(state);
-    let expected = drive_controller(&saver, h, 25, 60);
+    let expected = drive(&saver, saved, end);
 
-    let fmusim = Instance::new(&ccc::INFO);
+    let fmusim = Instance::new(info);
     let (s, restored) = fmusim.deserialize(&file);
     assert_eq!(s, OK);
     assert_eq!(fmusim.set_state(restored), OK);
     assert_eq!(fmusim.free_state_raw(restored as *mut fmi2FMUstate), OK);
-    assert_eq!(drive_controller(&fmusim, h, 25, 60), expected);
+    assert_eq!(drive(&fmusim, saved, end), expected);
     // The misused handle was freed: any later use is refused, not read.
     assert_eq!(fmusim.set_state(restored), ERROR);
     assert!(fmusim.last_error().contains("is not a live FMU state"));
-    assert_eq!(saver.free_state(&mut state), OK);
-
-    // Interpolator.
-    let saver = start_interpolator("trident", 45.0);
-    drive_interpolator(&saver, h, 0, 120);
-    let (_, mut state) = saver.get_state();
-    let (_, file) = saver.serialize(state);
-    let expected = drive_interpolator(&saver, h, 120, 400);
-    let fmusim = Instance::new(&interp::INFO);
-    let (s, restored) = fmusim.deserialize(&file);
-    assert_eq!(s, OK);
-    assert_eq!(fmusim.set_state(restored), OK);
-    assert_eq!(fmusim.free_state_raw(restored as *mut fmi2FMUstate), OK);
-    assert_eq!(drive_interpolator(&fmusim, h, 120, 400), expected);
     assert_eq!(saver.free_state(&mut state), OK);
 }
 

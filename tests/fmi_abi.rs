@@ -111,14 +111,7 @@ fn functions() -> Vec<(&'static str, Call, &'static [Mode], Answer)> {
     const GET: &[Mode] = &[Initialization, StepComplete, Terminated, Error];
     const SET: &[Mode] = &[Instantiated, Initialization, StepComplete];
     const STATUS: &[Mode] = &[StepComplete, Terminated];
-    const EVERY: &[Mode] = &[
-        Instantiated,
-        Initialization,
-        StepComplete,
-        Terminated,
-        Error,
-        Fatal,
-    ];
+    const EVERY: &[Mode] = &MODES;
     use Answer::{Documented, Ok as Fine};
     vec![
         (

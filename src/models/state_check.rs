@@ -8,6 +8,44 @@ use std::fmt;
 
 use serde::ser::{self, Serialize};
 
+/// `fn name(self, _: T) -> Done { Ok(()) }` for each `name: T`.
+macro_rules! ignore_scalars {
+    ($($name:ident: $ty:ty),* $(,)?) => {
+        $(fn $name(self, _: $ty) -> Done {
+            Ok(())
+        })*
+    };
+}
+
+/// One of serde's compound traits for [`Compound`], walking each value with `walk`
+/// (`element` for positional values, `field` for named ones).
+macro_rules! compound_impl {
+    ($trait:ident, $method:ident, element) => {
+        impl ser::$trait for Compound<'_> {
+            type Ok = ();
+            type Error = WalkError;
+            fn $method<T: Serialize + ?Sized>(&mut self, value: &T) -> Done {
+                self.element(value)
+            }
+            fn end(self) -> Done {
+                self.finish()
+            }
+        }
+    };
+    ($trait:ident, $method:ident, field) => {
+        impl ser::$trait for Compound<'_> {
+            type Ok = ();
+            type Error = WalkError;
+            fn $method<T: Serialize + ?Sized>(&mut self, key: &'static str, value: &T) -> Done {
+                self.field(key, value)
+            }
+            fn end(self) -> Done {
+                self.finish()
+            }
+        }
+    };
+}
+
 /// Every floating-point value of `value` with its field path, in serialisation order.
 pub fn floats<T: Serialize + ?Sized>(value: &T) -> Vec<(String, f64)> {
     let mut walker = Walker::default();
@@ -140,41 +178,11 @@ impl<'a> ser::Serializer for &'a mut Walker {
     fn serialize_f32(self, v: f32) -> Done {
         self.serialize_f64(f64::from(v))
     }
-    fn serialize_bool(self, _: bool) -> Done {
-        Ok(())
-    }
-    fn serialize_i8(self, _: i8) -> Done {
-        Ok(())
-    }
-    fn serialize_i16(self, _: i16) -> Done {
-        Ok(())
-    }
-    fn serialize_i32(self, _: i32) -> Done {
-        Ok(())
-    }
-    fn serialize_i64(self, _: i64) -> Done {
-        Ok(())
-    }
-    fn serialize_u8(self, _: u8) -> Done {
-        Ok(())
-    }
-    fn serialize_u16(self, _: u16) -> Done {
-        Ok(())
-    }
-    fn serialize_u32(self, _: u32) -> Done {
-        Ok(())
-    }
-    fn serialize_u64(self, _: u64) -> Done {
-        Ok(())
-    }
-    fn serialize_char(self, _: char) -> Done {
-        Ok(())
-    }
-    fn serialize_str(self, _: &str) -> Done {
-        Ok(())
-    }
-    fn serialize_bytes(self, _: &[u8]) -> Done {
-        Ok(())
+    // Nothing but floats is collected.
+    ignore_scalars! {
+        serialize_bool: bool, serialize_i8: i8, serialize_i16: i16, serialize_i32: i32,
+        serialize_i64: i64, serialize_u8: u8, serialize_u16: u16, serialize_u32: u32,
+        serialize_u64: u64, serialize_char: char, serialize_str: &str, serialize_bytes: &[u8],
     }
     fn serialize_none(self) -> Done {
         Ok(())
@@ -238,81 +246,23 @@ impl<'a> ser::Serializer for &'a mut Walker {
     }
 }
 
-impl ser::SerializeSeq for Compound<'_> {
-    type Ok = ();
-    type Error = WalkError;
-    fn serialize_element<T: Serialize + ?Sized>(&mut self, value: &T) -> Done {
-        self.element(value)
-    }
-    fn end(self) -> Done {
-        self.finish()
-    }
-}
-
-impl ser::SerializeTuple for Compound<'_> {
-    type Ok = ();
-    type Error = WalkError;
-    fn serialize_element<T: Serialize + ?Sized>(&mut self, value: &T) -> Done {
-        self.element(value)
-    }
-    fn end(self) -> Done {
-        self.finish()
-    }
-}
-
-impl ser::SerializeTupleStruct for Compound<'_> {
-    type Ok = ();
-    type Error = WalkError;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, value: &T) -> Done {
-        self.element(value)
-    }
-    fn end(self) -> Done {
-        self.finish()
-    }
-}
-
-impl ser::SerializeTupleVariant for Compound<'_> {
-    type Ok = ();
-    type Error = WalkError;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, value: &T) -> Done {
-        self.element(value)
-    }
-    fn end(self) -> Done {
-        self.finish()
-    }
-}
+// Sequences, tuples and map values are walked as elements (`[i]`), struct fields by
+// name; map keys are not walked (no state here uses numbers as keys).
+compound_impl!(SerializeSeq, serialize_element, element);
+compound_impl!(SerializeTuple, serialize_element, element);
+compound_impl!(SerializeTupleStruct, serialize_field, element);
+compound_impl!(SerializeTupleVariant, serialize_field, element);
+compound_impl!(SerializeStruct, serialize_field, field);
+compound_impl!(SerializeStructVariant, serialize_field, field);
 
 impl ser::SerializeMap for Compound<'_> {
     type Ok = ();
     type Error = WalkError;
-    /// Keys are not walked (no state here uses numbers as keys).
     fn serialize_key<T: Serialize + ?Sized>(&mut self, _: &T) -> Done {
         Ok(())
     }
     fn serialize_value<T: Serialize + ?Sized>(&mut self, value: &T) -> Done {
         self.element(value)
-    }
-    fn end(self) -> Done {
-        self.finish()
-    }
-}
-
-impl ser::SerializeStruct for Compound<'_> {
-    type Ok = ();
-    type Error = WalkError;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, key: &'static str, value: &T) -> Done {
-        self.field(key, value)
-    }
-    fn end(self) -> Done {
-        self.finish()
-    }
-}
-
-impl ser::SerializeStructVariant for Compound<'_> {
-    type Ok = ();
-    type Error = WalkError;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, key: &'static str, value: &T) -> Done {
-        self.field(key, value)
     }
     fn end(self) -> Done {
         self.finish()
