@@ -11,4 +11,3 @@ pub mod models;
 pub mod path;
 pub mod plant;
 pub mod sim;
-pub mod tuning;

@@ -9,7 +9,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::ptr;
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
-use fmi_sys::fmi2::*;
+use super::bindings::*;
 
 use super::instance::Instance;
 use super::logger::{Category, Logger};
@@ -853,7 +853,8 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
 }
 
 // ---------------------------------------------------------------------------------------
-// Compile-time check of every signature against the standard's header (via fmi-sys):
+// Compile-time check of every signature against the standard's header (the fmi2...TYPE
+// typedefs that bindings.rs holds, generated from third_party/fmi2/):
 // a mismatch is a type error here, not a crash in an importer.
 
 const _: () = {

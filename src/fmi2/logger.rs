@@ -5,7 +5,7 @@
 use std::cell::RefCell;
 use std::ffi::{c_char, CStr, CString};
 
-use fmi_sys::fmi2::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2String};
+use super::bindings::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2String};
 
 use super::status::Status;
 

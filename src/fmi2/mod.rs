@@ -1,6 +1,10 @@
 //! The FMI 2.0 Co-Simulation boundary: the only code that knows FMI types and the only
 //! place with `unsafe`. Models (`crate::models`) are plain Rust behind it.
 
+// Generated from third_party/fmi2/ by `cargo run -p xtask -- bindings`; kept as bindgen
+// wrote it (rustfmt would make it differ from the generator's output).
+#[rustfmt::skip]
+mod bindings;
 mod exports;
 mod fmu_state;
 mod instance;

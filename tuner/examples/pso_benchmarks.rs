@@ -4,7 +4,7 @@
 //!
 //! Usage: `pso_benchmarks [SEEDS] [SWARM] [ITERATIONS]` (20, 30, 200).
 
-use contour_fmu::tuning::{minimize, Algorithm, PsoSettings};
+use contour_tune::{minimize, Algorithm, PsoSettings};
 use serde_json::json;
 
 fn sphere(x: &[f64]) -> f64 {

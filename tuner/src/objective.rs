@@ -5,10 +5,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::control::{ControllerConfig, FuzzyFactors};
-use crate::path::Path;
-use crate::plant::XyTableParams;
-use crate::sim::{Metrics, SimConfig, Simulator};
+use contour_fmu::control::{ControllerConfig, FuzzyFactors};
+use contour_fmu::path::Path;
+use contour_fmu::plant::XyTableParams;
+use contour_fmu::sim::{Metrics, SimConfig, Simulator};
 
 /// The tuned factors, in the order of a PSO position, named as in ContourCCC2D
 /// (`fuzzy.<name>`).
@@ -131,20 +131,21 @@ impl ContourObjective {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::path::builtin;
+    use contour_fmu::path::builtin;
 
     #[test]
     fn paper_factors_score_the_simulators_metrics_and_divergence_is_penalised() {
         let circle = Path::Arc(builtin::circle());
         let objective = ContourObjective::new(
             circle.clone(),
-            crate::sim::PAPER_CIRCLE_FEED,
+            contour_fmu::sim::PAPER_CIRCLE_FEED,
             "paper",
             Fitness::Mean,
         )
         .unwrap();
         let paper = [1.0, 1.2, 87.0, 8.5, 4.0];
-        let sim = Simulator::new(SimConfig::new(circle, crate::sim::PAPER_CIRCLE_FEED)).unwrap();
+        let sim =
+            Simulator::new(SimConfig::new(circle, contour_fmu::sim::PAPER_CIRCLE_FEED)).unwrap();
         let m = sim.metrics();
         assert_eq!(objective.evaluate(&paper), m.mean_abs_error);
         assert!(m.mean_abs_error > 0.0 && m.mean_abs_error < 1e-3);
@@ -154,10 +155,10 @@ mod tests {
         // A diverged run scores above any stable one, less so the later it diverged.
         let diverged = |samples| Metrics {
             samples,
-            divergence: Some(crate::sim::Divergence {
+            divergence: Some(contour_fmu::sim::Divergence {
                 k: samples,
                 t: samples as f64 * 1e-3,
-                kind: crate::sim::DivergenceKind::NonFinite,
+                kind: contour_fmu::sim::DivergenceKind::NonFinite,
                 value: f64::NAN,
             }),
             ..m

@@ -11,8 +11,8 @@ use std::time::Instant;
 
 use contour_fmu::path::Path;
 use contour_fmu::sim::preset_feed;
-use contour_fmu::tuning::objective::{ContourObjective, Fitness, FACTOR_NAMES, LOWER, UPPER};
-use contour_fmu::tuning::{minimize, Algorithm, PsoSettings};
+use contour_tune::objective::{ContourObjective, Fitness, FACTOR_NAMES, LOWER, UPPER};
+use contour_tune::{minimize, Algorithm, PsoSettings};
 use serde_json::json;
 
 const USAGE: &str = "\

@@ -3,13 +3,13 @@
 //! final fitness of each algorithm (mean ± spread, best, worst) and how many seeds each
 //! won. Takes about 10 minutes on two cores.
 //!
-//! Usage: `cargo run --release --example pso_claim [SEEDS] [SWARM] [ITERATIONS] [json]`;
+//! Usage: `cargo run --release -p contour-tune --example pso_claim [SEEDS] [SWARM] [ITERATIONS] [json]`;
 //! with `json` the final fitness of every run is printed as JSON instead of the table.
 
 use contour_fmu::path::builtin;
 use contour_fmu::sim::{FREE_CURVE_FEED, PAPER_CIRCLE_FEED};
-use contour_fmu::tuning::objective::{ContourObjective, Fitness, LOWER, UPPER};
-use contour_fmu::tuning::{minimize, Algorithm, PsoSettings};
+use contour_tune::objective::{ContourObjective, Fitness, LOWER, UPPER};
+use contour_tune::{minimize, Algorithm, PsoSettings};
 
 fn stats(v: &[f64]) -> (f64, f64, f64, f64) {
     let n = v.len() as f64;
