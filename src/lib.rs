@@ -5,6 +5,7 @@
 //! place that speaks the FMI C ABI.
 
 pub mod contour;
+pub mod geometry;
 pub mod control;
 pub mod fmi2;
 pub mod models;

@@ -9,22 +9,23 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::contour::geom;
+use crate::contour::local_circle;
 use crate::contour::{ContourEstimate, ContourEstimator};
-use crate::path::{v2, Arc};
+use crate::geometry::{self, Vector2};
+use crate::path::Arc;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 enum ArcMode {
     /// Known circle.
     Fixed {
-        center: [f64; 2],
+        center: Vector2,
         radius: f64,
         ccw: bool,
         /// Unit vector from the centre used when P and the reference are both at it.
-        fallback: [f64; 2],
+        fallback: Vector2,
     },
     /// Circle through the last three distinct reference points (for non-arc paths).
-    Tracking { pts: [[f64; 2]; 3], count: u8 },
+    Tracking { pts: [Vector2; 3], count: u8 },
 }
 
 /// Arc/circle contour-error estimator.
@@ -39,23 +40,19 @@ const MIN_MOVE: f64 = 1e-9;
 /// Exact signed error of `p` against the circle (`center`, `radius`, direction `ccw`);
 /// `toward` gives the normal's direction if `p` is exactly at the centre.
 pub fn arc_error(
-    p: [f64; 2],
-    center: [f64; 2],
+    p: Vector2,
+    center: Vector2,
     radius: f64,
     ccw: bool,
-    toward: [f64; 2],
+    toward: Vector2,
 ) -> ContourEstimate {
-    let d = v2::sub(p, center);
-    let dist = v2::norm(d);
-    let outward = if dist > 0.0 {
-        v2::scale(d, 1.0 / dist)
-    } else {
-        toward
-    };
+    let d = p - center;
+    let dist = geometry::norm(&d);
+    let outward = if dist > 0.0 { d * (1.0 / dist) } else { toward };
     if ccw {
         ContourEstimate {
             error: dist - radius,
-            normal: v2::scale(outward, -1.0),
+            normal: (outward * (-1.0)),
         }
     } else {
         ContourEstimate {
@@ -74,7 +71,7 @@ impl ArcEstimator {
                 center: arc.center(),
                 radius: arc.radius(),
                 ccw: arc.is_ccw(),
-                fallback: [c, s],
+                fallback: Vector2::new(c, s),
             },
         }
     }
@@ -84,7 +81,7 @@ impl ArcEstimator {
     pub fn tracking() -> Self {
         ArcEstimator {
             mode: ArcMode::Tracking {
-                pts: [[0.0; 2]; 3],
+                pts: [Vector2::zeros(); 3],
                 count: 0,
             },
         }
@@ -92,7 +89,7 @@ impl ArcEstimator {
 }
 
 impl ContourEstimator for ArcEstimator {
-    fn estimate(&mut self, reference: [f64; 2], actual: [f64; 2]) -> ContourEstimate {
+    fn estimate(&mut self, reference: Vector2, actual: Vector2) -> ContourEstimate {
         match &mut self.mode {
             ArcMode::Fixed {
                 center,
@@ -100,18 +97,14 @@ impl ContourEstimator for ArcEstimator {
                 ccw,
                 fallback,
             } => {
-                let r = v2::sub(reference, *center);
-                let rl = v2::norm(r);
-                let toward = if rl > 0.0 {
-                    v2::scale(r, 1.0 / rl)
-                } else {
-                    *fallback
-                };
+                let r = reference - (*center);
+                let rl = geometry::norm(&r);
+                let toward = if rl > 0.0 { r * (1.0 / rl) } else { *fallback };
                 arc_error(actual, *center, *radius, *ccw, toward)
             }
             ArcMode::Tracking { pts, count } => {
                 let n = usize::from(*count).min(3);
-                if n == 0 || v2::dist(reference, pts[n - 1]) > MIN_MOVE {
+                if n == 0 || geometry::dist(&reference, &(pts[n - 1])) > MIN_MOVE {
                     if n == 3 {
                         pts.rotate_left(1);
                         pts[2] = reference;
@@ -121,10 +114,10 @@ impl ContourEstimator for ArcEstimator {
                     }
                 }
                 match *count {
-                    3 => geom::triple_error(actual, *pts, 2),
+                    3 => local_circle::triple_error(actual, *pts, 2),
                     2 => {
-                        let d = v2::sub(pts[1], pts[0]);
-                        let dir = v2::scale(d, 1.0 / v2::norm(d));
+                        let d = pts[1] - pts[0];
+                        let dir = d * (1.0 / geometry::norm(&d));
                         crate::contour::line::line_error(actual, pts[1], dir)
                     }
                     _ => ContourEstimate::default(),
@@ -148,47 +141,47 @@ mod tests {
     #[test]
     fn ccw_hand_cases() {
         // Centre (1, 2), r = 5, CCW quarter from angle 0 to π/2.
-        let arc = Arc::new([1.0, 2.0], 5.0, 0.0, PI / 2.0).unwrap();
+        let arc = Arc::new(Vector2::new(1.0, 2.0), 5.0, 0.0, PI / 2.0).unwrap();
         let mut e = ArcEstimator::new(&arc);
-        let r = e.estimate([6.0, 2.0], [1.0 + 3.0 * 0.6 * 2.0, 2.0 + 3.0 * 0.8 * 2.0]);
+        let r = e.estimate(Vector2::new(6.0, 2.0), Vector2::new(1.0 + 3.0 * 0.6 * 2.0, 2.0 + 3.0 * 0.8 * 2.0));
         // ‖P − O‖ = 6 → outside, right of CCW travel → +1; n points inward.
         assert!((r.error - 1.0).abs() < 1e-14);
         assert!((r.normal[0] + 0.6).abs() < 1e-15 && (r.normal[1] + 0.8).abs() < 1e-15);
         // Beyond the arc end (angle π): radial error to the full circle, −2.
-        let r = e.estimate([1.0, 7.0], [-2.0, 2.0]);
+        let r = e.estimate(Vector2::new(1.0, 7.0), Vector2::new(-2.0, 2.0));
         assert!((r.error + 2.0).abs() < 1e-14 && (r.normal[0] - 1.0).abs() < 1e-15);
         // Before the start (angle −π/2), on the circle: 0.
-        let r = e.estimate([6.0, 2.0], [1.0, -3.0]);
+        let r = e.estimate(Vector2::new(6.0, 2.0), Vector2::new(1.0, -3.0));
         assert!(r.error.abs() < 1e-14);
         // At the centre: −r, normal from the reference direction, no NaN.
-        let r = e.estimate([1.0, 7.0], [1.0, 2.0]);
+        let r = e.estimate(Vector2::new(1.0, 7.0), Vector2::new(1.0, 2.0));
         assert_eq!(r.error, -5.0);
-        assert_eq!(r.normal, [0.0, -1.0]);
+        assert_eq!(r.normal, Vector2::new(0.0, -1.0));
         // Centre and reference both at the centre: start-angle direction.
-        let r = e.estimate([1.0, 2.0], [1.0, 2.0]);
-        assert_eq!(r.normal, [-1.0, 0.0]);
+        let r = e.estimate(Vector2::new(1.0, 2.0), Vector2::new(1.0, 2.0));
+        assert_eq!(r.normal, Vector2::new(-1.0, 0.0));
     }
 
     #[test]
     fn cw_flips_signs() {
-        let arc = Arc::new([0.0, 0.0], 2.0, PI / 2.0, -PI).unwrap();
+        let arc = Arc::new(Vector2::new(0.0, 0.0), 2.0, PI / 2.0, -PI).unwrap();
         let mut e = ArcEstimator::new(&arc);
         // Inside (1.5 from centre): right of clockwise travel → +0.5, n outward.
-        let r = e.estimate([0.0, 2.0], [0.0, 1.5]);
-        assert!((r.error - 0.5).abs() < 1e-15 && r.normal == [0.0, 1.0]);
-        let r = e.estimate([0.0, 2.0], [3.0, 0.0]);
-        assert!((r.error + 1.0).abs() < 1e-15 && r.normal == [1.0, 0.0]);
-        let r = e.estimate([2.0, 0.0], [0.0, 0.0]);
-        assert!((r.error - 2.0).abs() < 1e-15 && r.normal == [1.0, 0.0]);
+        let r = e.estimate(Vector2::new(0.0, 2.0), Vector2::new(0.0, 1.5));
+        assert!((r.error - 0.5).abs() < 1e-15 && r.normal == Vector2::new(0.0, 1.0));
+        let r = e.estimate(Vector2::new(0.0, 2.0), Vector2::new(3.0, 0.0));
+        assert!((r.error + 1.0).abs() < 1e-15 && r.normal == Vector2::new(1.0, 0.0));
+        let r = e.estimate(Vector2::new(2.0, 0.0), Vector2::new(0.0, 0.0));
+        assert!((r.error - 2.0).abs() < 1e-15 && r.normal == Vector2::new(1.0, 0.0));
     }
 
     #[test]
     fn tracking_recovers_circle() {
         let mut e = ArcEstimator::tracking();
-        let c = |t: f64| [10.0 * t.cos(), 10.0 * t.sin()];
-        assert_eq!(e.estimate(c(0.0), [11.0, 0.0]).error, 0.0);
-        e.estimate(c(0.01), [11.0, 0.0]);
-        let r = e.estimate(c(0.02), [11.0 * 0.02f64.cos(), 11.0 * 0.02f64.sin()]);
+        let c = |t: f64| Vector2::new(10.0 * t.cos(), 10.0 * t.sin());
+        assert_eq!(e.estimate(c(0.0), Vector2::new(11.0, 0.0)).error, 0.0);
+        e.estimate(c(0.01), Vector2::new(11.0, 0.0));
+        let r = e.estimate(c(0.02), Vector2::new(11.0 * 0.02f64.cos(), 11.0 * 0.02f64.sin()));
         assert!((r.error - 1.0).abs() < 1e-9, "{}", r.error);
     }
 }

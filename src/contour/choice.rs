@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use crate::contour::{
     ArcEstimator, ContourEstimate, ContourEstimator, FreeCurveEstimator, LineEstimator,
 };
+use crate::geometry::Vector2;
 use crate::path::Path;
 
 /// Which estimator to use.
@@ -105,7 +106,7 @@ impl Estimator {
 }
 
 impl ContourEstimator for Estimator {
-    fn estimate(&mut self, reference: [f64; 2], actual: [f64; 2]) -> ContourEstimate {
+    fn estimate(&mut self, reference: Vector2, actual: Vector2) -> ContourEstimate {
         match self {
             Estimator::FreeCurve(e) => e.estimate(reference, actual),
             Estimator::Line(e) => e.estimate(reference, actual),
@@ -143,17 +144,17 @@ mod tests {
         let circle = builtin::by_name("circle").unwrap();
         let mut e = Estimator::for_path(EstimatorKind::Arc, &circle);
         // The paper's circle: centre (−10, 0), r = 10, CCW; P 0.25 mm outside at (0.25, 0).
-        let r = e.estimate([0.0, 0.0], [0.25, 0.0]);
-        assert!((r.error - 0.25).abs() < 1e-15 && r.normal == [-1.0, 0.0]);
+        let r = e.estimate(Vector2::new(0.0, 0.0), Vector2::new(0.25, 0.0));
+        assert!((r.error - 0.25).abs() < 1e-15 && r.normal == Vector2::new(-1.0, 0.0));
         let blob = postcard::to_stdvec(&e).unwrap();
         assert_eq!(postcard::from_bytes::<Estimator>(&blob).unwrap(), e);
         let line = builtin::by_name("line").unwrap();
         let mut e = Estimator::for_path(EstimatorKind::Line, &line);
         // Line (0,0)→(40,30): P = (3, −4) lies 5 mm right of the start, perpendicular to (4, 3).
-        let r = e.estimate([0.0, 0.0], [3.0, -4.0]);
+        let r = e.estimate(Vector2::new(0.0, 0.0), Vector2::new(3.0, -4.0));
         assert!((r.error - 5.0).abs() < 1e-14);
         assert_eq!(e.kind(), EstimatorKind::Line);
         let mut f = Estimator::for_path(EstimatorKind::FreeCurve, &line);
-        assert_eq!(f.estimate([0.0, 0.0], [3.0, -4.0]).error, 0.0);
+        assert_eq!(f.estimate(Vector2::new(0.0, 0.0), Vector2::new(3.0, -4.0)).error, 0.0);
     }
 }

@@ -1,23 +1,45 @@
-//! What every two-axis contour-error estimator returns, and the interface the
-//! cross-coupled controller drives them through.
+//! What every contour-error estimator returns, and the interface the cross-coupled
+//! controller drives them through, in any dimension.
 
 use serde::{Deserialize, Serialize};
 
-/// Signed contour error and the direction to correct along (docs/design.md §4.1).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ContourEstimate {
-    /// Signed distance from the actual point to the path, mm; positive when the actual
-    /// point lies to the right of the direction of travel.
+use crate::geometry::Vector;
+
+/// A contour error and the direction to correct along (docs/design.md §4.1).
+///
+/// `error · normal` is the error vector from the actual point to its foot point on the
+/// path. In the plane `error` is signed (positive when the actual point lies right of the
+/// direction of travel) and `normal` is the path's left unit normal, so both stay smooth
+/// when the tool crosses the path; in higher dimensions `error` is the distance (≥ 0) and
+/// `normal` the unit vector toward the path.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContourEstimate<const D: usize = 2> {
+    /// Contour error, mm: signed in the plane, the distance otherwise.
     pub error: f64,
-    /// Left unit normal of the path at the foot point; for a point right of the path it
-    /// points from the actual point toward the path.
-    pub normal: [f64; 2],
+    /// Unit direction such that `error · normal` points from the actual point to the path.
+    pub normal: Vector<D>,
+}
+
+impl<const D: usize> ContourEstimate<D> {
+    /// The error vector: from the actual point to its foot point on the path, mm.
+    pub fn vector(&self) -> Vector<D> {
+        self.normal * self.error
+    }
+}
+
+impl<const D: usize> Default for ContourEstimate<D> {
+    fn default() -> Self {
+        ContourEstimate {
+            error: 0.0,
+            normal: Vector::zeros(),
+        }
+    }
 }
 
 /// A contour-error estimator fed once per control sample.
-pub trait ContourEstimator {
+pub trait ContourEstimator<const D: usize = 2> {
     /// Takes the newest reference (command) point and the measured actual point, both mm.
-    fn estimate(&mut self, reference: [f64; 2], actual: [f64; 2]) -> ContourEstimate;
+    fn estimate(&mut self, reference: Vector<D>, actual: Vector<D>) -> ContourEstimate<D>;
     /// Forgets all history (e.g. on FMI reset).
     fn reset(&mut self);
 }

@@ -9,19 +9,17 @@
 use serde::{Deserialize, Serialize};
 
 use crate::contour::{ContourEstimate, ContourEstimator};
-use crate::path::{v2, Line};
+use crate::geometry::{self, Vector2};
+use crate::path::Line;
 
 /// How the line is known.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 enum LineMode {
     /// A fixed line through `point` with unit direction `dir`.
-    Fixed { point: [f64; 2], dir: [f64; 2] },
+    Fixed { point: Vector2, dir: Vector2 },
     /// The line through the newest reference with the direction of the last reference
     /// move (for paths that are not a single line); `dir` is zero until the first move.
-    Tracking {
-        prev: Option<[f64; 2]>,
-        dir: [f64; 2],
-    },
+    Tracking { prev: Option<Vector2>, dir: Vector2 },
 }
 
 /// Line contour-error estimator.
@@ -34,10 +32,10 @@ pub struct LineEstimator {
 const MIN_MOVE: f64 = 1e-9;
 
 /// Signed error of `p` against the line through `a` with unit direction `dir`.
-pub fn line_error(p: [f64; 2], a: [f64; 2], dir: [f64; 2]) -> ContourEstimate {
+pub fn line_error(p: Vector2, a: Vector2, dir: Vector2) -> ContourEstimate {
     ContourEstimate {
-        error: -v2::cross(dir, v2::sub(p, a)),
-        normal: v2::perp(dir),
+        error: -geometry::cross(&dir, &(p - a)),
+        normal: geometry::perp(&dir),
     }
 }
 
@@ -53,10 +51,13 @@ impl LineEstimator {
     }
 
     /// Exact error against the line through `point` at direction angle `theta` (rad).
-    pub fn from_angle(point: [f64; 2], theta: f64) -> Self {
+    pub fn from_angle(point: Vector2, theta: f64) -> Self {
         let (s, c) = theta.sin_cos();
         LineEstimator {
-            mode: LineMode::Fixed { point, dir: [c, s] },
+            mode: LineMode::Fixed {
+                point,
+                dir: Vector2::new(c, s),
+            },
         }
     }
 
@@ -66,28 +67,28 @@ impl LineEstimator {
         LineEstimator {
             mode: LineMode::Tracking {
                 prev: None,
-                dir: [0.0, 0.0],
+                dir: Vector2::zeros(),
             },
         }
     }
 }
 
 impl ContourEstimator for LineEstimator {
-    fn estimate(&mut self, reference: [f64; 2], actual: [f64; 2]) -> ContourEstimate {
+    fn estimate(&mut self, reference: Vector2, actual: Vector2) -> ContourEstimate {
         match &mut self.mode {
             LineMode::Fixed { point, dir } => line_error(actual, *point, *dir),
             LineMode::Tracking { prev, dir } => {
                 if let Some(p) = *prev {
-                    let d = v2::sub(reference, p);
-                    let l = v2::norm(d);
+                    let d = reference - p;
+                    let l = geometry::norm(&d);
                     if l > MIN_MOVE {
-                        *dir = v2::scale(d, 1.0 / l);
+                        *dir = d * (1.0 / l);
                         *prev = Some(reference);
                     }
                 } else {
                     *prev = Some(reference);
                 }
-                if *dir == [0.0, 0.0] {
+                if *dir == Vector2::zeros() {
                     ContourEstimate::default()
                 } else {
                     line_error(actual, reference, *dir)
@@ -99,7 +100,7 @@ impl ContourEstimator for LineEstimator {
     fn reset(&mut self) {
         if let LineMode::Tracking { prev, dir } = &mut self.mode {
             *prev = None;
-            *dir = [0.0, 0.0];
+            *dir = Vector2::zeros();
         }
     }
 }
@@ -111,18 +112,18 @@ mod tests {
     #[test]
     fn hand_computed_cases() {
         // 3-4-5 line from (1, 1) towards (4, 5): θ = atan2(4, 3), n = (−0.8, 0.6).
-        let l = Line::new([1.0, 1.0], [4.0, 5.0]).unwrap();
+        let l = Line::new(Vector2::new(1.0, 1.0), Vector2::new(4.0, 5.0)).unwrap();
         let mut e = LineEstimator::new(&l);
         // P = (1,1) + 2·(0.8, −0.6): 2 mm right of travel.
-        let r = e.estimate([2.5, 3.0], [2.6, -0.2]);
+        let r = e.estimate(Vector2::new(2.5, 3.0), Vector2::new(2.6, -0.2));
         assert!((r.error - 2.0).abs() < 1e-14, "{}", r.error);
         assert!((r.normal[0] + 0.8).abs() < 1e-15 && (r.normal[1] - 0.6).abs() < 1e-15);
         // Left of travel, beyond the end of the segment: still the perpendicular distance.
-        let r = e.estimate([4.0, 5.0], [7.0 - 0.8, 9.0 + 0.6]);
+        let r = e.estimate(Vector2::new(4.0, 5.0), Vector2::new(7.0 - 0.8, 9.0 + 0.6));
         assert!((r.error + 1.0).abs() < 1e-14);
         // The formula of docs/design.md §4.1 with following errors ex = xr − xp, ey = yr − yp.
-        let (th, rr, p) = (0.3f64, [2.0, 1.0], [2.5, 0.2]);
-        let mut f = LineEstimator::from_angle([2.0 - 3.0 * th.cos(), 1.0 - 3.0 * th.sin()], th);
+        let (th, rr, p) = (0.3f64, Vector2::new(2.0, 1.0), Vector2::new(2.5, 0.2));
+        let mut f = LineEstimator::from_angle(Vector2::new(2.0 - 3.0 * th.cos(), 1.0 - 3.0 * th.sin()), th);
         let (ex, ey) = (rr[0] - p[0], rr[1] - p[1]);
         let koren = -ex * th.sin() + ey * th.cos();
         assert!((f.estimate(rr, p).error - koren).abs() < 1e-14);
@@ -132,16 +133,16 @@ mod tests {
     fn tracking_follows_reference_direction() {
         let mut e = LineEstimator::tracking();
         assert_eq!(
-            e.estimate([0.0, 0.0], [0.0, -1.0]),
+            e.estimate(Vector2::new(0.0, 0.0), Vector2::new(0.0, -1.0)),
             ContourEstimate::default()
         );
         // Moving −x: right of travel is +y.
-        let r = e.estimate([-0.1, 0.0], [-0.2, 0.5]);
-        assert!((r.error - 0.5).abs() < 1e-15 && r.normal == [0.0, -1.0]);
+        let r = e.estimate(Vector2::new(-0.1, 0.0), Vector2::new(-0.2, 0.5));
+        assert!((r.error - 0.5).abs() < 1e-15 && r.normal == Vector2::new(0.0, -1.0));
         // Holding still keeps the direction.
-        let r = e.estimate([-0.1, 0.0], [-0.2, 0.5]);
+        let r = e.estimate(Vector2::new(-0.1, 0.0), Vector2::new(-0.2, 0.5));
         assert!((r.error - 0.5).abs() < 1e-15);
         e.reset();
-        assert_eq!(e.estimate([0.0, 0.0], [0.0, -1.0]).error, 0.0);
+        assert_eq!(e.estimate(Vector2::new(0.0, 0.0), Vector2::new(0.0, -1.0)).error, 0.0);
     }
 }

@@ -9,17 +9,17 @@
 //! collinear samples need no special threshold and large radii lose no digits.
 
 use crate::contour::ContourEstimate;
-use crate::path::v2;
+use crate::geometry::{self, Vector2};
 
 /// Signed error of `p` against the circle through `a` with tangent `t` and curvature `kappa`.
-pub(crate) fn circle_error(p: [f64; 2], a: [f64; 2], t: [f64; 2], kappa: f64) -> ContourEstimate {
-    let q = v2::sub(p, a);
-    let n = v2::perp(t);
-    let m = v2::sub(n, v2::scale(q, kappa));
-    let mlen = v2::norm(m);
-    let error = (kappa * v2::dot(q, q) - 2.0 * v2::dot(q, n)) / (1.0 + mlen);
+pub(crate) fn circle_error(p: Vector2, a: Vector2, t: Vector2, kappa: f64) -> ContourEstimate {
+    let q = p - a;
+    let n = geometry::perp(&t);
+    let m = n - (q * kappa);
+    let mlen = geometry::norm(&m);
+    let error = (kappa * q.dot(&q) - 2.0 * q.dot(&n)) / (1.0 + mlen);
     let normal = if mlen > 1e-300 {
-        v2::scale(m, 1.0 / mlen)
+        m * (1.0 / mlen)
     } else {
         // P at the centre: every direction is a foot direction; keep the anchor's normal.
         n
@@ -29,10 +29,10 @@ pub(crate) fn circle_error(p: [f64; 2], a: [f64; 2], t: [f64; 2], kappa: f64) ->
 
 /// Signed curvature of the circle through three points in travel order `a → b → c`
 /// (κ = 2·(b − a)×(c − b) / (|b − a||c − b||c − a|)); 0 when degenerate.
-pub(crate) fn curvature3(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
-    let (ab, bc, ac) = (v2::sub(b, a), v2::sub(c, b), v2::sub(c, a));
-    let den = v2::norm(ab) * v2::norm(bc) * v2::norm(ac);
-    let k = 2.0 * v2::cross(ab, bc) / den;
+pub(crate) fn curvature3(a: Vector2, b: Vector2, c: Vector2) -> f64 {
+    let (ab, bc, ac) = ((b - a), (c - b), (c - a));
+    let den = geometry::norm(&ab) * geometry::norm(&bc) * geometry::norm(&ac);
+    let k = 2.0 * geometry::cross(&ab, &bc) / den;
     if den > 0.0 && k.is_finite() {
         k
     } else {
@@ -42,22 +42,22 @@ pub(crate) fn curvature3(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
 
 /// Unit tangent at an end of the chord `x → y` of a circle of curvature `kappa`: the
 /// chord direction turned back (at `x`) or forward (at `y`) by half the subtended angle.
-pub(crate) fn chord_tangent(x: [f64; 2], y: [f64; 2], kappa: f64, at_end: bool) -> [f64; 2] {
-    let c = v2::sub(y, x);
-    let len = v2::norm(c);
+pub(crate) fn chord_tangent(x: Vector2, y: Vector2, kappa: f64, at_end: bool) -> Vector2 {
+    let c = y - x;
+    let len = geometry::norm(&c);
     if len == 0.0 {
-        return [0.0, 0.0];
+        return Vector2::zeros();
     }
-    let dir = v2::scale(c, 1.0 / len);
+    let dir = c * (1.0 / len);
     let half = (0.5 * kappa * len).clamp(-1.0, 1.0).asin();
     let ang = if at_end { half } else { -half };
     let (s, co) = ang.sin_cos();
-    [dir[0] * co - dir[1] * s, dir[0] * s + dir[1] * co]
+    Vector2::new(dir[0] * co - dir[1] * s, dir[0] * s + dir[1] * co)
 }
 
 /// Estimate against the circle through `a → b → c` at whichever of the three is `anchor`
 /// (0 = a, 1 = b, 2 = c).
-pub(crate) fn triple_error(p: [f64; 2], pts: [[f64; 2]; 3], anchor: usize) -> ContourEstimate {
+pub(crate) fn triple_error(p: Vector2, pts: [Vector2; 3], anchor: usize) -> ContourEstimate {
     let [a, b, c] = pts;
     let k = curvature3(a, b, c);
     let t = match anchor {
@@ -66,10 +66,10 @@ pub(crate) fn triple_error(p: [f64; 2], pts: [[f64; 2]; 3], anchor: usize) -> Co
         _ => {
             let t1 = chord_tangent(a, b, k, true);
             let t2 = chord_tangent(b, c, k, false);
-            let s = v2::add(t1, t2);
-            let l = v2::norm(s);
+            let s = t1 + t2;
+            let l = geometry::norm(&s);
             if l > 0.0 {
-                v2::scale(s, 1.0 / l)
+                s * (1.0 / l)
             } else {
                 t2
             }
@@ -80,15 +80,11 @@ pub(crate) fn triple_error(p: [f64; 2], pts: [[f64; 2]; 3], anchor: usize) -> Co
 
 /// Mean of two estimates: errors averaged, normals averaged and renormalised.
 pub(crate) fn mean(e1: ContourEstimate, e2: ContourEstimate) -> ContourEstimate {
-    let s = v2::add(e1.normal, e2.normal);
-    let l = v2::norm(s);
+    let s = e1.normal + e2.normal;
+    let l = geometry::norm(&s);
     ContourEstimate {
         error: 0.5 * (e1.error + e2.error),
-        normal: if l > 0.0 {
-            v2::scale(s, 1.0 / l)
-        } else {
-            e1.normal
-        },
+        normal: if l > 0.0 { s * (1.0 / l) } else { e1.normal },
     }
 }
 
@@ -99,32 +95,32 @@ mod tests {
     #[test]
     fn circle_error_matches_radial_distance_both_directions() {
         // Unit circle about the origin, anchor (1, 0).
-        let a = [1.0, 0.0];
+        let a = Vector2::new(1.0, 0.0);
         // CCW: tangent +y, κ = +1. Outside point → positive (right of travel).
-        let e = circle_error([2.0, 0.0], a, [0.0, 1.0], 1.0);
+        let e = circle_error(Vector2::new(2.0, 0.0), a, Vector2::new(0.0, 1.0), 1.0);
         assert!((e.error - 1.0).abs() < 1e-15);
         assert!((e.normal[0] + 1.0).abs() < 1e-15);
-        let e = circle_error([0.0, 0.5], a, [0.0, 1.0], 1.0);
+        let e = circle_error(Vector2::new(0.0, 0.5), a, Vector2::new(0.0, 1.0), 1.0);
         assert!((e.error + 0.5).abs() < 1e-15);
         // CW: tangent −y, κ = −1. Inside point is right of travel → positive.
-        let e = circle_error([0.0, 0.5], a, [0.0, -1.0], -1.0);
+        let e = circle_error(Vector2::new(0.0, 0.5), a, Vector2::new(0.0, -1.0), -1.0);
         assert!((e.error - 0.5).abs() < 1e-15);
         assert!((e.normal[1] - 1.0).abs() < 1e-15);
         // Centre: ε = −r (CCW), finite normal.
-        let e = circle_error([0.0, 0.0], a, [0.0, 1.0], 1.0);
+        let e = circle_error(Vector2::new(0.0, 0.0), a, Vector2::new(0.0, 1.0), 1.0);
         assert!((e.error + 1.0).abs() < 1e-15 && e.normal[0].is_finite());
         // κ = 0: line distance.
-        let e = circle_error([5.0, -3.0], a, [0.0, 1.0], 0.0);
-        assert!((e.error - 4.0).abs() < 1e-15 && e.normal == [-1.0, 0.0]);
+        let e = circle_error(Vector2::new(5.0, -3.0), a, Vector2::new(0.0, 1.0), 0.0);
+        assert!((e.error - 4.0).abs() < 1e-15 && e.normal == Vector2::new(-1.0, 0.0));
     }
 
     #[test]
     fn triple_recovers_circle() {
-        let pt = |t: f64| [3.0 + 2.0 * t.cos(), -1.0 + 2.0 * t.sin()];
+        let pt = |t: f64| Vector2::new(3.0 + 2.0 * t.cos(), -1.0 + 2.0 * t.sin());
         let pts = [pt(0.1), pt(0.15), pt(0.2)];
         assert!((curvature3(pts[0], pts[1], pts[2]) - 0.5).abs() < 1e-12);
         for anchor in 0..3 {
-            let p = [3.0 + 2.5 * 0.3f64.cos(), -1.0 + 2.5 * 0.3f64.sin()];
+            let p = Vector2::new(3.0 + 2.5 * 0.3f64.cos(), -1.0 + 2.5 * 0.3f64.sin());
             let e = triple_error(p, pts, anchor);
             assert!(
                 (e.error - 0.5).abs() < 1e-12,
@@ -134,7 +130,7 @@ mod tests {
         }
         // Reversed order = clockwise travel: the outside is then left of travel, so the
         // error flips sign.
-        let e = triple_error([3.0 + 2.5, -1.0], [pts[2], pts[1], pts[0]], 1);
+        let e = triple_error(Vector2::new(3.0 + 2.5, -1.0), [pts[2], pts[1], pts[0]], 1);
         assert!((e.error + 0.5).abs() < 1e-12);
     }
 }

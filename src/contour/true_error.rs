@@ -19,24 +19,26 @@
 use serde::{Deserialize, Serialize};
 
 use crate::contour::ContourEstimate;
-use crate::path::{v2, Arc, Curve, Line, Path};
+use crate::geometry::{self, Vector, Vector2};
+use crate::path::{Arc, Curve, Line, Path};
 
 /// Exact contour error of one point.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct TrueError {
-    /// Signed distance to the path, mm, positive right of travel.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrueError<const D: usize = 2> {
+    /// Distance to the path, mm; in the plane signed, positive right of travel.
     pub error: f64,
-    /// Left unit normal of the path at the foot point.
-    pub normal: [f64; 2],
+    /// Unit direction with `error · normal` from the point to the foot point (in the
+    /// plane: the path's left unit normal there).
+    pub normal: Vector<D>,
     /// Curve parameter of the foot point.
     pub u: f64,
     /// Foot point (nearest point of the path).
-    pub foot: [f64; 2],
+    pub foot: Vector<D>,
 }
 
-impl TrueError {
+impl<const D: usize> TrueError<D> {
     /// As an estimator result.
-    pub fn estimate(&self) -> ContourEstimate {
+    pub fn estimate(&self) -> ContourEstimate<D> {
         ContourEstimate {
             error: self.error,
             normal: self.normal,
@@ -45,7 +47,7 @@ impl TrueError {
 }
 
 /// Global brute-force true contour error of `p` against `path`.
-pub fn true_error(path: &Path, p: [f64; 2]) -> TrueError {
+pub fn true_error(path: &Path, p: Vector2) -> TrueError {
     match path {
         Path::Line(l) => line_true_error(l, p),
         Path::Arc(a) => arc_true_error(a, p),
@@ -57,7 +59,7 @@ pub fn true_error(path: &Path, p: [f64; 2]) -> TrueError {
 const BRUTE_SAMPLES: usize = 256;
 
 /// Global brute force for any [`Curve`]: dense sampling + Newton refinement.
-pub fn curve_true_error<C: Curve + ?Sized>(c: &C, p: [f64; 2]) -> TrueError {
+pub fn curve_true_error<C: Curve + ?Sized>(c: &C, p: Vector2) -> TrueError {
     let bps = c.breakpoints();
     // Dense samples (parameter, distance) over every smooth piece.
     let mut us = Vec::with_capacity(bps.len() * BRUTE_SAMPLES);
@@ -67,11 +69,11 @@ pub fn curve_true_error<C: Curve + ?Sized>(c: &C, p: [f64; 2]) -> TrueError {
         }
     }
     us.push(*bps.last().unwrap_or(&c.param_range().1));
-    let pts: Vec<[f64; 2]> = us.iter().map(|&u| c.point(u)).collect();
-    let ds: Vec<f64> = pts.iter().map(|&q| v2::dist(q, p)).collect();
+    let pts: Vec<Vector2> = us.iter().map(|&u| c.point(u)).collect();
+    let ds: Vec<f64> = pts.iter().map(|&q| geometry::dist(&q, &p)).collect();
     let max_chord = pts
         .windows(2)
-        .map(|w| v2::dist(w[0], w[1]))
+        .map(|w| geometry::dist(&w[0], &w[1]))
         .fold(0.0, f64::max);
     let dmin = ds.iter().cloned().fold(f64::INFINITY, f64::min);
     let n = us.len();
@@ -95,16 +97,16 @@ pub fn curve_true_error<C: Curve + ?Sized>(c: &C, p: [f64; 2]) -> TrueError {
 /// Minimises |C(u) − P| over [a, b] starting from `u`: safeguarded Newton on
 /// f(u) = (C − P)·C' with bisection fallback; also compares the bracket ends.
 /// Returns (distance, parameter).
-fn refine<C: Curve + ?Sized>(c: &C, p: [f64; 2], a0: f64, b0: f64, u0: f64) -> (f64, f64) {
+fn refine<C: Curve + ?Sized>(c: &C, p: Vector2, a0: f64, b0: f64, u0: f64) -> (f64, f64) {
     let (mut a, mut b, mut u) = (a0, b0, u0);
     for _ in 0..64 {
         let e = c.eval(u);
-        let q = v2::sub(e.p, p);
-        let f = v2::dot(q, e.d1);
+        let q = e.p - p;
+        let f = q.dot(&e.d1);
         if f == 0.0 {
             break;
         }
-        let fp = v2::dot(e.d1, e.d1) + v2::dot(q, e.d2);
+        let fp = e.d1.dot(&e.d1) + q.dot(&e.d2);
         if f > 0.0 {
             b = u;
         } else {
@@ -121,9 +123,9 @@ fn refine<C: Curve + ?Sized>(c: &C, p: [f64; 2], a0: f64, b0: f64, u0: f64) -> (
             break;
         }
     }
-    let mut best = (v2::dist(c.point(u), p), u);
+    let mut best = (geometry::dist(&c.point(u), &p), u);
     for v in [a0, b0] {
-        let d = v2::dist(c.point(v), p);
+        let d = geometry::dist(&c.point(v), &p);
         if d < best.0 {
             best = (d, v);
         }
@@ -132,49 +134,49 @@ fn refine<C: Curve + ?Sized>(c: &C, p: [f64; 2], a0: f64, b0: f64, u0: f64) -> (
 }
 
 /// Builds the result at foot parameter `u`.
-fn finish<C: Curve + ?Sized>(c: &C, p: [f64; 2], u: f64) -> TrueError {
+fn finish<C: Curve + ?Sized>(c: &C, p: Vector2, u: f64) -> TrueError {
     let e = c.eval(u);
     let mut t = e.d1;
-    if v2::norm(t) < 1e-12 {
+    if geometry::norm(&t) < 1e-12 {
         // Degenerate speed (repeated control points): use a short secant instead.
         let (lo, hi) = c.param_range();
         let h = 1e-7 * (hi - lo);
-        t = v2::sub(c.point((u + h).min(hi)), c.point((u - h).max(lo)));
+        t = c.point((u + h).min(hi)) - c.point((u - h).max(lo));
     }
-    let tl = v2::norm(t);
+    let tl = geometry::norm(&t);
     let t = if tl > 0.0 {
-        v2::scale(t, 1.0 / tl)
+        t * (1.0 / tl)
     } else {
-        [1.0, 0.0]
+        Vector2::new(1.0, 0.0)
     };
     signed(p, e.p, t, u)
 }
 
-fn signed(p: [f64; 2], foot: [f64; 2], t: [f64; 2], u: f64) -> TrueError {
-    let q = v2::sub(p, foot);
-    let dist = v2::norm(q);
-    let side = -v2::cross(t, q);
+fn signed(p: Vector2, foot: Vector2, t: Vector2, u: f64) -> TrueError {
+    let q = p - foot;
+    let dist = geometry::norm(&q);
+    let side = -geometry::cross(&t, &q);
     TrueError {
         error: dist.copysign(side),
-        normal: v2::perp(t),
+        normal: geometry::perp(&t),
         u,
         foot,
     }
 }
 
 /// Exact distance to a finite segment.
-fn line_true_error(l: &Line, p: [f64; 2]) -> TrueError {
+fn line_true_error(l: &Line, p: Vector2) -> TrueError {
     let a = l.start();
-    let d = v2::sub(l.end(), a);
-    let u = (v2::dot(v2::sub(p, a), d) / v2::dot(d, d)).clamp(0.0, 1.0);
+    let d = l.end() - a;
+    let u = ((p - a).dot(&d) / d.dot(&d)).clamp(0.0, 1.0);
     signed(p, l.point(u), l.direction(), u)
 }
 
 /// Exact distance to a finite arc.
-fn arc_true_error(arc: &Arc, p: [f64; 2]) -> TrueError {
+fn arc_true_error(arc: &Arc, p: Vector2) -> TrueError {
     let o = arc.center();
-    let d = v2::sub(p, o);
-    let r = v2::norm(d);
+    let d = p - o;
+    let r = geometry::norm(&d);
     let within = if r > 0.0 {
         arc.param_of_angle(d[1].atan2(d[0]))
     } else {
@@ -183,7 +185,7 @@ fn arc_true_error(arc: &Arc, p: [f64; 2]) -> TrueError {
     let u = match within {
         Some(u) => u,
         None => {
-            if v2::dist(arc.point(0.0), p) <= v2::dist(arc.point(1.0), p) {
+            if geometry::dist(&arc.point(0.0), &p) <= geometry::dist(&arc.point(1.0), &p) {
                 0.0
             } else {
                 1.0
@@ -191,7 +193,7 @@ fn arc_true_error(arc: &Arc, p: [f64; 2]) -> TrueError {
         }
     };
     let e = arc.eval(u);
-    let t = v2::scale(e.d1, 1.0 / v2::norm(e.d1));
+    let t = e.d1 * (1.0 / geometry::norm(&e.d1));
     let mut res = signed(p, e.p, t, u);
     if within.is_some() {
         // Radial formula: exact sign even at the centre (where q ∥ n gives side 0 issues).
@@ -222,7 +224,7 @@ const EMPTY: BBox = [
     f64::NEG_INFINITY,
 ];
 
-fn box_dist2(b: &BBox, p: [f64; 2]) -> f64 {
+fn box_dist2(b: &BBox, p: Vector2) -> f64 {
     if b[0] > b[2] {
         return f64::INFINITY;
     }
@@ -269,11 +271,11 @@ impl TrueErrorIndex {
                 // Length and turning of the piece from a coarse scan.
                 const SCAN: usize = 64;
                 let mut turn = 0.0;
-                let mut prev_t: Option<[f64; 2]> = None;
+                let mut prev_t: Option<Vector2> = None;
                 for i in 0..=SCAN {
                     let d1 = path.eval(a + (b - a) * i as f64 / SCAN as f64).d1;
                     if let Some(t0) = prev_t {
-                        turn += v2::cross(t0, d1).atan2(v2::dot(t0, d1)).abs();
+                        turn += geometry::cross(&t0, &d1).atan2(t0.dot(&d1)).abs();
                     }
                     prev_t = Some(d1);
                 }
@@ -320,7 +322,7 @@ impl TrueErrorIndex {
 
     /// Exact true contour error of `p`; `hint` is a parameter near the expected foot
     /// (the previous foot or the reference's parameter). Any hint gives the same result.
-    pub fn error(&self, p: [f64; 2], hint: f64) -> TrueError {
+    pub fn error(&self, p: Vector2, hint: f64) -> TrueError {
         match &self.path {
             Path::Line(l) => return line_true_error(l, p),
             Path::Arc(a) => return arc_true_error(a, p),
@@ -375,13 +377,13 @@ impl TrueErrorIndex {
     }
 
     /// Minimum distance over chunk `i`: best of its samples, then Newton in the bracket.
-    fn chunk_min(&self, i: usize, p: [f64; 2]) -> (f64, f64) {
+    fn chunk_min(&self, i: usize, p: Vector2) -> (f64, f64) {
         let Chunk { u0, u1 } = self.chunks[i];
         let h = (u1 - u0) / CHUNK_SUB as f64;
         let mut bi = 0;
         let mut bd = f64::INFINITY;
         for k in 0..=CHUNK_SUB {
-            let d = v2::dist2(self.path.point(u0 + h * k as f64), p);
+            let d = geometry::dist2(&self.path.point(u0 + h * k as f64), &p);
             if d < bd {
                 bd = d;
                 bi = k;
@@ -407,7 +409,7 @@ fn chunk_box(c: &Path, u0: f64, u1: f64) -> BBox {
     for k in 0..=S {
         let e = c.eval(u0 + h * k as f64);
         b = union(&b, &[e.p[0], e.p[1], e.p[0], e.p[1]]);
-        acc = acc.max(v2::norm(e.d2));
+        acc = acc.max(geometry::norm(&e.d2));
     }
     let m = 2.0 * acc * h * h / 8.0 + 1e-9;
     [b[0] - m, b[1] - m, b[2] + m, b[3] + m]
@@ -421,23 +423,23 @@ mod tests {
 
     #[test]
     fn line_and_arc_hand_cases() {
-        let l = Path::Line(Line::new([0.0, 0.0], [4.0, 0.0]).unwrap());
-        let r = true_error(&l, [2.0, -1.5]);
-        assert_eq!((r.error, r.u, r.normal), (1.5, 0.5, [0.0, 1.0]));
+        let l = Path::Line(Line::new(Vector2::new(0.0, 0.0), Vector2::new(4.0, 0.0)).unwrap());
+        let r = true_error(&l, Vector2::new(2.0, -1.5));
+        assert_eq!((r.error, r.u, r.normal), (1.5, 0.5, Vector2::new(0.0, 1.0)));
         // Beyond the end: distance to the end point, sign by side.
-        let r = true_error(&l, [7.0, 4.0]);
+        let r = true_error(&l, Vector2::new(7.0, 4.0));
         assert_eq!((r.error, r.u), (-5.0, 1.0));
-        let a = Path::Arc(Arc::new([0.0, 0.0], 2.0, 0.0, PI / 2.0).unwrap());
-        let r = true_error(&a, [0.0, 3.0]);
+        let a = Path::Arc(Arc::new(Vector2::new(0.0, 0.0), 2.0, 0.0, PI / 2.0).unwrap());
+        let r = true_error(&a, Vector2::new(0.0, 3.0));
         assert!((r.error - 1.0).abs() < 1e-15 && (r.u - 1.0).abs() < 1e-15);
         // Beyond the arc end (angle 3π/4): nearest is the end point (0, 2).
-        let r = true_error(&a, [-1.0, 1.0]);
+        let r = true_error(&a, Vector2::new(-1.0, 1.0));
         assert!((r.error.abs() - 2f64.sqrt()).abs() < 1e-15 && r.u == 1.0);
         // At the centre: −r for CCW.
-        let r = true_error(&a, [0.0, 0.0]);
+        let r = true_error(&a, Vector2::new(0.0, 0.0));
         assert_eq!(r.error, -2.0);
-        let cw = Path::Arc(Arc::new([0.0, 0.0], 2.0, PI / 2.0, -PI / 2.0).unwrap());
-        let r = true_error(&cw, [0.3, 0.4]);
+        let cw = Path::Arc(Arc::new(Vector2::new(0.0, 0.0), 2.0, PI / 2.0, -PI / 2.0).unwrap());
+        let r = true_error(&cw, Vector2::new(0.3, 0.4));
         assert!((r.error - 1.5).abs() < 1e-15);
     }
 
@@ -447,7 +449,7 @@ mod tests {
         for k in 0..50 {
             let ang = 0.123 + k as f64 * 0.1257;
             let rad = 0.2 + 0.05 * k as f64;
-            let r = true_error(&c, [rad * ang.cos(), rad * ang.sin()]);
+            let r = true_error(&c, Vector2::new(rad * ang.cos(), rad * ang.sin()));
             assert!((r.error - (rad - 1.0)).abs() < 1e-13, "k={k}: {}", r.error);
             assert!((r.normal[0] + ang.cos()).abs() < 1e-9);
         }
@@ -469,9 +471,9 @@ mod tests {
             for _ in 0..200 {
                 let u = rnd();
                 let e = path.eval(u);
-                let n = v2::perp(v2::scale(e.d1, 1.0 / v2::norm(e.d1)));
+                let n = geometry::perp(&(e.d1 * (1.0 / geometry::norm(&e.d1))));
                 let off = (rnd() - 0.5) * if rnd() < 0.8 { 0.4 } else { 20.0 };
-                let p = v2::add(e.p, v2::scale(n, off));
+                let p = (e.p + (n * off));
                 let g = true_error(&path, p);
                 for hint in [u, rnd(), 0.0] {
                     let h = idx.error(p, hint);

@@ -1,15 +1,19 @@
-//! Control laws: discrete PID, the Mamdani fuzzy gain scheduler with its rule tables, and
-//! the two-axis cross-coupled contour controller (docs/design.md §4.2, 4.3).
+//! Control laws: discrete PID, the Mamdani fuzzy gain scheduler with its rule tables, the
+//! scalar contour law and the N-axis cross-coupled contour controller around it
+//! (docs/design.md §4.2, 4.3).
 
-pub mod ccc;
+pub mod ccc_law;
+pub mod config;
+pub mod cross_coupled;
 pub mod fuzzy;
 pub mod pid;
 pub mod rules;
 
-pub use ccc::{
-    folded_inputs, CccConfig, CccLaw, CccMode, CccStep, ConfigError, ControlOutput,
-    ControllerConfig, CrossCoupledController, FuzzyFactors,
+pub use ccc_law::{folded_inputs, CccLaw, CccStep};
+pub use config::{
+    CccConfig, CccMode, ConfigError, ControllerConfig, FuzzyFactor, FuzzyFactors, Gain, Parameter,
 };
+pub use cross_coupled::{ControlOutput, CrossCoupledController};
 pub use fuzzy::{FuzzyEngine, FuzzyOutput};
 pub use pid::{Pid, PidGains};
 pub use rules::{RuleTable, Term};

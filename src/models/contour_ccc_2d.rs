@@ -4,40 +4,17 @@
 //! `fmi2DoStep` on the inputs held over the step, whatever the communication step.
 
 use super::sample_clock::{check_period, SampleClock};
-use super::variables::{EnumItem, EnumType, Start, Values, Variable, Vr};
+use super::variable_table::{axis_block, variable_table, AxisTemplate, AxisUnit, AxisWord, XY};
+use super::variables::{EnumItem, EnumType, Start, Values, Variable};
 use super::{
-    decode_checked, encode_state, geometry, state_check, DefaultExperiment, Environment, Model,
-    ModelInfo, ModelResult, SavedState, StateLayout,
+    decode_checked, encode_state, line_arc_parameters, state_check, DefaultExperiment, Environment,
+    Model, ModelInfo, ModelResult, SavedState, StateLayout,
 };
 use crate::contour::{ArcEstimator, Estimator, EstimatorKind, FreeCurveEstimator, LineEstimator};
 use crate::control::{
-    CccConfig, CccMode, ControllerConfig, CrossCoupledController, FuzzyFactors, Pid, PidGains,
+    CccConfig, CccMode, ConfigError, ControllerConfig, CrossCoupledController, FuzzyFactor,
+    FuzzyFactors, Gain, Parameter, Pid, PidGains,
 };
-
-pub const REF_X: Vr = 0;
-pub const REF_Y: Vr = 1;
-pub const POS_X: Vr = 2;
-pub const POS_Y: Vr = 3;
-pub const U_X: Vr = 4;
-pub const U_Y: Vr = 5;
-pub const CONTOUR_ERROR: Vr = 6;
-pub const ERR_X: Vr = 7;
-pub const ERR_Y: Vr = 8;
-pub const CCC_KP: Vr = 9;
-pub const CCC_KI: Vr = 10;
-pub const CCC_KD: Vr = 11;
-pub const TS: Vr = 12;
-/// Kp, Ki, Kd of the X position loop, then of Y.
-pub const AXIS_GAINS: Vr = 13;
-pub const CCC_ENABLE: Vr = 19;
-pub const FUZZY_ENABLE: Vr = 20;
-/// Kp0, Ki0, Kd0.
-pub const CCC_GAINS0: Vr = 21;
-pub const CCC_LIMIT: Vr = 24;
-/// ke, kde, kp, ki, kd.
-pub const FUZZY_FACTORS: Vr = 25;
-pub const ESTIMATOR: Vr = 30;
-pub const GEOMETRY: Vr = 31;
 
 /// The `estimator` parameter's type: an FMI Enumeration (importers show a drop-down), in
 /// the order of [`EstimatorKind::ALL`] (values 1, 2, 3).
@@ -62,169 +39,112 @@ pub static ESTIMATOR_TYPE: EnumType = EnumType {
 
 /// Start values: the controller library's documented defaults.
 const DEFAULT: ControllerConfig = ControllerConfig::DEFAULT;
-
-const fn real(vr: Vr, name: &'static str, start: f64, description: &'static str) -> Variable {
-    Variable::parameter(vr, name, Start::Real(start), description).min(0.0)
-}
-
-const G: [Variable; geometry::COUNT] = geometry::variables(GEOMETRY);
-const A: [PidGains; 2] = DEFAULT.axis;
+const A: PidGains = DEFAULT.axis[0];
 const C: CccConfig = DEFAULT.ccc;
 
-static VARIABLES: [Variable; 31 + geometry::COUNT] = [
-    Variable::input(REF_X, "ref.x", 0.0, "Reference (command) position, x").unit("mm"),
-    Variable::input(REF_Y, "ref.y", 0.0, "Reference (command) position, y").unit("mm"),
-    Variable::input(POS_X, "pos.x", 0.0, "Measured position, x").unit("mm"),
-    Variable::input(POS_Y, "pos.y", 0.0, "Measured position, y").unit("mm"),
-    Variable::output(U_X, "u.x", "Velocity command to the X drive").unit("mm/s"),
-    Variable::output(U_Y, "u.y", "Velocity command to the Y drive").unit("mm/s"),
-    Variable::output(
-        CONTOUR_ERROR,
+const fn real(name: &'static str, start: f64, description: &'static str) -> Variable {
+    Variable::parameter(name, Start::Real(start), description).min(0.0)
+}
+
+/// A position-loop gain of every axis.
+const fn axis_gain(
+    suffix: &'static str,
+    start: f64,
+    what: &'static str,
+    unit: AxisUnit,
+) -> AxisTemplate {
+    AxisTemplate::parameter(
+        ("axis.", suffix),
+        (start, start),
+        ("", AxisWord::Label, what),
+    )
+    .unit(unit)
+    .min(0.0)
+}
+
+variable_table! {
+    static VARIABLES;
+    REF: Reals<2> = axis_block(&XY, &[AxisTemplate::input(
+        ("ref.", ""),
+        ("Reference (command) position, ", AxisWord::Name, ""),
+    )
+    .unit(AxisUnit::POSITION)]);
+    POS: Reals<2> = axis_block(&XY, &[AxisTemplate::input(
+        ("pos.", ""),
+        ("Measured position, ", AxisWord::Name, ""),
+    )
+    .unit(AxisUnit::POSITION)]);
+    U: Reals<2> = axis_block(&XY, &[AxisTemplate::output(
+        ("u.", ""),
+        ("Velocity command to the ", AxisWord::Label, " drive"),
+    )
+    .unit(AxisUnit::VELOCITY)]);
+    CONTOUR_ERROR: Real = Variable::output(
         "contourError",
         "Estimated contour error, > 0 when the tool is right of the direction of travel",
     )
-    .unit("mm"),
-    Variable::output(ERR_X, "err.x", "Following error ref.x - pos.x").unit("mm"),
-    Variable::output(ERR_Y, "err.y", "Following error ref.y - pos.y").unit("mm"),
-    Variable::output(CCC_KP, "ccc.Kp", "Contour PID gain Kp in use").unit("1/s"),
-    Variable::output(CCC_KI, "ccc.Ki", "Contour PID gain Ki in use").unit("1/s2"),
-    Variable::output(CCC_KD, "ccc.Kd", "Contour PID gain Kd in use"),
-    Variable::parameter(
-        TS,
+    .unit("mm");
+    ERR: Reals<2> = axis_block(&XY, &[AxisTemplate::output(
+        ("err.", ""),
+        ("Following error (ref - pos), ", AxisWord::Name, ""),
+    )
+    .unit(AxisUnit::POSITION)]);
+    CCC_GAINS: Reals<3> = [
+        Variable::output("ccc.Kp", "Contour PID gain Kp in use").unit("1/s"),
+        Variable::output("ccc.Ki", "Contour PID gain Ki in use").unit("1/s2"),
+        Variable::output("ccc.Kd", "Contour PID gain Kd in use"),
+    ];
+    TS: Real = Variable::parameter(
         "Ts",
         Start::Real(DEFAULT.ts),
         "Control period (at least 1 us)",
     )
-    .unit("s"),
-    real(
-        AXIS_GAINS,
-        "axis.x.Kp",
-        A[0].kp,
-        "X position loop, proportional gain",
-    )
-    .unit("1/s"),
-    real(
-        AXIS_GAINS + 1,
-        "axis.x.Ki",
-        A[0].ki,
-        "X position loop, integral gain",
-    )
-    .unit("1/s2"),
-    real(
-        AXIS_GAINS + 2,
-        "axis.x.Kd",
-        A[0].kd,
-        "X position loop, derivative gain",
-    ),
-    real(
-        AXIS_GAINS + 3,
-        "axis.y.Kp",
-        A[1].kp,
-        "Y position loop, proportional gain",
-    )
-    .unit("1/s"),
-    real(
-        AXIS_GAINS + 4,
-        "axis.y.Ki",
-        A[1].ki,
-        "Y position loop, integral gain",
-    )
-    .unit("1/s2"),
-    real(
-        AXIS_GAINS + 5,
-        "axis.y.Kd",
-        A[1].kd,
-        "Y position loop, derivative gain",
-    ),
-    Variable::parameter(
-        CCC_ENABLE,
+    .unit("s");
+    /// Kp, Ki, Kd of the X position loop, then of Y.
+    AXIS_GAINS: Reals<6> = axis_block(&XY, &[
+        axis_gain(".Kp", A.kp, " position loop, proportional gain", AxisUnit::Fixed("1/s")),
+        axis_gain(".Ki", A.ki, " position loop, integral gain", AxisUnit::Fixed("1/s2")),
+        axis_gain(".Kd", A.kd, " position loop, derivative gain", AxisUnit::None),
+    ]);
+    CCC_ENABLE: Bool = Variable::parameter(
         "ccc.enable",
         Start::Boolean(true),
         "Apply the cross-coupled correction",
-    ),
-    Variable::parameter(
-        FUZZY_ENABLE,
+    );
+    FUZZY_ENABLE: Bool = Variable::parameter(
         "fuzzy.enable",
         Start::Boolean(true),
         "Adapt the contour PID gains with the fuzzy system (else fixed Kp0, Ki0, Kd0)",
-    ),
-    real(
-        CCC_GAINS0,
-        "ccc.Kp0",
-        C.gains0.kp,
-        "Contour PID base gain Kp0",
-    )
-    .unit("1/s"),
-    real(
-        CCC_GAINS0 + 1,
-        "ccc.Ki0",
-        C.gains0.ki,
-        "Contour PID base gain Ki0",
-    )
-    .unit("1/s2"),
-    real(
-        CCC_GAINS0 + 2,
-        "ccc.Kd0",
-        C.gains0.kd,
-        "Contour PID base gain Kd0",
-    ),
-    Variable::parameter(
-        CCC_LIMIT,
+    );
+    /// Kp0, Ki0, Kd0.
+    CCC_GAINS0: Reals<3> = [
+        real("ccc.Kp0", C.gains0.kp, "Contour PID base gain Kp0").unit("1/s"),
+        real("ccc.Ki0", C.gains0.ki, "Contour PID base gain Ki0").unit("1/s2"),
+        real("ccc.Kd0", C.gains0.kd, "Contour PID base gain Kd0"),
+    ];
+    CCC_LIMIT: Real = Variable::parameter(
         "ccc.limit",
         Start::Real(100.0),
         "Bound on the contour correction (> 0), with anti-windup",
     )
-    .unit("mm/s"),
-    real(
-        FUZZY_FACTORS,
-        "fuzzy.ke",
-        C.fuzzy.ke,
-        "Contour error quantisation factor (per um)",
-    ),
-    real(
-        FUZZY_FACTORS + 1,
-        "fuzzy.kde",
-        C.fuzzy.kde,
-        "Error change quantisation factor (per um/sample)",
-    ),
-    real(
-        FUZZY_FACTORS + 2,
-        "fuzzy.kp",
-        C.fuzzy.kpf,
-        "Scale of the fuzzy Kp adjustment",
-    )
-    .unit("1/s"),
-    real(
-        FUZZY_FACTORS + 3,
-        "fuzzy.ki",
-        C.fuzzy.kif,
-        "Scale of the fuzzy Ki adjustment",
-    )
-    .unit("1/s2"),
-    real(
-        FUZZY_FACTORS + 4,
-        "fuzzy.kd",
-        C.fuzzy.kdf,
-        "Scale of the fuzzy Kd adjustment",
-    ),
-    Variable::parameter(
-        ESTIMATOR,
+    .unit("mm/s");
+    /// ke, kde, kp, ki, kd.
+    FUZZY_FACTORS: Reals<5> = [
+        real("fuzzy.ke", C.fuzzy.ke, "Contour error quantisation factor (per um)"),
+        real("fuzzy.kde", C.fuzzy.kde, "Error change quantisation factor (per um/sample)"),
+        real("fuzzy.kp", C.fuzzy.kpf, "Scale of the fuzzy Kp adjustment").unit("1/s"),
+        real("fuzzy.ki", C.fuzzy.kif, "Scale of the fuzzy Ki adjustment").unit("1/s2"),
+        real("fuzzy.kd", C.fuzzy.kdf, "Scale of the fuzzy Kd adjustment"),
+    ];
+    ESTIMATOR: Int = Variable::parameter(
         "estimator",
         Start::Integer(1),
         "Contour estimator: free_curve (two circles through recent references), or line / arc \
          (exact, from the line.*/arc.* parameters)",
     )
-    .enumeration(&ESTIMATOR_TYPE),
-    G[0],
-    G[1],
-    G[2],
-    G[3],
-    G[4],
-    G[5],
-    G[6],
-    G[7],
-    G[8],
-];
+    .enumeration(&ESTIMATOR_TYPE);
+    GEOMETRY: Reals<{ line_arc_parameters::COUNT }> = line_arc_parameters::VARIABLES;
+}
 
 pub static INFO: ModelInfo = ModelInfo {
     identifier: "ContourCCC2D",
@@ -242,10 +162,11 @@ pub static INFO: ModelInfo = ModelInfo {
     create: |_: &Environment| Box::new(ContourCcc2D { state: None }),
 };
 
-/// Version 1: `Option<State>` as below.
+/// `Option<State>` as below. Version 2: the controller became N-axis (per-axis contour
+/// PIDs, unused in the plane, joined its state).
 const LAYOUT: StateLayout = StateLayout {
     model: "ContourCCC2D",
-    version: 1,
+    version: 2,
 };
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
@@ -271,14 +192,10 @@ impl SavedState for State {
                 config.ts
             ));
         }
-        let [x, y] = controller.axes();
-        for (name, pid) in [
-            ("X position loop", x),
-            ("Y position loop", y),
-            ("contour PID", controller.law().pid()),
-        ] {
-            check_pid(name, pid, config.ts)?;
+        for (axis, pid) in XY.iter().zip(controller.axes()) {
+            check_pid(&format!("{} position loop", axis.label), pid, config.ts)?;
         }
+        check_pid("contour PID", controller.law().pid(), config.ts)?;
         state_check::all_positive(self, "radius").map_err(|e| format!("estimator: {e}"))?;
         state_check::all_finite(self)
     }
@@ -324,43 +241,73 @@ pub struct ContourCcc2D {
     state: Option<State>,
 }
 
-fn gains(values: &Values, first: Vr) -> PidGains {
-    PidGains::new(
-        values.real(first),
-        values.real(first + 1),
-        values.real(first + 2),
-    )
+fn gains([kp, ki, kd]: [f64; 3]) -> PidGains {
+    PidGains::new(kp, ki, kd)
 }
 
 fn config(values: &Values) -> ControllerConfig {
-    let f = |i| values.real(FUZZY_FACTORS + i);
-    let mode = match (values.boolean(CCC_ENABLE), values.boolean(FUZZY_ENABLE)) {
+    let [ke, kde, kpf, kif, kdf] = FUZZY_FACTORS.get(values);
+    let mode = match (CCC_ENABLE.get(values), FUZZY_ENABLE.get(values)) {
         (false, _) => CccMode::Off,
         (true, false) => CccMode::Fixed,
         (true, true) => CccMode::Fuzzy,
     };
+    let [xp, xi, xd, yp, yi, yd] = AXIS_GAINS.get(values);
     ControllerConfig {
-        ts: values.real(TS),
-        axis: [gains(values, AXIS_GAINS), gains(values, AXIS_GAINS + 3)],
+        ts: TS.get(values),
+        axis: [gains([xp, xi, xd]), gains([yp, yi, yd])],
         axis_limit: None,
         ccc: CccConfig {
             mode,
-            gains0: gains(values, CCC_GAINS0),
+            gains0: gains(CCC_GAINS0.get(values)),
             fuzzy: FuzzyFactors {
-                ke: f(0),
-                kde: f(1),
-                kpf: f(2),
-                kif: f(3),
-                kdf: f(4),
+                ke,
+                kde,
+                kpf,
+                kif,
+                kdf,
             },
-            limit: Some(values.real(CCC_LIMIT)),
+            limit: Some(CCC_LIMIT.get(values)),
         },
     }
 }
 
+/// The variable that sets a configuration value.
+fn variable_of(parameter: Parameter) -> &'static Variable {
+    let gain = |g: Gain| match g {
+        Gain::Kp => 0,
+        Gain::Ki => 1,
+        Gain::Kd => 2,
+    };
+    let vr = match parameter {
+        Parameter::Ts => TS.vr(),
+        Parameter::AxisGain(axis, g) => AXIS_GAINS.vr() + 3 * axis + gain(g),
+        // Not an FMU parameter (the FMU never sets an axis limit); the contour limit is
+        // the nearest thing a user can act on.
+        Parameter::AxisLimit | Parameter::ContourLimit => CCC_LIMIT.vr(),
+        Parameter::ContourGain(g) => CCC_GAINS0.vr() + gain(g),
+        Parameter::Fuzzy(f) => {
+            FUZZY_FACTORS.vr()
+                + match f {
+                    FuzzyFactor::Ke => 0,
+                    FuzzyFactor::Kde => 1,
+                    FuzzyFactor::Kpf => 2,
+                    FuzzyFactor::Kif => 3,
+                    FuzzyFactor::Kdf => 4,
+                }
+        }
+    };
+    &VARIABLES[vr]
+}
+
+/// A configuration error in the FMU's own parameter names.
+fn config_message(e: ConfigError) -> String {
+    e.message_for(&variable_of(e.parameter).name.to_string())
+}
+
 /// The estimator kind the `estimator` value selects.
 fn estimator_kind(values: &Values) -> Result<EstimatorKind, String> {
-    let value = values.integer(ESTIMATOR);
+    let value = ESTIMATOR.get(values);
     usize::try_from(value)
         .ok()
         .and_then(|v| v.checked_sub(1))
@@ -377,24 +324,26 @@ fn estimator(values: &Values) -> Result<Estimator, String> {
     let kind = estimator_kind(values)?;
     Ok(match kind {
         EstimatorKind::FreeCurve => Estimator::FreeCurve(FreeCurveEstimator::default()),
-        EstimatorKind::Line => {
-            Estimator::Line(LineEstimator::new(&geometry::line(values, GEOMETRY)?))
-        }
-        EstimatorKind::Arc => Estimator::Arc(ArcEstimator::new(&geometry::arc(values, GEOMETRY)?)),
+        EstimatorKind::Line => Estimator::Line(LineEstimator::new(&line_arc_parameters::line(
+            values, GEOMETRY,
+        )?)),
+        EstimatorKind::Arc => Estimator::Arc(ArcEstimator::new(&line_arc_parameters::arc(
+            values, GEOMETRY,
+        )?)),
     })
 }
 
 impl Model for ContourCcc2D {
     fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult {
-        check_period("Ts", values.real(TS))?;
+        check_period("Ts", TS.get(values))?;
         let config = config(values);
         let controller =
-            CrossCoupledController::new(config, estimator(values)?).map_err(|e| e.to_string())?;
+            CrossCoupledController::new(config, estimator(values)?).map_err(config_message)?;
         self.state = Some(State {
             controller,
             clock: SampleClock::new(start_time, config.ts),
         });
-        for vr in U_X..=CCC_KD {
+        for vr in U.vr()..CCC_GAINS.vr() + 3 {
             values.set_real(vr, 0.0);
         }
         Ok(())
@@ -402,18 +351,15 @@ impl Model for ContourCcc2D {
 
     fn do_step(&mut self, values: &mut Values, time: f64, step: f64) -> ModelResult {
         let state = self.state.as_mut().ok_or("not initialized")?;
-        let reference = [values.real(REF_X), values.real(REF_Y)];
-        let actual = [values.real(POS_X), values.real(POS_Y)];
+        let reference = REF.vector(values);
+        let actual = POS.vector(values);
         while state.clock.take_before(time + step) {
             let out = state.controller.sample(reference, actual);
-            values.set_real(U_X, out.u[0]);
-            values.set_real(U_Y, out.u[1]);
-            values.set_real(CONTOUR_ERROR, out.contour.error);
-            values.set_real(ERR_X, out.following_error[0]);
-            values.set_real(ERR_Y, out.following_error[1]);
-            values.set_real(CCC_KP, out.gains.0);
-            values.set_real(CCC_KI, out.gains.1);
-            values.set_real(CCC_KD, out.gains.2);
+            U.set(values, &out.u);
+            CONTOUR_ERROR.set(values, out.contour.error);
+            ERR.set(values, &out.following_error);
+            let (kp, ki, kd) = out.gains;
+            CCC_GAINS.set(values, &[kp, ki, kd].into());
         }
         Ok(())
     }
@@ -445,6 +391,25 @@ mod tests {
     }
 
     #[test]
+    fn configuration_errors_use_the_fmu_parameter_names() {
+        let mut values = Values::from_table(&VARIABLES);
+        values.set_real(AXIS_GAINS.at(4).vr(), -1.0);
+        let e = CrossCoupledController::new(
+            config(&values),
+            Estimator::FreeCurve(FreeCurveEstimator::default()),
+        )
+        .unwrap_err();
+        assert_eq!(
+            config_message(e),
+            "parameter axis.y.Ki = -1 is invalid: must be finite and >= 0"
+        );
+        let mut values = Values::from_table(&VARIABLES);
+        values.set_real(FUZZY_FACTORS.at(3).vr(), f64::NAN);
+        let e = config(&values).validate().unwrap_err();
+        assert!(config_message(e).starts_with("parameter fuzzy.ki = NaN"));
+    }
+
+    #[test]
     fn enumeration_items_are_the_estimator_kinds_in_order() {
         assert_eq!(ESTIMATOR_TYPE.items.len(), EstimatorKind::ALL.len());
         let mut values = Values::from_table(&VARIABLES);
@@ -455,11 +420,11 @@ mod tests {
             .enumerate()
         {
             assert_eq!(item.name, kind.as_str());
-            values.set(ESTIMATOR, super::super::Value::Integer(i as i32 + 1));
+            values.set(ESTIMATOR.vr(), super::super::Value::Integer(i as i32 + 1));
             assert_eq!(estimator_kind(&values), Ok(kind));
         }
         for bad in [0, 4, -1] {
-            values.set(ESTIMATOR, super::super::Value::Integer(bad));
+            values.set(ESTIMATOR.vr(), super::super::Value::Integer(bad));
             let message = estimator_kind(&values).unwrap_err();
             assert!(
                 message.contains("1 = free_curve, 2 = line, 3 = arc"),

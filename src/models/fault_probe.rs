@@ -2,63 +2,50 @@
 //! panics on demand, so the ABI tests can drive the FMI layer into its `Error` and
 //! `Fatal` modes and check that a panic becomes `fmi2Fatal`, never an abort.
 
-use super::variables::{Start, Values, Variable, Vr};
+use super::variable_table::variable_table;
+use super::variables::{Start, Values, Variable};
 use super::{
     decode_state, encode_state, DefaultExperiment, Environment, Model, ModelInfo, ModelResult,
     StateLayout, Value,
 };
 
-pub const PANIC: Vr = 0;
-pub const FAIL: Vr = 1;
-pub const LABEL: Vr = 2;
-pub const STEPS: Vr = 3;
-pub const ECHO: Vr = 4;
-pub const GAIN: Vr = 5;
-pub const LEVEL: Vr = 6;
-pub const NOTE: Vr = 7;
-
-static VARIABLES: [Variable; 8] = [
-    Variable::discrete_input(
-        PANIC,
+variable_table! {
+    static VARIABLES;
+    PANIC: Bool = Variable::discrete_input(
         "panic",
         Start::Boolean(false),
         "Panic in the next fmi2DoStep",
-    ),
-    Variable::discrete_input(
-        FAIL,
+    );
+    FAIL: Bool = Variable::discrete_input(
         "fail",
         Start::Boolean(false),
         "Fail the next fmi2DoStep",
-    ),
-    Variable::parameter(
-        LABEL,
+    );
+    LABEL: Str = Variable::parameter(
         "label",
         Start::String("probe"),
         "A string parameter, echoed",
-    ),
-    Variable::discrete_output(STEPS, "steps", Start::Integer(0), "Steps completed"),
-    Variable::discrete_output(ECHO, "echo", Start::String(""), "The label, as computed"),
-    Variable::parameter(
-        GAIN,
+    );
+    STEPS: Int = Variable::discrete_output("steps", Start::Integer(0), "Steps completed");
+    ECHO: Str = Variable::discrete_output("echo", Start::String(""), "The label, as computed");
+    GAIN: Real = Variable::parameter(
         "gain",
         Start::Real(1.0),
         "A tunable parameter that must stay < 10",
     )
     .tunable()
-    .min(0.0),
-    Variable::discrete_input(
-        LEVEL,
+    .min(0.0);
+    LEVEL: Int = Variable::discrete_input(
         "level",
         Start::Integer(0),
         "An Integer input (settable whenever inputs are)",
-    ),
-    Variable::discrete_input(
-        NOTE,
+    );
+    NOTE: Str = Variable::discrete_input(
         "note",
         Start::String(""),
         "A String input (settable whenever inputs are)",
-    ),
-];
+    );
+}
 
 pub static INFO: ModelInfo = ModelInfo {
     identifier: "FaultProbe",
@@ -70,7 +57,7 @@ pub static INFO: ModelInfo = ModelInfo {
         step_size: 1e-3,
     },
     // `echo` is the label as initialized; `steps` starts at 0.
-    initial_dependencies: &[(ECHO, &[LABEL])],
+    initial_dependencies: &[(ECHO.vr(), &[LABEL.vr()])],
     create: |_: &Environment| Box::new(FaultProbe { steps: 0 }),
 };
 
@@ -95,13 +82,13 @@ impl Model for FaultProbe {
     fn initialize(&mut self, values: &mut Values, _start_time: f64) -> ModelResult {
         self.parameters_changed(values)?;
         self.steps = 0;
-        values.set(STEPS, Value::Integer(0));
-        values.set(ECHO, Value::String(values.string(LABEL).to_owned()));
+        values.set(STEPS.vr(), Value::Integer(0));
+        values.set(ECHO.vr(), Value::String(LABEL.get(values).to_owned()));
         Ok(())
     }
 
     fn parameters_changed(&mut self, values: &mut Values) -> ModelResult {
-        let gain = values.real(GAIN);
+        let gain = GAIN.get(values);
         if gain >= 10.0 {
             return Err(format!("parameter 'gain' must be < 10 (got {gain})"));
         }
@@ -109,14 +96,14 @@ impl Model for FaultProbe {
     }
 
     fn do_step(&mut self, values: &mut Values, _time: f64, _step: f64) -> ModelResult {
-        if values.boolean(PANIC) {
+        if PANIC.get(values) {
             panic!("FaultProbe: injected panic");
         }
-        if values.boolean(FAIL) {
+        if FAIL.get(values) {
             return Err("FaultProbe: injected failure".into());
         }
         self.steps += 1;
-        values.set(STEPS, Value::Integer(self.steps));
+        values.set(STEPS.vr(), Value::Integer(self.steps));
         Ok(())
     }
 

@@ -2,11 +2,13 @@
 //! function. Nothing here knows FMI types; `crate::fmi2` adapts these to the C ABI.
 
 pub mod contour_ccc_2d;
-pub mod geometry;
+pub mod line_arc_parameters;
 pub mod path_interpolator_2d;
 pub mod sample_clock;
 pub mod state_check;
+pub mod text;
 pub mod units;
+pub mod variable_table;
 pub mod variables;
 pub mod xy_servo_plant;
 
@@ -17,6 +19,7 @@ use std::path::PathBuf;
 
 use sha2::{Digest, Sha256};
 
+pub use text::Text;
 pub use variables::{
     Causality, EnumItem, EnumType, Start, Value, Values, VarType, Variability, Variable, Vr,
 };
@@ -296,7 +299,7 @@ mod tests {
                     model.identifier, v.name
                 );
                 assert!(
-                    names.insert(v.name),
+                    names.insert(v.name.to_string()),
                     "{}: '{}' twice",
                     model.identifier,
                     v.name

@@ -5,63 +5,48 @@
 use std::f64::consts::PI;
 
 use super::sample_clock::{check_period, SampleClock};
-use super::variables::{Start, Values, Variable, Vr};
+use super::variable_table::{
+    axis_block, variable_table, AxisTemplate, AxisUnit, AxisWord, Real, XY,
+};
+use super::variables::{Start, Values, Variable};
 use super::{
-    decode_checked, encode_state, geometry, state_check, DefaultExperiment, Environment, Model,
-    ModelInfo, ModelResult, SavedState, StateLayout,
+    decode_checked, encode_state, line_arc_parameters, state_check, DefaultExperiment, Environment,
+    Model, ModelInfo, ModelResult, SavedState, StateLayout,
 };
 use crate::path::{Arc, Curve, Interpolator, Line, Path};
 
-pub const REF_X: Vr = 0;
-pub const REF_Y: Vr = 1;
-pub const DONE: Vr = 2;
-pub const PATH: Vr = 3;
-pub const FEED: Vr = 4;
-pub const TS: Vr = 5;
-pub const GEOMETRY: Vr = 6;
-
-const G: [Variable; geometry::COUNT] = geometry::variables(GEOMETRY);
-
-static VARIABLES: [Variable; 6 + geometry::COUNT] = [
-    Variable::output(REF_X, "ref.x", "Reference position, x").unit("mm"),
-    Variable::output(REF_Y, "ref.y", "Reference position, y").unit("mm"),
-    Variable::discrete_output(
-        DONE,
+variable_table! {
+    static VARIABLES;
+    REF: Reals<2> = axis_block(&XY, &[AxisTemplate::output(
+        ("ref.", ""),
+        ("Reference position, ", AxisWord::Name, ""),
+    )
+    .unit(AxisUnit::POSITION)]);
+    DONE: Bool = Variable::discrete_output(
         "done",
         Start::Boolean(false),
         "The end of the path has been reached",
-    ),
-    Variable::parameter(
-        PATH,
+    );
+    PATH: Str = Variable::parameter(
         "path",
         Start::String("circle"),
         "circle (the paper's), line or arc (from the line.*/arc.* parameters), infinity, \
          trident, or a NURBS JSON file: absolute, or relative to the FMU's resources folder",
-    ),
-    Variable::parameter(
-        FEED,
+    );
+    FEED: Real = Variable::parameter(
         "feed",
         Start::Real(10.0 * PI),
         "Feed rate along the path (> 0)",
     )
-    .unit("mm/s"),
-    Variable::parameter(
-        TS,
+    .unit("mm/s");
+    TS: Real = Variable::parameter(
         "Ts",
         Start::Real(1e-3),
         "Interpolation period (at least 1 us)",
     )
-    .unit("s"),
-    G[0],
-    G[1],
-    G[2],
-    G[3],
-    G[4],
-    G[5],
-    G[6],
-    G[7],
-    G[8],
-];
+    .unit("s");
+    GEOMETRY: Reals<{ line_arc_parameters::COUNT }> = line_arc_parameters::VARIABLES;
+}
 
 pub static INFO: ModelInfo = ModelInfo {
     identifier: "PathInterpolator2D",
@@ -79,23 +64,23 @@ pub static INFO: ModelInfo = ModelInfo {
     // Feed and Ts only matter from the first step on; `done` starts false.
     initial_dependencies: &[
         (
-            REF_X,
+            REF.at(0).vr(),
             &[
-                PATH,
-                GEOMETRY + geometry::LINE_X0,
-                GEOMETRY + geometry::ARC_CX,
-                GEOMETRY + geometry::ARC_R,
-                GEOMETRY + geometry::ARC_START,
+                PATH.vr(),
+                GEOMETRY.at(line_arc_parameters::LINE_X0).vr(),
+                GEOMETRY.at(line_arc_parameters::ARC_CX).vr(),
+                GEOMETRY.at(line_arc_parameters::ARC_R).vr(),
+                GEOMETRY.at(line_arc_parameters::ARC_START).vr(),
             ],
         ),
         (
-            REF_Y,
+            REF.at(1).vr(),
             &[
-                PATH,
-                GEOMETRY + geometry::LINE_Y0,
-                GEOMETRY + geometry::ARC_CY,
-                GEOMETRY + geometry::ARC_R,
-                GEOMETRY + geometry::ARC_START,
+                PATH.vr(),
+                GEOMETRY.at(line_arc_parameters::LINE_Y0).vr(),
+                GEOMETRY.at(line_arc_parameters::ARC_CY).vr(),
+                GEOMETRY.at(line_arc_parameters::ARC_R).vr(),
+                GEOMETRY.at(line_arc_parameters::ARC_START).vr(),
             ],
         ),
     ],
@@ -165,21 +150,22 @@ pub struct PathInterpolator2D {
     state: Option<State>,
 }
 
-fn positive(values: &Values, vr: Vr, name: &str) -> Result<f64, String> {
-    let v = values.real(vr);
+fn positive(values: &Values, variable: Real) -> Result<f64, String> {
+    let v = variable.get(values);
     if v > 0.0 {
         Ok(v)
     } else {
+        let name = VARIABLES[variable.vr()].name;
         Err(format!("parameter '{name}' must be > 0 (got {v})"))
     }
 }
 
 /// The path the parameters describe; file errors name the file and line.
 fn path(values: &Values, environment: &Environment) -> Result<Path, String> {
-    let spec = values.string(PATH).trim();
+    let spec = PATH.get(values).trim();
     match spec.to_ascii_lowercase().as_str() {
-        "line" => geometry::line(values, GEOMETRY).map(Path::Line),
-        "arc" => geometry::arc(values, GEOMETRY).map(Path::Arc),
+        "line" => line_arc_parameters::line(values, GEOMETRY).map(Path::Line),
+        "arc" => line_arc_parameters::arc(values, GEOMETRY).map(Path::Arc),
         _ => Path::from_spec(spec, environment.resource_dir.as_deref())
             .map_err(|e| format!("parameter 'path': {e}")),
     }
@@ -189,17 +175,16 @@ impl PathInterpolator2D {
     fn write_outputs(&self, values: &mut Values) {
         if let Some(state) = &self.state {
             let sample = state.interpolator.current();
-            values.set_real(REF_X, sample.point[0]);
-            values.set_real(REF_Y, sample.point[1]);
-            values.set_boolean(DONE, sample.done);
+            REF.set(values, &sample.point);
+            DONE.set(values, sample.done);
         }
     }
 }
 
 impl Model for PathInterpolator2D {
     fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult {
-        let feed = positive(values, FEED, "feed")?;
-        let ts = check_period("Ts", values.real(TS))?;
+        let feed = positive(values, FEED)?;
+        let ts = check_period("Ts", TS.get(values))?;
         let interpolator = Interpolator::new(path(values, &self.environment)?, feed, ts)
             .map_err(|e| e.to_string())?;
         self.state = Some(State {
@@ -247,7 +232,7 @@ mod tests {
             builtin::by_name("circle").unwrap()
         );
         for name in ["line", "arc"] {
-            values.set(PATH, super::super::Value::String(name.into()));
+            values.set(PATH.vr(), super::super::Value::String(name.into()));
             assert_eq!(
                 path(&values, &env).unwrap(),
                 builtin::by_name(name).unwrap()

@@ -2,9 +2,13 @@
 //!
 //! The FMI layer does get/set from it, `fmu-build` renders `modelDescription.xml` and the
 //! documentation from it, and the GUID is a hash of it. A variable's value reference is
-//! its index in the table, so storage is a plain vector indexed by value reference.
+//! its index in the table, so storage is a plain vector indexed by value reference; the
+//! tables are declared with [`variable_table!`](super::variable_table), which numbers
+//! them.
 
 use serde::{Deserialize, Serialize};
+
+pub use super::text::Text;
 
 /// Value reference: the index of the variable in its model's table.
 pub type Vr = usize;
@@ -135,10 +139,11 @@ impl EnumType {
 /// One row of a model's variable table.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Variable {
+    /// Its index in the table (set when the table is assembled).
     pub vr: Vr,
     /// Structured FMI name, e.g. `x.Kvp`.
-    pub name: &'static str,
-    pub description: &'static str,
+    pub name: Text,
+    pub description: Text,
     pub causality: Causality,
     pub variability: Variability,
     /// Start value; for outputs it is the value before the first computation and is not
@@ -154,16 +159,15 @@ pub struct Variable {
 }
 
 impl Variable {
-    const fn new(
-        vr: Vr,
-        name: &'static str,
+    pub(crate) const fn new(
+        name: Text,
         causality: Causality,
         variability: Variability,
         start: Start,
-        description: &'static str,
+        description: Text,
     ) -> Self {
         Variable {
-            vr,
+            vr: 0,
             name,
             description,
             causality,
@@ -177,78 +181,66 @@ impl Variable {
     }
 
     /// A continuous Real input.
-    pub const fn input(vr: Vr, name: &'static str, start: f64, description: &'static str) -> Self {
+    pub const fn input(name: &'static str, start: f64, description: &'static str) -> Self {
         Self::new(
-            vr,
-            name,
+            Text::plain(name),
             Causality::Input,
             Variability::Continuous,
             Start::Real(start),
-            description,
+            Text::plain(description),
         )
     }
 
     /// A discrete input of a non-Real type.
     pub const fn discrete_input(
-        vr: Vr,
         name: &'static str,
         start: Start,
         description: &'static str,
     ) -> Self {
         Self::new(
-            vr,
-            name,
+            Text::plain(name),
             Causality::Input,
             Variability::Discrete,
             start,
-            description,
+            Text::plain(description),
         )
     }
 
     /// A continuous Real output.
-    pub const fn output(vr: Vr, name: &'static str, description: &'static str) -> Self {
+    pub const fn output(name: &'static str, description: &'static str) -> Self {
         Self::new(
-            vr,
-            name,
+            Text::plain(name),
             Causality::Output,
             Variability::Continuous,
             Start::Real(0.0),
-            description,
+            Text::plain(description),
         )
     }
 
     /// A discrete output of a non-Real type (`start` only gives the type and the value
     /// before the first computation).
     pub const fn discrete_output(
-        vr: Vr,
         name: &'static str,
         start: Start,
         description: &'static str,
     ) -> Self {
         Self::new(
-            vr,
-            name,
+            Text::plain(name),
             Causality::Output,
             Variability::Discrete,
             start,
-            description,
+            Text::plain(description),
         )
     }
 
     /// A parameter fixed after initialization.
-    pub const fn parameter(
-        vr: Vr,
-        name: &'static str,
-        start: Start,
-        description: &'static str,
-    ) -> Self {
+    pub const fn parameter(name: &'static str, start: Start, description: &'static str) -> Self {
         Self::new(
-            vr,
-            name,
+            Text::plain(name),
             Causality::Parameter,
             Variability::Fixed,
             start,
-            description,
+            Text::plain(description),
         )
     }
 

@@ -2,126 +2,102 @@
 //! commands in, positions and velocities out; integrated exactly, so the trajectory does
 //! not depend on the communication step.
 
-use super::variables::{Start, Values, Variable, Vr};
+use super::variable_table::{axis_block, variable_table, AxisTemplate, AxisUnit, AxisWord, XY};
+use super::variables::Values;
 use super::{
     decode_state, encode_state, state_check, DefaultExperiment, Environment, Model, ModelInfo,
     ModelResult, StateLayout,
 };
-use crate::plant::{AxisParams, ServoAxis, XyTable, XyTableParams};
-
-pub const U_X: Vr = 0;
-pub const U_Y: Vr = 1;
-pub const POS_X: Vr = 2;
-pub const POS_Y: Vr = 3;
-pub const VEL_X: Vr = 4;
-pub const VEL_Y: Vr = 5;
-/// First parameter of each axis; the six drive parameters follow in [`AXIS_FIELDS`] order.
-const X_PARAMS: Vr = 6;
-const Y_PARAMS: Vr = 12;
-pub const POS0_X: Vr = 18;
-pub const POS0_Y: Vr = 19;
-
-/// Per-axis parameter names (after the `x.`/`y.` prefix) in table order.
-const AXIS_FIELDS: [&str; 6] = ["J", "B", "CT", "lead", "Kvp", "Kvi"];
+use crate::plant::{AxisParams, ServoAxis, Transmission, XyTable, XyTableParams};
 
 const P: AxisParams = AxisParams::PAPER;
+const LEAD: f64 = match P.transmission {
+    Transmission::Linear { lead } => lead,
+    Transmission::Rotary { .. } => panic!("the paper's axis is linear"),
+};
 
-macro_rules! axis_parameters {
-    ($first:expr, $axis:literal) => {
-        [
-            Variable::parameter(
-                $first,
-                concat!($axis, ".J"),
-                Start::Real(P.inertia),
-                concat!("Inertia of the ", $axis, " motor plus reflected load"),
-            )
-            .unit("kg.m2")
-            .min(0.0),
-            Variable::parameter(
-                $first + 1,
-                concat!($axis, ".B"),
-                Start::Real(P.friction),
-                concat!("Viscous friction of the ", $axis, " axis"),
-            )
-            .unit("N.m.s/rad")
-            .min(0.0),
-            Variable::parameter(
-                $first + 2,
-                concat!($axis, ".CT"),
-                Start::Real(P.torque_constant),
-                concat!("Torque constant of the ", $axis, " motor"),
-            )
-            .unit("N.m/A")
-            .min(0.0),
-            Variable::parameter(
-                $first + 3,
-                concat!($axis, ".lead"),
-                Start::Real(P.lead),
-                concat!(
-                    "Ball-screw lead of the ",
-                    $axis,
-                    " axis (mm per revolution)"
-                ),
-            )
-            .unit("mm")
-            .min(0.0),
-            Variable::parameter(
-                $first + 4,
-                concat!($axis, ".Kvp"),
-                Start::Real(P.kvp),
-                concat!("Proportional gain of the ", $axis, " drive's velocity loop"),
-            )
-            .unit("A.s/rad")
-            .min(0.0),
-            Variable::parameter(
-                $first + 5,
-                concat!($axis, ".Kvi"),
-                Start::Real(P.kvi),
-                concat!("Integral gain of the ", $axis, " drive's velocity loop"),
-            )
-            .unit("A/rad")
-            .min(0.0),
-        ]
-    };
+/// A drive parameter of every axis (`x.J`, `y.J`, …), > 0 or ≥ 0.
+const fn drive(
+    suffix: &'static str,
+    start: f64,
+    description: (&'static str, &'static str),
+    unit: &'static str,
+) -> AxisTemplate {
+    AxisTemplate::parameter(
+        ("", suffix),
+        (start, start),
+        (description.0, AxisWord::Name, description.1),
+    )
+    .unit(AxisUnit::Fixed(unit))
+    .min(0.0)
 }
 
-const X_AXIS: [Variable; 6] = axis_parameters!(X_PARAMS, "x");
-const Y_AXIS: [Variable; 6] = axis_parameters!(Y_PARAMS, "y");
-
-static VARIABLES: [Variable; 20] = [
-    Variable::input(U_X, "u.x", 0.0, "Velocity command to the X drive").unit("mm/s"),
-    Variable::input(U_Y, "u.y", 0.0, "Velocity command to the Y drive").unit("mm/s"),
-    Variable::output(POS_X, "pos.x", "Position of the X axis").unit("mm"),
-    Variable::output(POS_Y, "pos.y", "Position of the Y axis").unit("mm"),
-    Variable::output(VEL_X, "vel.x", "Velocity of the X axis").unit("mm/s"),
-    Variable::output(VEL_Y, "vel.y", "Velocity of the Y axis").unit("mm/s"),
-    X_AXIS[0],
-    X_AXIS[1],
-    X_AXIS[2],
-    X_AXIS[3],
-    X_AXIS[4],
-    X_AXIS[5],
-    Y_AXIS[0],
-    Y_AXIS[1],
-    Y_AXIS[2],
-    Y_AXIS[3],
-    Y_AXIS[4],
-    Y_AXIS[5],
-    Variable::parameter(
-        POS0_X,
-        "pos0.x",
-        Start::Real(0.0),
-        "Initial position of the X axis",
-    )
-    .unit("mm"),
-    Variable::parameter(
-        POS0_Y,
-        "pos0.y",
-        Start::Real(0.0),
-        "Initial position of the Y axis",
-    )
-    .unit("mm"),
+/// The drive parameters, in [`AxisParams`] field order.
+const AXIS_FIELDS: [AxisTemplate; 6] = [
+    drive(
+        ".J",
+        P.inertia,
+        ("Inertia of the ", " motor plus reflected load"),
+        "kg.m2",
+    ),
+    drive(
+        ".B",
+        P.friction,
+        ("Viscous friction of the ", " axis"),
+        "N.m.s/rad",
+    ),
+    drive(
+        ".CT",
+        P.torque_constant,
+        ("Torque constant of the ", " motor"),
+        "N.m/A",
+    ),
+    drive(
+        ".lead",
+        LEAD,
+        ("Ball-screw lead of the ", " axis (mm per revolution)"),
+        "mm",
+    ),
+    drive(
+        ".Kvp",
+        P.kvp,
+        ("Proportional gain of the ", " drive's velocity loop"),
+        "A.s/rad",
+    ),
+    drive(
+        ".Kvi",
+        P.kvi,
+        ("Integral gain of the ", " drive's velocity loop"),
+        "A/rad",
+    ),
 ];
+
+variable_table! {
+    static VARIABLES;
+    U: Reals<2> = axis_block(&XY, &[AxisTemplate::input(
+        ("u.", ""),
+        ("Velocity command to the ", AxisWord::Label, " drive"),
+    )
+    .unit(AxisUnit::VELOCITY)]);
+    POS: Reals<2> = axis_block(&XY, &[AxisTemplate::output(
+        ("pos.", ""),
+        ("Position of the ", AxisWord::Label, " axis"),
+    )
+    .unit(AxisUnit::POSITION)]);
+    VEL: Reals<2> = axis_block(&XY, &[AxisTemplate::output(
+        ("vel.", ""),
+        ("Velocity of the ", AxisWord::Label, " axis"),
+    )
+    .unit(AxisUnit::VELOCITY)]);
+    /// J, B, CT, lead, Kvp, Kvi of X, then of Y.
+    AXIS_PARAMS: Reals<12> = axis_block(&XY, &AXIS_FIELDS);
+    POS0: Reals<2> = axis_block(&XY, &[AxisTemplate::parameter(
+        ("pos0.", ""),
+        (0.0, 0.0),
+        ("Initial position of the ", AxisWord::Label, " axis"),
+    )
+    .unit(AxisUnit::POSITION)]);
+}
 
 pub static INFO: ModelInfo = ModelInfo {
     identifier: "XYServoPlant",
@@ -135,20 +111,24 @@ pub static INFO: ModelInfo = ModelInfo {
         step_size: 1e-3,
     },
     // Both axes start at rest at pos0.
-    initial_dependencies: &[(POS_X, &[POS0_X]), (POS_Y, &[POS0_Y])],
+    initial_dependencies: &[
+        (POS.at(0).vr(), &[POS0.at(0).vr()]),
+        (POS.at(1).vr(), &[POS0.at(1).vr()]),
+    ],
     create: |_: &Environment| Box::new(XyServoPlant::default()),
 };
 
-/// Version 1: the [`XyTable`] as it serialises.
+/// The [`XyTable`] as it serialises. Version 2: each axis's lead became a
+/// [`Transmission`] (linear or rotary).
 const LAYOUT: StateLayout = StateLayout {
     model: "XYServoPlant",
-    version: 1,
+    version: 2,
 };
 
 /// Checks a restored table like the parameters it was built from; the error names the
 /// offending value.
 fn validate(table: &XyTable) -> Result<(), String> {
-    for (name, axis) in [("x", &table.x), ("y", &table.y)] {
+    for (name, axis) in XY.iter().map(|a| a.name).zip(&table.axes) {
         axis.params()
             .validate()
             .map_err(|e| format!("axis {name}: {e}"))?;
@@ -208,59 +188,54 @@ pub struct XyServoPlant {
 impl Default for XyServoPlant {
     fn default() -> Self {
         XyServoPlant {
-            table: XyTable::new(XyTableParams::PAPER, [0.0, 0.0]),
+            table: XyTable::new(XyTableParams::PAPER, [0.0, 0.0].into()),
         }
     }
 }
 
-fn axis_params(values: &Values, first: Vr, axis: &str) -> Result<AxisParams, String> {
-    let p = |i: usize| values.real(first + i);
+/// The parameters of axis `index` (0 = x, 1 = y).
+fn axis_params(values: &Values, index: usize) -> Result<AxisParams, String> {
+    let first = index * AXIS_FIELDS.len();
+    let p = |i: usize| AXIS_PARAMS.at(first + i).get(values);
     let params = AxisParams {
         inertia: p(0),
         friction: p(1),
         torque_constant: p(2),
-        lead: p(3),
+        transmission: Transmission::Linear { lead: p(3) },
         kvp: p(4),
         kvi: p(5),
     };
     // J, CT and lead divide or scale the dynamics: zero is as unphysical as negative.
     for i in [0, 2, 3] {
         if p(i) <= 0.0 {
-            return Err(format!(
-                "parameter '{axis}.{}' must be > 0 (got {})",
-                AXIS_FIELDS[i],
-                p(i)
-            ));
+            let name = VARIABLES[AXIS_PARAMS.at(first + i).vr()].name;
+            return Err(format!("parameter '{name}' must be > 0 (got {})", p(i)));
         }
     }
+    let axis = XY[index].name;
     params.validate().map_err(|e| format!("axis {axis}: {e}"))?;
     Ok(params)
 }
 
 impl XyServoPlant {
     fn write_outputs(&self, values: &mut Values) {
-        let [px, py] = self.table.position();
-        let [vx, vy] = self.table.velocity();
-        values.set_real(POS_X, px);
-        values.set_real(POS_Y, py);
-        values.set_real(VEL_X, vx);
-        values.set_real(VEL_Y, vy);
+        POS.set(values, &self.table.position());
+        VEL.set(values, &self.table.velocity());
     }
 }
 
 impl Model for XyServoPlant {
     fn initialize(&mut self, values: &mut Values, _start_time: f64) -> ModelResult {
         let params = XyTableParams {
-            x: axis_params(values, X_PARAMS, "x")?,
-            y: axis_params(values, Y_PARAMS, "y")?,
+            axes: [axis_params(values, 0)?, axis_params(values, 1)?],
         };
-        self.table = XyTable::new(params, [values.real(POS0_X), values.real(POS0_Y)]);
+        self.table = XyTable::new(params, POS0.vector(values));
         self.write_outputs(values);
         Ok(())
     }
 
     fn do_step(&mut self, values: &mut Values, _time: f64, step: f64) -> ModelResult {
-        self.table.step([values.real(U_X), values.real(U_Y)], step);
+        self.table.step(U.vector(values), step);
         self.write_outputs(values);
         Ok(())
     }

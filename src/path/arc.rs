@@ -1,4 +1,4 @@
-//! Circular arc: centre O, radius r, start angle φ0 and signed sweep Δφ (positive =
+//! Planar circular arc: centre O, radius r, start angle φ0 and signed sweep Δφ (positive =
 //! counter-clockwise). Parameter u ∈ [0, 1], angle φ(u) = φ0 + u·Δφ, so the speed |C'| is
 //! the constant r·|Δφ| and the feed-rate interpolator steps it exactly.
 
@@ -6,12 +6,13 @@ use std::f64::consts::PI;
 
 use serde::{Deserialize, Serialize};
 
-use super::{clamp_param, v2, Curve, CurvePoint, PathError};
+use super::{clamp_param, Curve, CurvePoint, PathError};
+use crate::geometry::{self, Vector2};
 
 /// Circular arc (a full circle when |sweep| = 2π).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Arc {
-    center: [f64; 2],
+    center: Vector2,
     radius: f64,
     start_angle: f64,
     sweep: f64,
@@ -20,12 +21,13 @@ pub struct Arc {
 impl Arc {
     /// Arc with `radius > 0`, `0 < |sweep| ≤ 2π` (sign = direction), all finite.
     pub fn new(
-        center: [f64; 2],
+        center: impl Into<Vector2>,
         radius: f64,
         start_angle: f64,
         sweep: f64,
     ) -> Result<Self, PathError> {
-        if !v2::finite(center) || !radius.is_finite() || !start_angle.is_finite() {
+        let center = center.into();
+        if !geometry::is_finite(&center) || !radius.is_finite() || !start_angle.is_finite() {
             return Err(PathError::invalid(
                 "arc centre, radius and start angle must be finite",
             ));
@@ -50,7 +52,7 @@ impl Arc {
 
     /// Full circle starting at `start_angle`, counter-clockwise when `ccw`.
     pub fn circle(
-        center: [f64; 2],
+        center: impl Into<Vector2>,
         radius: f64,
         start_angle: f64,
         ccw: bool,
@@ -64,7 +66,7 @@ impl Arc {
     }
 
     /// Centre O.
-    pub fn center(&self) -> [f64; 2] {
+    pub fn center(&self) -> Vector2 {
         self.center
     }
     /// Radius r, mm.
@@ -113,9 +115,9 @@ impl Curve for Arc {
         let r = self.radius;
         let w = self.sweep;
         CurvePoint {
-            p: [self.center[0] + r * c, self.center[1] + r * s],
-            d1: [-r * w * s, r * w * c],
-            d2: [-r * w * w * c, -r * w * w * s],
+            p: Vector2::new(self.center[0] + r * c, self.center[1] + r * s),
+            d1: Vector2::new(-r * w * s, r * w * c),
+            d2: Vector2::new(-r * w * w * c, -r * w * w * s),
         }
     }
     fn length_between(&self, u0: f64, u1: f64) -> f64 {

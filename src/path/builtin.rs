@@ -122,7 +122,7 @@ pub fn rational_unit_circle() -> Nurbs {
 fn cubic_uniform(p: &[[f64; 2]]) -> Nurbs {
     Nurbs::new(
         3,
-        Nurbs::clamped_uniform_knots(p.len(), 3),
+        crate::path::nurbs::clamped_uniform_knots(p.len(), 3),
         p.to_vec(),
         None,
     )

@@ -18,7 +18,9 @@ use super::nurbs::NurbsData;
 use super::{Nurbs, PathError};
 
 /// Reads and validates a NURBS JSON file.
-pub fn load_nurbs(file: impl AsRef<std::path::Path>) -> Result<Nurbs, PathError> {
+pub fn load_nurbs<const D: usize>(
+    file: impl AsRef<std::path::Path>,
+) -> Result<Nurbs<D>, PathError> {
     let file = file.as_ref();
     let name = file.display().to_string();
     let text = std::fs::read_to_string(file).map_err(|e| PathError::File {
@@ -31,8 +33,8 @@ pub fn load_nurbs(file: impl AsRef<std::path::Path>) -> Result<Nurbs, PathError>
 }
 
 /// Parses the JSON text of a NURBS file; `name` is used in error messages.
-pub fn parse_nurbs(text: &str, name: &str) -> Result<Nurbs, PathError> {
-    let data: NurbsData = serde_json::from_str(text).map_err(|e| PathError::File {
+pub fn parse_nurbs<const D: usize>(text: &str, name: &str) -> Result<Nurbs<D>, PathError> {
+    let data: NurbsData<D> = serde_json::from_str(text).map_err(|e| PathError::File {
         file: name.to_string(),
         line: e.line(),
         column: e.column(),
@@ -67,15 +69,15 @@ mod tests {
           "control_points": [[0, 0], [10, 5], [20, 0], [30, 5], [40, 0]],
           "weights": [1, 1, 2, 1, 1]
         }"#;
-        let n = parse_nurbs(t, "ex.json").unwrap();
+        let n = parse_nurbs::<2>(t, "ex.json").unwrap();
         assert_eq!(n.weights()[2], 2.0);
-        assert_eq!(n.point(1.0), [40.0, 0.0]);
+        assert_eq!(n.point(1.0), crate::geometry::Vector2::new(40.0, 0.0));
     }
 
     #[test]
     fn syntax_error_names_file_and_line() {
         let t = "{\n \"degree\": 3,\n \"knots\": [0, 0,, 1]\n}";
-        let e = parse_nurbs(t, "bad.json").unwrap_err();
+        let e = parse_nurbs::<2>(t, "bad.json").unwrap_err();
         match &e {
             PathError::File { file, line, .. } => {
                 assert_eq!(file, "bad.json");
@@ -89,15 +91,15 @@ mod tests {
     #[test]
     fn content_errors_name_file() {
         let t = r#"{"degree": 3, "knots": [0,0,0,1,1,1,1], "control_points": [[0,0],[1,1],[2,0],[3,1]]}"#;
-        let e = parse_nurbs(t, "short.json").unwrap_err().to_string();
+        let e = parse_nurbs::<2>(t, "short.json").unwrap_err().to_string();
         assert!(e.contains("short.json") && e.contains("knot count"), "{e}");
         let t = r#"{"degree": 3, "knot": []}"#;
-        let e = parse_nurbs(t, "typo.json").unwrap_err().to_string();
+        let e = parse_nurbs::<2>(t, "typo.json").unwrap_err().to_string();
         assert!(
             e.contains("typo.json:1:") && e.contains("unknown field"),
             "{e}"
         );
-        let e = load_nurbs("/nonexistent/dir/x.json")
+        let e = load_nurbs::<2>("/nonexistent/dir/x.json")
             .unwrap_err()
             .to_string();
         assert!(
@@ -119,7 +121,7 @@ mod tests {
         .unwrap();
         let p = Path::from_spec("s.json", Some(&dir)).unwrap();
         assert!((p.length() - 5.0).abs() < 1e-12);
-        assert_eq!(p.end_point(), [3.0, 4.0]);
+        assert_eq!(p.end_point(), crate::geometry::Vector2::new(3.0, 4.0));
         let e = Path::from_spec("nope.json", Some(&dir)).unwrap_err();
         assert!(e.to_string().contains("nope.json") && e.to_string().contains("cannot read"));
         assert!(matches!(

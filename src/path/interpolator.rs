@@ -11,27 +11,29 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{v2, Curve, CurvePoint, Path, PathError};
+use super::{Curve, CurvePoint, Path, PathError};
+use crate::geometry::{self, Vector};
 
 /// One emitted reference sample.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Sample {
+pub struct Sample<const D: usize = 2> {
     /// Reference point, mm.
-    pub point: [f64; 2],
+    pub point: Vector<D>,
     /// Curve parameter of the point (a hint for exact-distance searches).
     pub u: f64,
     /// True once the path end has been reached (this and every later sample is the end).
     pub done: bool,
 }
 
-/// Samples a [`Path`] at a constant feed. The whole struct is the state the FMU saves.
+/// Samples a curve (a planar [`Path`] unless said otherwise) at a constant feed. The
+/// whole struct is the state the FMU saves.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Interpolator {
-    path: Path,
+pub struct Interpolator<const D: usize = 2, C = Path> {
+    path: C,
     feed: f64,
     ts: f64,
     u: f64,
-    cur: CurvePoint,
+    cur: CurvePoint<D>,
     done: bool,
     samples: u64,
 }
@@ -57,9 +59,9 @@ fn check(feed: f64, ts: f64) -> Result<(), PathError> {
     Ok(())
 }
 
-impl Interpolator {
+impl<const D: usize, C: Curve<D>> Interpolator<D, C> {
     /// Starts at the beginning of `path` with feed `feed` (mm/s, ≥ 0) and period `ts` (s, > 0).
-    pub fn new(path: Path, feed: f64, ts: f64) -> Result<Self, PathError> {
+    pub fn new(path: C, feed: f64, ts: f64) -> Result<Self, PathError> {
         check(feed, ts)?;
         let u = path.param_range().0;
         let cur = path.eval(u);
@@ -90,7 +92,7 @@ impl Interpolator {
     }
 
     /// The path being followed.
-    pub fn path(&self) -> &Path {
+    pub fn path(&self) -> &C {
         &self.path
     }
     /// Feed, mm/s.
@@ -102,7 +104,7 @@ impl Interpolator {
         self.ts
     }
     /// Current reference point (sample number [`Self::samples`]).
-    pub fn point(&self) -> [f64; 2] {
+    pub fn point(&self) -> Vector<D> {
         self.cur.p
     }
     /// Current curve parameter.
@@ -118,7 +120,7 @@ impl Interpolator {
         self.samples
     }
     /// The current sample.
-    pub fn current(&self) -> Sample {
+    pub fn current(&self) -> Sample<D> {
         Sample {
             point: self.cur.p,
             u: self.u,
@@ -128,7 +130,7 @@ impl Interpolator {
 
     /// Advances by one period and returns the new reference sample. The sample that would
     /// pass the path end is clamped to the end point and reports `done`.
-    pub fn step(&mut self) -> Sample {
+    pub fn step(&mut self) -> Sample<D> {
         if self.done {
             return self.current();
         }
@@ -140,9 +142,9 @@ impl Interpolator {
         let (_, u_end) = self.path.param_range();
         let (u0, p0) = (self.u, self.cur.p);
         let d1 = self.cur.d1;
-        let sp = v2::norm(d1);
+        let sp = geometry::norm(&d1);
         let mut du = if sp > 1e-12 {
-            l / sp - l * l * v2::dot(d1, self.cur.d2) / (2.0 * sp.powi(4))
+            l / sp - l * l * d1.dot(&self.cur.d2) / (2.0 * sp.powi(4))
         } else {
             f64::NAN
         };
@@ -159,18 +161,18 @@ impl Interpolator {
             // The Taylor step is checked by the chord it produced; where it misses
             // (degenerate parametrisation, derivative jumps at knots) a few Newton steps on
             // the chord length fix it, and bisection backs those up.
-            let mut c = v2::dist(e.p, p0);
+            let mut c = geometry::dist(&e.p, &p0);
             let mut iters = 0;
             while (c - l).abs() > CHORD_TOL * l && iters < NEWTON_ITERS {
                 iters += 1;
-                let g1 = v2::dot(v2::sub(e.p, p0), e.d1) / c;
+                let g1 = (e.p - p0).dot(&e.d1) / c;
                 let next = u1 - (c - l) / g1;
                 if !(g1 > 0.0 && next.is_finite() && next > u0) {
                     break;
                 }
                 u1 = next.min(u_end);
                 e = self.path.eval(u1);
-                c = v2::dist(e.p, p0);
+                c = geometry::dist(&e.p, &p0);
             }
             if (c - l).abs() > CHORD_TOL * l {
                 u1 = u0 + self.bisect_step(l);
@@ -181,7 +183,7 @@ impl Interpolator {
                 self.cur = e;
                 return self.current();
             }
-        } else if v2::dist(self.path.point(u_end), p0) > (1.0 + CHORD_TOL) * l {
+        } else if geometry::dist(&self.path.point(u_end), &p0) > (1.0 + CHORD_TOL) * l {
             // Predictor overshot the end although the end is still more than L away.
             u1 = u0 + self.bisect_step(l);
             if u1 < u_end {
@@ -200,7 +202,7 @@ impl Interpolator {
     fn bisect_step(&self, l: f64) -> f64 {
         let (u0, u_end) = (self.u, self.path.param_range().1);
         let p0 = self.cur.p;
-        let chord = |du: f64| v2::dist(self.path.point(u0 + du), p0);
+        let chord = |du: f64| geometry::dist(&self.path.point(u0 + du), &p0);
         let span = u_end - u0;
         if chord(span) <= l {
             return span;
@@ -231,6 +233,7 @@ impl Interpolator {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::Vector2;
     use crate::path::{builtin, Nurbs};
 
     /// Worst relative chord deviation over the whole run (last clamped sample excluded)
@@ -244,11 +247,11 @@ mod tests {
         loop {
             let s = it.step();
             if s.done {
-                let c = v2::dist(s.point, prev);
+                let c = geometry::dist(&s.point, &prev);
                 assert!(c <= l * 1.001, "final chord {c} longer than F·Ts");
                 break;
             }
-            worst = worst.max((v2::dist(s.point, prev) / l - 1.0).abs());
+            worst = worst.max((geometry::dist(&s.point, &prev) / l - 1.0).abs());
             prev = s.point;
             n += 1;
             assert!(n < 10_000_000);
@@ -295,7 +298,7 @@ mod tests {
             ts,
         )
         .unwrap();
-        assert_eq!(it.point(), [0.0, 0.0]);
+        assert_eq!(it.point(), Vector2::new(0.0, 0.0).into());
         for k in 1..2000 {
             let s = it.step();
             let t = k as f64 * ts;
@@ -318,8 +321,8 @@ mod tests {
         // Repeated first control points give |C'(0)| = 0 (and C''(0) = 0 for a triple).
         let n = Nurbs::new(
             3,
-            Nurbs::clamped_uniform_knots(6, 3),
-            vec![[0., 0.], [0., 0.], [0., 0.], [5., 5.], [10., 0.], [15., 5.]],
+            crate::path::nurbs::clamped_uniform_knots(6, 3),
+            vec![Vector2::new(0., 0.), Vector2::new(0., 0.), Vector2::new(0., 0.), Vector2::new(5., 5.), Vector2::new(10., 0.), Vector2::new(15., 5.)],
             None,
         )
         .unwrap();

@@ -1,8 +1,10 @@
-//! Two-axis reference paths (lines, arcs, NURBS), the built-in shapes and the feed-rate
-//! interpolator that samples them every `Ts` (docs/design.md §4.6). Units: mm, s.
+//! Reference paths (lines and NURBS in any dimension, planar arcs), the built-in shapes
+//! and the feed-rate interpolator that samples them every `Ts` (docs/design.md §4.6).
+//! Units: mm, s.
 //!
-//! Every geometric type implements [`Curve`], and [`Path`] is the closed set the FMUs
-//! choose from by name ([`builtin::by_name`]) or by file ([`file::load_nurbs`]).
+//! Every geometric type implements [`Curve`] in its dimension, and [`Path`] is the closed
+//! set of planar paths the two-axis FMUs choose from by name ([`builtin::by_name`]) or by
+//! file ([`file::load_nurbs`]).
 
 pub mod arc;
 pub mod builtin;
@@ -14,6 +16,8 @@ pub mod nurbs;
 use std::fmt;
 
 use serde::{Deserialize, Serialize};
+
+use crate::geometry::{self, Vector, Vector2};
 
 pub use arc::Arc;
 pub use interpolator::{Interpolator, Sample};
@@ -73,27 +77,37 @@ impl fmt::Display for PathError {
 impl std::error::Error for PathError {}
 
 /// Point and first two parameter derivatives of a curve at one parameter value.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct CurvePoint {
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CurvePoint<const D: usize = 2> {
     /// C(u), mm.
-    pub p: [f64; 2],
+    pub p: Vector<D>,
     /// C'(u), mm per unit parameter.
-    pub d1: [f64; 2],
+    pub d1: Vector<D>,
     /// C''(u).
-    pub d2: [f64; 2],
+    pub d2: Vector<D>,
 }
 
-/// A planar parametric curve on a closed parameter interval.
+impl<const D: usize> Default for CurvePoint<D> {
+    fn default() -> Self {
+        CurvePoint {
+            p: Vector::zeros(),
+            d1: Vector::zeros(),
+            d2: Vector::zeros(),
+        }
+    }
+}
+
+/// A parametric curve in `D` dimensions on a closed parameter interval.
 ///
 /// Evaluation never allocates and never panics: parameters outside the interval (and NaN)
 /// are clamped to it, so a corrupt caller cannot index out of bounds.
-pub trait Curve {
+pub trait Curve<const D: usize = 2> {
     /// Parameter interval `(u_start, u_end)`, `u_start < u_end`.
     fn param_range(&self) -> (f64, f64);
     /// Point and derivatives at `u`.
-    fn eval(&self, u: f64) -> CurvePoint;
+    fn eval(&self, u: f64) -> CurvePoint<D>;
     /// Point only (implementations may skip the derivative work).
-    fn point(&self, u: f64) -> [f64; 2] {
+    fn point(&self, u: f64) -> Vector<D> {
         self.eval(u).p
     }
     /// Arc length between two parameters (absolute, mm).
@@ -157,12 +171,12 @@ impl Path {
     }
 
     /// First point of the path.
-    pub fn start_point(&self) -> [f64; 2] {
+    pub fn start_point(&self) -> Vector2 {
         self.point(self.param_range().0)
     }
 
     /// Last point of the path.
-    pub fn end_point(&self) -> [f64; 2] {
+    pub fn end_point(&self) -> Vector2 {
         self.point(self.param_range().1)
     }
 
@@ -171,7 +185,7 @@ impl Path {
     /// mirrored run exactly (the contour error negated sample by sample), which is how the
     /// tests and the demo check that it does not depend on the direction of travel.
     pub fn mirrored(&self) -> Path {
-        let flip = |p: [f64; 2]| [p[0], -p[1]];
+        let flip = |p: Vector2| Vector2::new(p[0], -p[1]);
         let rebuilt = match self {
             Path::Line(l) => Line::new(flip(l.start()), flip(l.end())).map(Path::Line),
             Path::Arc(a) => {
@@ -205,7 +219,7 @@ impl Curve for Path {
             Path::Nurbs(c) => c.eval(u),
         }
     }
-    fn point(&self, u: f64) -> [f64; 2] {
+    fn point(&self, u: f64) -> Vector2 {
         match self {
             Path::Line(c) => c.point(u),
             Path::Arc(c) => c.point(u),
@@ -244,60 +258,17 @@ impl From<Nurbs> for Path {
     }
 }
 
-/// Small vector helpers shared by path and contour code.
-pub(crate) mod v2 {
-    #[inline]
-    pub fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-        [a[0] - b[0], a[1] - b[1]]
-    }
-    #[inline]
-    pub fn add(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-        [a[0] + b[0], a[1] + b[1]]
-    }
-    #[inline]
-    pub fn scale(a: [f64; 2], s: f64) -> [f64; 2] {
-        [a[0] * s, a[1] * s]
-    }
-    #[inline]
-    pub fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
-        a[0] * b[0] + a[1] * b[1]
-    }
-    /// z-component of the 2-D cross product; positive when `b` is left of `a`.
-    #[inline]
-    pub fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
-        a[0] * b[1] - a[1] * b[0]
-    }
-    #[inline]
-    pub fn norm(a: [f64; 2]) -> f64 {
-        a[0].hypot(a[1])
-    }
-    #[inline]
-    pub fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
-        norm(sub(a, b))
-    }
-    /// Squared distance: cheaper than `dist` (no hypot) where only comparisons matter.
-    #[inline]
-    pub fn dist2(a: [f64; 2], b: [f64; 2]) -> f64 {
-        let d = sub(a, b);
-        d[0] * d[0] + d[1] * d[1]
-    }
-    /// Left perpendicular (rotation by +90°).
-    #[inline]
-    pub fn perp(a: [f64; 2]) -> [f64; 2] {
-        [-a[1], a[0]]
-    }
-    #[inline]
-    pub fn finite(a: [f64; 2]) -> bool {
-        a[0].is_finite() && a[1].is_finite()
-    }
-}
-
 /// Arc length of a smooth piece by adaptive Gauss–Legendre quadrature of |C'(u)|.
 ///
 /// Compares a 5-point rule on the whole interval with the sum over its halves and splits
 /// until they agree to `tol` (absolute, mm); depth is bounded so the cost is bounded.
-pub(crate) fn gauss_length<C: Curve + ?Sized>(c: &C, a: f64, b: f64, tol: f64) -> f64 {
-    fn gl5<C: Curve + ?Sized>(c: &C, a: f64, b: f64) -> f64 {
+pub(crate) fn gauss_length<const D: usize, C: Curve<D> + ?Sized>(
+    c: &C,
+    a: f64,
+    b: f64,
+    tol: f64,
+) -> f64 {
+    fn gl5<const D: usize, C: Curve<D> + ?Sized>(c: &C, a: f64, b: f64) -> f64 {
         // Nodes and weights of the 5-point Gauss–Legendre rule on [-1, 1].
         const X: [f64; 5] = [
             0.0,
@@ -317,11 +288,18 @@ pub(crate) fn gauss_length<C: Curve + ?Sized>(c: &C, a: f64, b: f64, tol: f64) -
         let h = 0.5 * (b - a);
         let mut s = 0.0;
         for k in 0..5 {
-            s += W[k] * v2::norm(c.eval(m + h * X[k]).d1);
+            s += W[k] * geometry::norm(&c.eval(m + h * X[k]).d1);
         }
         s * h
     }
-    fn rec<C: Curve + ?Sized>(c: &C, a: f64, b: f64, whole: f64, tol: f64, depth: u32) -> f64 {
+    fn rec<const D: usize, C: Curve<D> + ?Sized>(
+        c: &C,
+        a: f64,
+        b: f64,
+        whole: f64,
+        tol: f64,
+        depth: u32,
+    ) -> f64 {
         let m = 0.5 * (a + b);
         let l = gl5(c, a, m);
         let r = gl5(c, m, b);

@@ -1,4 +1,4 @@
-//! Planar NURBS curve of any degree 1..=[`MAX_DEGREE`] with positive rational weights and a
+//! NURBS curve in any dimension, of any degree 1..=[`MAX_DEGREE`] with positive rational weights and a
 //! clamped knot vector, with first and second derivatives (docs/design.md §4.6).
 //!
 //! Evaluation builds the triangle of B-spline basis values of degrees 0..p on the knot
@@ -13,6 +13,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{clamp_param, gauss_length, Curve, CurvePoint, PathError};
+use crate::geometry::{self, Vector};
 
 /// Highest supported degree (bounds the stack scratch of the evaluator).
 pub const MAX_DEGREE: usize = 10;
@@ -23,38 +24,48 @@ const M: usize = MAX_DEGREE + 1;
 /// corrupt state blob or file can never produce a curve that panics when evaluated.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct NurbsData {
+pub struct NurbsData<const D: usize = 2> {
     /// Polynomial degree p.
     pub degree: usize,
     /// Clamped, nondecreasing knot vector of length n + p + 1 (n control points).
     pub knots: Vec<f64>,
-    /// Control points [x, y], mm.
-    pub control_points: Vec<[f64; 2]>,
+    /// Control points [x, y, …], mm.
+    pub control_points: Vec<Vector<D>>,
     /// Optional weights (all 1 when absent), each finite and > 0. Always serialised (no
     /// `skip_serializing_if`) so non-self-describing formats such as postcard round-trip.
     #[serde(default)]
     pub weights: Option<Vec<f64>>,
 }
 
+/// Clamped uniform knot vector on [0, 1] for `n` control points of degree `p`
+/// (p + 1 zeros, interior knots k/(n − p), p + 1 ones).
+pub fn clamped_uniform_knots(n: usize, p: usize) -> Vec<f64> {
+    let spans = n.saturating_sub(p).max(1);
+    let mut k = vec![0.0; p + 1];
+    k.extend((1..spans).map(|i| i as f64 / spans as f64));
+    k.extend(std::iter::repeat_n(1.0, p + 1));
+    k
+}
+
 /// A validated NURBS curve; the parameter runs over `[knots[0], knots[last]]`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "NurbsData", into = "NurbsData")]
-pub struct Nurbs {
+#[serde(try_from = "NurbsData<D>", into = "NurbsData<D>")]
+pub struct Nurbs<const D: usize = 2> {
     degree: usize,
     knots: Vec<f64>,
-    ctrl: Vec<[f64; 2]>,
+    ctrl: Vec<Vector<D>>,
     weights: Vec<f64>,
 }
 
-impl TryFrom<NurbsData> for Nurbs {
+impl<const D: usize> TryFrom<NurbsData<D>> for Nurbs<D> {
     type Error = PathError;
-    fn try_from(d: NurbsData) -> Result<Self, PathError> {
+    fn try_from(d: NurbsData<D>) -> Result<Self, PathError> {
         Nurbs::new(d.degree, d.knots, d.control_points, d.weights)
     }
 }
 
-impl From<Nurbs> for NurbsData {
-    fn from(n: Nurbs) -> Self {
+impl<const D: usize> From<Nurbs<D>> for NurbsData<D> {
+    fn from(n: Nurbs<D>) -> Self {
         let rational = n.weights.iter().any(|&w| w != 1.0);
         NurbsData {
             degree: n.degree,
@@ -65,7 +76,7 @@ impl From<Nurbs> for NurbsData {
     }
 }
 
-impl Nurbs {
+impl<const D: usize> Nurbs<D> {
     /// Validates and builds a curve. Requirements: 1 ≤ degree ≤ [`MAX_DEGREE`]; at least
     /// degree + 1 control points, all finite; knot count = control points + degree + 1;
     /// knots finite and nondecreasing, clamped (first and last degree + 1 knots equal),
@@ -74,9 +85,10 @@ impl Nurbs {
     pub fn new(
         degree: usize,
         knots: Vec<f64>,
-        control_points: Vec<[f64; 2]>,
+        control_points: Vec<impl Into<Vector<D>>>,
         weights: Option<Vec<f64>>,
     ) -> Result<Self, PathError> {
+        let control_points: Vec<Vector<D>> = control_points.into_iter().map(Into::into).collect();
         let p = degree;
         if p == 0 || p > MAX_DEGREE {
             return Err(PathError::invalid(format!(
@@ -90,10 +102,7 @@ impl Nurbs {
                 p + 1
             )));
         }
-        if let Some(i) = control_points
-            .iter()
-            .position(|c| !(c[0].is_finite() && c[1].is_finite()))
-        {
+        if let Some(i) = control_points.iter().position(|c| !geometry::is_finite(c)) {
             return Err(PathError::invalid(format!(
                 "control point {i} is not finite"
             )));
@@ -175,16 +184,6 @@ impl Nurbs {
         })
     }
 
-    /// Clamped uniform knot vector on [0, 1] for `n` control points of degree `p`
-    /// (p + 1 zeros, interior knots k/(n − p), p + 1 ones).
-    pub fn clamped_uniform_knots(n: usize, p: usize) -> Vec<f64> {
-        let spans = n.saturating_sub(p).max(1);
-        let mut k = vec![0.0; p + 1];
-        k.extend((1..spans).map(|i| i as f64 / spans as f64));
-        k.extend(std::iter::repeat_n(1.0, p + 1));
-        k
-    }
-
     /// Degree p.
     pub fn degree(&self) -> usize {
         self.degree
@@ -194,7 +193,7 @@ impl Nurbs {
         &self.knots
     }
     /// Control points.
-    pub fn control_points(&self) -> &[[f64; 2]] {
+    pub fn control_points(&self) -> &[Vector<D>] {
         &self.ctrl
     }
     /// Weights (all 1 for a non-rational curve).
@@ -282,12 +281,12 @@ impl Nurbs {
     }
 }
 
-impl Curve for Nurbs {
+impl<const D: usize> Curve<D> for Nurbs<D> {
     fn param_range(&self) -> (f64, f64) {
         (self.knots[0], self.knots[self.knots.len() - 1])
     }
 
-    fn eval(&self, u: f64) -> CurvePoint {
+    fn eval(&self, u: f64) -> CurvePoint<D> {
         let u = self.clamp(u);
         let p = self.degree;
         let s = self.span(u);
@@ -301,7 +300,7 @@ impl Curve for Nurbs {
             [0.0; M]
         };
         // Homogeneous sums and their derivatives.
-        let (mut a0, mut a1, mut a2) = ([0.0; 2], [0.0; 2], [0.0; 2]);
+        let (mut a0, mut a1, mut a2) = ([0.0; D], [0.0; D], [0.0; D]);
         let (mut w0, mut w1, mut w2) = (0.0, 0.0, 0.0);
         for j in 0..=p {
             let i = s + j - p;
@@ -311,14 +310,14 @@ impl Curve for Nurbs {
             w0 += b0;
             w1 += b1;
             w2 += b2;
-            for d in 0..2 {
+            for d in 0..D {
                 a0[d] += b0 * c[d];
                 a1[d] += b1 * c[d];
                 a2[d] += b2 * c[d];
             }
         }
         let mut out = CurvePoint::default();
-        for d in 0..2 {
+        for d in 0..D {
             let c0 = a0[d] / w0;
             let c1 = (a1[d] - w1 * c0) / w0;
             let c2 = (a2[d] - 2.0 * w1 * c1 - w2 * c0) / w0;
@@ -329,20 +328,21 @@ impl Curve for Nurbs {
         out
     }
 
-    fn point(&self, u: f64) -> [f64; 2] {
+    fn point(&self, u: f64) -> Vector<D> {
         let u = self.clamp(u);
         let p = self.degree;
         let s = self.span(u);
         let t = self.basis_triangle(s, u);
-        let (mut a, mut w) = ([0.0; 2], 0.0);
+        let (mut a, mut w) = ([0.0; D], 0.0);
         for (j, nj) in t[p].iter().enumerate().take(p + 1) {
             let i = s + j - p;
             let b = nj * self.weights[i];
             w += b;
-            a[0] += b * self.ctrl[i][0];
-            a[1] += b * self.ctrl[i][1];
+            for (ad, cd) in a.iter_mut().zip(self.ctrl[i].iter()) {
+                *ad += b * cd;
+            }
         }
-        [a[0] / w, a[1] / w]
+        Vector::from_fn(|d, _| a[d] / w)
     }
 
     fn length_between(&self, u0: f64, u1: f64) -> f64 {
@@ -376,6 +376,7 @@ impl Curve for Nurbs {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::Vector2;
 
     /// docs/design.md §4.6: exact unit circle, degree 2, 9 control points on a square.
     fn unit_circle() -> Nurbs {
@@ -437,20 +438,20 @@ mod tests {
         let c = Nurbs::new(
             1,
             vec![0., 0., 0.5, 1., 1.],
-            vec![[0., 0.], [2., 0.], [2., 2.]],
+            vec![Vector2::new(0., 0.), Vector2::new(2., 0.), Vector2::new(2., 2.)],
             None,
         )
         .unwrap();
-        assert_eq!(c.point(0.25), [1.0, 0.0]);
-        assert_eq!(c.eval(0.75).d1, [0.0, 4.0]);
-        assert_eq!(c.eval(0.75).d2, [0.0, 0.0]);
+        assert_eq!(c.point(0.25), Vector2::new(1.0, 0.0));
+        assert_eq!(c.eval(0.75).d1, Vector2::new(0.0, 4.0));
+        assert_eq!(c.eval(0.75).d2, Vector2::new(0.0, 0.0));
         assert!((c.length() - 4.0).abs() < 1e-12);
     }
 
     #[test]
     fn rejects_bad_input_with_clear_messages() {
-        let pts = vec![[0., 0.], [1., 1.], [2., 0.], [3., 1.]];
-        let ok = Nurbs::clamped_uniform_knots(4, 3);
+        let pts = vec![Vector2::new(0., 0.), Vector2::new(1., 1.), Vector2::new(2., 0.), Vector2::new(3., 1.)];
+        let ok = clamped_uniform_knots(4, 3);
         assert_eq!(ok, vec![0., 0., 0., 0., 1., 1., 1., 1.]);
         let err = |r: Result<Nurbs, PathError>| r.unwrap_err().to_string();
         assert!(err(Nurbs::new(3, vec![0.; 7], pts.clone(), None)).contains("knot count"));

@@ -1,7 +1,8 @@
-//! Test plants: the servo axis of docs/design.md §4.5 and the XY table built from two of them.
+//! Test plants: the servo axis of docs/design.md §4.5 (linear or rotary) and a machine's
+//! axes built from several of them (the XY table is two).
 
+pub mod servo_axes;
 pub mod servo_axis;
-pub mod xy_table;
 
-pub use servo_axis::{AxisParams, ServoAxis};
-pub use xy_table::{XyTable, XyTableParams};
+pub use servo_axes::{ServoAxes, ServoAxesParams, XyTable, XyTableParams};
+pub use servo_axis::{AxisParams, ServoAxis, Transmission};

@@ -1,20 +1,62 @@
-//! One feed axis of the test plant (docs/design.md §4.5): a servo drive whose PI loop closes on
-//! motor speed, a motor with inertia and viscous friction, and a ball screw.
+//! One axis of a test plant (docs/design.md §4.5): a servo drive whose PI loop closes on
+//! motor speed, a motor with inertia and viscous friction, and a transmission — a ball
+//! screw for a linear axis (position in mm) or a gearbox for a rotary one (rad).
 //!
-//! The drive takes a velocity command `v` (mm/s). In screw coordinates (x = θ·lead/2π)
-//! the three states are position x (mm), velocity ẋ (mm/s) and the PI integral z of the
-//! velocity error (mm), and the dynamics are linear:
+//! The drive takes a velocity command `v` (mm/s or rad/s). In axis coordinates (x = θ/k,
+//! with k = 2π/lead or the gear ratio the motor angle per axis unit) the three states
+//! are position x, velocity ẋ and the PI integral z of the velocity error, and the
+//! dynamics are linear:
 //!
 //! ```text
 //! ẍ = (CT·(Kvp·(v − ẋ) + Kvi·z) − B·ẋ) / J,    ż = v − ẋ
 //! ```
 //!
-//! (the lead cancels out of the dynamics; it only scales the motor current). The
+//! (k cancels out of the dynamics; it only scales the motor current, so a linear and a
+//! rotary axis with the same drive follow the same law in their own units). The
 //! command is held constant over a step (zero-order hold), so the exact discretisation
 //! by the matrix exponential makes the trajectory independent of the step size.
 
 use nalgebra::{Matrix3, Matrix4, Vector3};
 use serde::{Deserialize, Serialize};
+
+/// How motor revolutions become axis motion.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Transmission {
+    /// Ball screw: the axis position is in mm, `lead` mm per motor revolution.
+    Linear { lead: f64 },
+    /// Gearbox: the axis position is in rad, `ratio` motor revolutions per axis revolution.
+    Rotary { ratio: f64 },
+}
+
+impl Transmission {
+    /// Motor angle per axis unit: rad/mm (2π/lead) or rad/rad (the gear ratio).
+    pub fn motor_per_axis_unit(&self) -> f64 {
+        match *self {
+            Transmission::Linear { lead } => 2.0 * std::f64::consts::PI / lead,
+            Transmission::Rotary { ratio } => ratio,
+        }
+    }
+
+    /// The axis position's unit.
+    pub fn unit(&self) -> &'static str {
+        match self {
+            Transmission::Linear { .. } => "mm",
+            Transmission::Rotary { .. } => "rad",
+        }
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        let (name, value) = match *self {
+            Transmission::Linear { lead } => ("lead", lead),
+            Transmission::Rotary { ratio } => ("ratio", ratio),
+        };
+        if value.is_finite() && value > 0.0 {
+            Ok(())
+        } else {
+            Err(format!("{name} must be finite and > 0 (got {value})"))
+        }
+    }
+}
 
 /// Physical and drive parameters of one axis, SI-like units as the paper gives them.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -25,8 +67,8 @@ pub struct AxisParams {
     pub friction: f64,
     /// Motor torque constant, N·m/A.
     pub torque_constant: f64,
-    /// Ball-screw lead, mm per revolution.
-    pub lead: f64,
+    /// Ball screw (linear axis) or gearbox (rotary axis).
+    pub transmission: Transmission,
     /// Drive velocity-loop proportional gain, A·s/rad.
     pub kvp: f64,
     /// Drive velocity-loop integral gain, A/rad.
@@ -40,7 +82,7 @@ impl AxisParams {
         inertia: 0.015,
         friction: 1.2,
         torque_constant: 0.57,
-        lead: 10.0,
+        transmission: Transmission::Linear { lead: 10.0 },
         kvp: 8.26,
         kvi: 661.0,
     };
@@ -51,7 +93,6 @@ impl AxisParams {
         let positive = [
             ("inertia", self.inertia),
             ("torque_constant", self.torque_constant),
-            ("lead", self.lead),
         ];
         for (name, value) in positive {
             if !(value.is_finite() && value > 0.0) {
@@ -68,7 +109,7 @@ impl AxisParams {
                 return Err(format!("{name} must be finite and >= 0 (got {value})"));
             }
         }
-        Ok(())
+        self.transmission.validate()
     }
 
     /// Continuous-time system matrices (A, b) of the state (x, ẋ, z) with input v.
@@ -125,7 +166,7 @@ pub struct ServoAxis {
 }
 
 impl ServoAxis {
-    /// An axis at rest at `position` (mm).
+    /// An axis at rest at `position` (mm or rad).
     pub fn new(params: AxisParams, position: f64) -> Self {
         ServoAxis {
             params,
@@ -138,12 +179,12 @@ impl ServoAxis {
         &self.params
     }
 
-    /// Position, mm.
+    /// Position, mm or rad.
     pub fn position(&self) -> f64 {
         self.state[0]
     }
 
-    /// Velocity, mm/s.
+    /// Velocity, mm/s or rad/s.
     pub fn velocity(&self) -> f64 {
         self.state[1]
     }
@@ -151,11 +192,11 @@ impl ServoAxis {
     /// Motor current demanded by the drive, A.
     pub fn current(&self, command: f64) -> f64 {
         let p = &self.params;
-        let scale = 2.0 * std::f64::consts::PI / p.lead;
+        let scale = p.transmission.motor_per_axis_unit();
         scale * (p.kvp * (command - self.state[1]) + p.kvi * self.state[2])
     }
 
-    /// Advances by `step` seconds with the velocity command `command` (mm/s) held.
+    /// Advances by `step` seconds with the velocity command `command` (mm/s or rad/s) held.
     /// No heap allocation; the matrix exponential is only recomputed when the step
     /// length changes.
     pub fn step(&mut self, command: f64, step: f64) {

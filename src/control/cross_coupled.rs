@@ -1,0 +1,150 @@
+//! N-axis cross-coupled contour controller (docs/design.md §4.2) with optional fuzzy gain
+//! adaptation (docs/design.md §4.3).
+//!
+//! Per sample: following errors `e = R − P`; per-axis position controllers give velocity
+//! commands `G(e)` (mm/s); the contour estimator gives the contour error ε and the unit
+//! direction n along which ε·n points to the path (in the plane: ε signed, n the left
+//! normal). The fuzzy mode schedules (Kp, Ki, Kd) from ε and Δε every sample.
+//!
+//! In the plane the contour law runs on the scalar ε, `U_c = Kp·ε + Ki·Σε·Ts + Kd·Δε/Ts`,
+//! and `u = G(e) + n·U_c`: the normal space is one line that turns with the path, so the
+//! integral of ε is what holds a steady correction on a curve. In space the normal space
+//! is a plane (or more) in which the error vector can turn, and an integral of ε along
+//! whatever direction the error has now mixes up directions and chatters; there the law
+//! runs per axis on the error vector ε·n (same scheduled gains, one PID per axis), which
+//! holds any steady correction vector.
+//!
+//! Everything lives in fixed-size fields, so `sample` never allocates (it runs inside
+//! `fmi2DoStep`) and the whole controller serialises with serde for FMU state saving.
+
+use serde::{Deserialize, Serialize};
+use serde_big_array::BigArray;
+
+use super::ccc_law::{CccLaw, CccStep};
+use super::config::{CccMode, ConfigError, ControllerConfig};
+use super::pid::Pid;
+use crate::contour::{ContourEstimate, ContourEstimator};
+use crate::geometry::{self, Vector};
+
+/// What the controller produces each sample.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ControlOutput<const D: usize = 2> {
+    /// Velocity commands to the drives, in axis order, mm/s (rad/s for rotary axes).
+    pub u: Vector<D>,
+    /// Following errors R − P, mm.
+    pub following_error: Vector<D>,
+    /// The estimator's contour error and normal this sample.
+    pub contour: ContourEstimate<D>,
+    /// CCC gains (Kp, Ki, Kd) used this sample; all 0 when the CCC is off.
+    pub gains: (f64, f64, f64),
+}
+
+impl<const D: usize> Default for ControlOutput<D> {
+    fn default() -> Self {
+        ControlOutput {
+            u: Vector::zeros(),
+            following_error: Vector::zeros(),
+            contour: ContourEstimate::default(),
+            gains: (0.0, 0.0, 0.0),
+        }
+    }
+}
+
+/// Position control of `D` axes (two unless said otherwise) with cross-coupled contour
+/// correction, generic over the contour estimator. Serialisable (for FMU state) whenever
+/// the estimator is.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CrossCoupledController<E, const D: usize = 2> {
+    config: ControllerConfig<D>,
+    #[serde(with = "BigArray")]
+    axes: [Pid; D],
+    law: CccLaw,
+    /// The law per axis on the error vector, for D ≥ 3 (see the module docs).
+    #[serde(with = "BigArray")]
+    contour_axes: [Pid; D],
+    estimator: E,
+}
+
+impl<E: ContourEstimator<D>, const D: usize> CrossCoupledController<E, D> {
+    /// Validates `config` and builds the controller around `estimator`.
+    pub fn new(config: ControllerConfig<D>, estimator: E) -> Result<Self, ConfigError> {
+        config.validate()?;
+        Ok(Self {
+            axes: config
+                .axis
+                .map(|gains| Pid::new(gains, config.ts, config.axis_limit)),
+            law: CccLaw::new(config.ccc, config.ts)?,
+            contour_axes: [(); D].map(|_| Pid::new(config.ccc.gains0, config.ts, config.ccc.limit)),
+            estimator,
+            config,
+        })
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &ControllerConfig<D> {
+        &self.config
+    }
+
+    /// The contour estimator.
+    pub fn estimator(&self) -> &E {
+        &self.estimator
+    }
+
+    /// Mutable access to the contour estimator (e.g. to load a path).
+    pub fn estimator_mut(&mut self) -> &mut E {
+        &mut self.estimator
+    }
+
+    /// The contour law (state inspection).
+    pub fn law(&self) -> &CccLaw {
+        &self.law
+    }
+
+    /// The position controllers, in axis order (state inspection).
+    pub fn axes(&self) -> &[Pid; D] {
+        &self.axes
+    }
+
+    /// One control sample: `reference` is the command point R, `actual` the measured
+    /// point P (both mm). The estimator runs every sample, also with the CCC off, so its
+    /// history and the reported contour error stay valid.
+    pub fn sample(&mut self, reference: Vector<D>, actual: Vector<D>) -> ControlOutput<D> {
+        let following_error = reference - actual;
+        let axes = &mut self.axes;
+        let mut u = Vector::from_fn(|i, _| axes[i].update(following_error[i]));
+        let contour = self.estimator.estimate(reference, actual);
+        let n = contour.normal;
+        // A non-finite normal gets the same treatment as a non-finite error (see
+        // `CccLaw::update`): no correction, CCC state untouched.
+        let mut step = CccStep::default();
+        if geometry::is_finite(&n) {
+            step = self.law.update(contour.error);
+            if self.law.config().mode != CccMode::Off {
+                if D <= 2 {
+                    u += n * step.correction;
+                } else {
+                    let error = contour.vector();
+                    for (i, pid) in self.contour_axes.iter_mut().enumerate() {
+                        pid.set_gains(step.gains);
+                        u[i] += pid.update(error[i]);
+                    }
+                }
+            }
+        }
+        ControlOutput {
+            u,
+            following_error,
+            contour,
+            gains: step.gains.as_tuple(),
+        }
+    }
+
+    /// Back to the initial state: axis and contour integrators, previous errors and the
+    /// estimator's history are cleared; the configuration is kept.
+    pub fn reset(&mut self) {
+        self.axes.iter_mut().for_each(Pid::reset);
+        self.contour_axes.iter_mut().for_each(Pid::reset);
+        self.law.reset();
+        self.estimator.reset();
+    }
+}

@@ -1,0 +1,76 @@
+//! Names and descriptions that a constant table can build from pieces (`"axis."`, `"x"`,
+//! `".Kp"`): `const fn`s cannot concatenate strings, so a [`Text`] keeps up to three
+//! static parts and joins them when it is printed or compared.
+
+use std::fmt;
+
+/// Up to three static strings read as one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Text {
+    parts: [&'static str; 3],
+}
+
+impl Text {
+    /// One string.
+    pub const fn plain(text: &'static str) -> Self {
+        Text {
+            parts: [text, "", ""],
+        }
+    }
+
+    /// `a` followed by `b` and `c`.
+    pub const fn join(a: &'static str, b: &'static str, c: &'static str) -> Self {
+        Text { parts: [a, b, c] }
+    }
+
+    /// Length in bytes of the joined text.
+    pub fn len(&self) -> usize {
+        self.parts.iter().map(|p| p.len()).sum()
+    }
+
+    /// True when every part is empty.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+impl fmt::Display for Text {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.parts.iter().try_for_each(|p| f.write_str(p))
+    }
+}
+
+impl PartialEq<str> for Text {
+    fn eq(&self, other: &str) -> bool {
+        let mut rest = other;
+        for part in self.parts {
+            match rest.strip_prefix(part) {
+                Some(r) => rest = r,
+                None => return false,
+            }
+        }
+        rest.is_empty()
+    }
+}
+
+impl PartialEq<&str> for Text {
+    fn eq(&self, other: &&str) -> bool {
+        *self == **other
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn joins_and_compares_as_one_string() {
+        let t = Text::join("axis.", "x", ".Kp");
+        assert_eq!(t.to_string(), "axis.x.Kp");
+        assert_eq!(t, "axis.x.Kp");
+        assert_ne!(t, "axis.x.K");
+        assert_ne!(t, "axis.x.Kpp");
+        assert_eq!(t.len(), 9);
+        assert_eq!(Text::plain("Ts"), "Ts");
+    }
+}
