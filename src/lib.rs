@@ -5,9 +5,9 @@
 //! place that speaks the FMI C ABI.
 
 pub mod contour;
-pub mod geometry;
 pub mod control;
 pub mod fmi2;
+pub mod geometry;
 pub mod models;
 pub mod path;
 pub mod plant;

@@ -143,7 +143,10 @@ mod tests {
         // Centre (1, 2), r = 5, CCW quarter from angle 0 to π/2.
         let arc = Arc::new(Vector2::new(1.0, 2.0), 5.0, 0.0, PI / 2.0).unwrap();
         let mut e = ArcEstimator::new(&arc);
-        let r = e.estimate(Vector2::new(6.0, 2.0), Vector2::new(1.0 + 3.0 * 0.6 * 2.0, 2.0 + 3.0 * 0.8 * 2.0));
+        let r = e.estimate(
+            Vector2::new(6.0, 2.0),
+            Vector2::new(1.0 + 3.0 * 0.6 * 2.0, 2.0 + 3.0 * 0.8 * 2.0),
+        );
         // ‖P − O‖ = 6 → outside, right of CCW travel → +1; n points inward.
         assert!((r.error - 1.0).abs() < 1e-14);
         assert!((r.normal[0] + 0.6).abs() < 1e-15 && (r.normal[1] + 0.8).abs() < 1e-15);
@@ -181,7 +184,10 @@ mod tests {
         let c = |t: f64| Vector2::new(10.0 * t.cos(), 10.0 * t.sin());
         assert_eq!(e.estimate(c(0.0), Vector2::new(11.0, 0.0)).error, 0.0);
         e.estimate(c(0.01), Vector2::new(11.0, 0.0));
-        let r = e.estimate(c(0.02), Vector2::new(11.0 * 0.02f64.cos(), 11.0 * 0.02f64.sin()));
+        let r = e.estimate(
+            c(0.02),
+            Vector2::new(11.0 * 0.02f64.cos(), 11.0 * 0.02f64.sin()),
+        );
         assert!((r.error - 1.0).abs() < 1e-9, "{}", r.error);
     }
 }

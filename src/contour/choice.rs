@@ -155,6 +155,10 @@ mod tests {
         assert!((r.error - 5.0).abs() < 1e-14);
         assert_eq!(e.kind(), EstimatorKind::Line);
         let mut f = Estimator::for_path(EstimatorKind::FreeCurve, &line);
-        assert_eq!(f.estimate(Vector2::new(0.0, 0.0), Vector2::new(3.0, -4.0)).error, 0.0);
+        assert_eq!(
+            f.estimate(Vector2::new(0.0, 0.0), Vector2::new(3.0, -4.0))
+                .error,
+            0.0
+        );
     }
 }

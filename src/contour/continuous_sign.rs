@@ -65,16 +65,28 @@ mod tests {
     fn crossing_the_path_changes_the_sign_not_the_direction() {
         let mut sign = ContinuousSign::<3>::default();
         let up = Vector::<3>::new(0.0, 0.0, 1.0);
-        let first = sign.orient(ContourEstimate { error: 2.0, normal: up });
+        let first = sign.orient(ContourEstimate {
+            error: 2.0,
+            normal: up,
+        });
         assert_eq!((first.error, first.normal), (2.0, up));
-        let on = sign.orient(ContourEstimate { error: 0.0, normal: Vector::zeros() });
+        let on = sign.orient(ContourEstimate {
+            error: 0.0,
+            normal: Vector::zeros(),
+        });
         assert_eq!((on.error, on.normal), (0.0, up));
         // Past the path the direction toward it is −up: reported as −1 along +up.
-        let past = sign.orient(ContourEstimate { error: 1.0, normal: -up });
+        let past = sign.orient(ContourEstimate {
+            error: 1.0,
+            normal: -up,
+        });
         assert_eq!((past.error, past.normal), (-1.0, up));
         assert_eq!(past.vector(), -up);
         sign.reset();
-        let fresh = sign.orient(ContourEstimate { error: 1.0, normal: -up });
+        let fresh = sign.orient(ContourEstimate {
+            error: 1.0,
+            normal: -up,
+        });
         assert_eq!((fresh.error, fresh.normal), (1.0, -up));
     }
 }

@@ -241,10 +241,17 @@ mod tests {
     #[test]
     fn collinear_and_held_reference() {
         let mut e = FreeCurveEstimator::new(8);
-        assert_eq!(e.estimate(Vector2::new(0.0, 0.0), Vector2::new(0.0, 0.0)).error, 0.0);
+        assert_eq!(
+            e.estimate(Vector2::new(0.0, 0.0), Vector2::new(0.0, 0.0))
+                .error,
+            0.0
+        );
         for i in 1..20 {
             let x = i as f64 * 0.1;
-            let r = e.estimate(Vector2::new(x, 2.0 * x), Vector2::new(x - 0.2 + 0.002, 2.0 * x - 0.4 - 0.001));
+            let r = e.estimate(
+                Vector2::new(x, 2.0 * x),
+                Vector2::new(x - 0.2 + 0.002, 2.0 * x - 0.4 - 0.001),
+            );
             // Offset (0.002, −0.001) is √5·0.001 right of the direction (1, 2)/√5.
             assert!((r.error - 5f64.sqrt() * 1e-3).abs() < 1e-14, "{}", r.error);
         }

@@ -123,7 +123,8 @@ mod tests {
         assert!((r.error + 1.0).abs() < 1e-14);
         // The formula of docs/design.md §4.1 with following errors ex = xr − xp, ey = yr − yp.
         let (th, rr, p) = (0.3f64, Vector2::new(2.0, 1.0), Vector2::new(2.5, 0.2));
-        let mut f = LineEstimator::from_angle(Vector2::new(2.0 - 3.0 * th.cos(), 1.0 - 3.0 * th.sin()), th);
+        let mut f =
+            LineEstimator::from_angle(Vector2::new(2.0 - 3.0 * th.cos(), 1.0 - 3.0 * th.sin()), th);
         let (ex, ey) = (rr[0] - p[0], rr[1] - p[1]);
         let koren = -ex * th.sin() + ey * th.cos();
         assert!((f.estimate(rr, p).error - koren).abs() < 1e-14);
@@ -143,6 +144,10 @@ mod tests {
         let r = e.estimate(Vector2::new(-0.1, 0.0), Vector2::new(-0.2, 0.5));
         assert!((r.error - 0.5).abs() < 1e-15);
         e.reset();
-        assert_eq!(e.estimate(Vector2::new(0.0, 0.0), Vector2::new(0.0, -1.0)).error, 0.0);
+        assert_eq!(
+            e.estimate(Vector2::new(0.0, 0.0), Vector2::new(0.0, -1.0))
+                .error,
+            0.0
+        );
     }
 }

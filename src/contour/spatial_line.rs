@@ -73,10 +73,19 @@ mod tests {
         let line = Line::new([1.0, 2.0], [4.0, 6.0]).unwrap();
         let mut spatial = SpatialLineEstimator::new(&line);
         let mut planar = crate::contour::LineEstimator::new(&line);
-        let points = [[3.0, -1.0], [2.0, 3.5], [-2.0, 5.0], [10.0, 10.5], [0.5, 1.0]];
+        let points = [
+            [3.0, -1.0],
+            [2.0, 3.5],
+            [-2.0, 5.0],
+            [10.0, 10.5],
+            [0.5, 1.0],
+        ];
         let mut sign = None;
         for p in points {
-            let (s, q) = (spatial.estimate(p.into(), p.into()), planar.estimate(p.into(), p.into()));
+            let (s, q) = (
+                spatial.estimate(p.into(), p.into()),
+                planar.estimate(p.into(), p.into()),
+            );
             let k = *sign.get_or_insert(s.error / q.error);
             assert!((k.abs() - 1.0).abs() < 1e-12);
             assert!((s.error - k * q.error).abs() < 1e-12);

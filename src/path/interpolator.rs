@@ -322,7 +322,14 @@ mod tests {
         let n = Nurbs::new(
             3,
             crate::path::nurbs::clamped_uniform_knots(6, 3),
-            vec![Vector2::new(0., 0.), Vector2::new(0., 0.), Vector2::new(0., 0.), Vector2::new(5., 5.), Vector2::new(10., 0.), Vector2::new(15., 5.)],
+            vec![
+                Vector2::new(0., 0.),
+                Vector2::new(0., 0.),
+                Vector2::new(0., 0.),
+                Vector2::new(5., 5.),
+                Vector2::new(10., 0.),
+                Vector2::new(15., 5.),
+            ],
             None,
         )
         .unwrap();

@@ -96,6 +96,9 @@ mod tests {
     fn works_in_three_dimensions() {
         let l = Line::<3>::new([0.0, 0.0, 0.0], [2.0, 3.0, 6.0]).unwrap();
         assert_eq!(l.length(), 7.0);
-        assert_eq!(l.point(0.5), crate::geometry::Vector::<3>::new(1.0, 1.5, 3.0));
+        assert_eq!(
+            l.point(0.5),
+            crate::geometry::Vector::<3>::new(1.0, 1.5, 3.0)
+        );
     }
 }

@@ -438,7 +438,11 @@ mod tests {
         let c = Nurbs::new(
             1,
             vec![0., 0., 0.5, 1., 1.],
-            vec![Vector2::new(0., 0.), Vector2::new(2., 0.), Vector2::new(2., 2.)],
+            vec![
+                Vector2::new(0., 0.),
+                Vector2::new(2., 0.),
+                Vector2::new(2., 2.),
+            ],
             None,
         )
         .unwrap();
@@ -450,7 +454,12 @@ mod tests {
 
     #[test]
     fn rejects_bad_input_with_clear_messages() {
-        let pts = vec![Vector2::new(0., 0.), Vector2::new(1., 1.), Vector2::new(2., 0.), Vector2::new(3., 1.)];
+        let pts = vec![
+            Vector2::new(0., 0.),
+            Vector2::new(1., 1.),
+            Vector2::new(2., 0.),
+            Vector2::new(3., 1.),
+        ];
         let ok = clamped_uniform_knots(4, 3);
         assert_eq!(ok, vec![0., 0., 0., 0., 1., 1., 1., 1.]);
         let err = |r: Result<Nurbs, PathError>| r.unwrap_err().to_string();
