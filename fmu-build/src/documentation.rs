@@ -49,27 +49,27 @@ pub fn render(model: &ModelInfo) -> String {
         writeln!(
             rows,
             "<tr><td><code>{}</code></td><td>{}</td><td>{kind}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            escape(v.name),
+            escape(&v.name.to_string()),
             v.vr,
             escape(&type_name),
             escape(&start),
             escape(v.unit.unwrap_or("")),
             escape(&range),
-            escape(v.description),
+            escape(&v.description.to_string()),
         )
         .unwrap();
     }
-    let inputs: Vec<&str> = model
+    let inputs: Vec<String> = model
         .variables
         .iter()
         .filter(|v| v.causality == Causality::Input)
-        .map(|v| v.name)
+        .map(|v| v.name.to_string())
         .collect();
-    let outputs: Vec<&str> = model
+    let outputs: Vec<String> = model
         .variables
         .iter()
         .filter(|v| v.causality == Causality::Output)
-        .map(|v| v.name)
+        .map(|v| v.name.to_string())
         .collect();
     let e = model.default_experiment;
     format!(

@@ -189,9 +189,9 @@ pub fn render(model: &ModelInfo) -> String {
         writeln!(
             w,
             "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"{}\" causality=\"{}\" variability=\"{}\"{initial}>",
-            escape(v.name),
+            escape(&v.name.to_string()),
             v.vr,
-            escape(v.description),
+            escape(&v.description.to_string()),
             v.causality.name(),
             v.variability.name(),
         )

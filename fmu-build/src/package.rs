@@ -67,7 +67,7 @@ impl Resource {
             })?
             .to_string();
         if model == PATH_MODEL && name.to_ascii_lowercase().ends_with(".json") {
-            contour_fmu::path::file::load_nurbs(&source)
+            contour_fmu::path::file::load_nurbs::<2>(&source)
                 .map_err(|e| format!("--resource {model}={}: {e}", source.display()))?;
         }
         Ok(Resource {
