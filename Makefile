@@ -1,17 +1,48 @@
 # The two commands of the README, and what they need on a fresh machine.
-#   make demo   build the FMUs and run the closed-loop demo
-#   make test   run every test (Rust unit/ABI tests, fmpy/libcosim and reference tests)
+#   make demo   build the FMUs and the tuner, run the closed-loop demo; needs only cargo and
+#               python3 (no root): the venv gets the run set and the contour_fmu package
+#   make test   lint, then every test (Rust unit/ABI tests, fmpy/libcosim/ecos and reference
+#               tests); installs libclang-dev and libtbb12 through apt when they are missing
+#               (root), the venv gets the test set and the package
+# Other targets: fmus, ccc-tune, bindings, lint, bench, pso-claim, setup.
 
 VENV   := .venv
 PYTHON := $(VENV)/bin/python
+PIP    := $(PYTHON) -m pip install --quiet --disable-pip-version-check
 CARGO  ?= cargo
 
-.PHONY: demo test fmus setup libclang libtbb lint bench pso-claim
+.PHONY: demo test fmus ccc-tune bindings lint bench pso-claim setup libclang libtbb
 
-setup: libclang libtbb $(VENV)/.installed
+# --- demo: cargo and python3 only ---------------------------------------------------------
 
-# fmi-sys generates its FMI bindings with bindgen, which needs libclang (the C API in
-# libclang-dev; Debian images often carry only libclang-cpp, which bindgen cannot use).
+demo: fmus ccc-tune $(VENV)/.run-installed
+	MPLBACKEND=Agg $(PYTHON) -m contour_fmu.demo --tune
+
+fmus:
+	$(CARGO) run --release -p fmu-build
+
+ccc-tune:
+	$(CARGO) build --release -p contour-tune --bin ccc-tune
+
+# --- the Python venv ----------------------------------------------------------------------
+# The package is installed in editable mode: python/contour_fmu is what runs. The test set
+# includes the run set (requirements/test.txt starts with -r run.txt).
+
+$(PYTHON):
+	python3 -m venv $(VENV)
+
+$(VENV)/.run-installed: requirements/run.txt python/pyproject.toml | $(PYTHON)
+	$(PIP) -r requirements/run.txt -e ./python
+	touch $@
+
+$(VENV)/.test-installed: requirements/test.txt requirements/run.txt python/pyproject.toml | $(PYTHON)
+	$(PIP) -r requirements/test.txt -e './python[test]'
+	touch $@ $(VENV)/.run-installed
+
+# --- test: may use root (apt) -------------------------------------------------------------
+
+# bindgen needs libclang (the C API in libclang-dev; Debian images often carry only
+# libclang-cpp, which bindgen cannot use): for the FMI-bindings regeneration (xtask).
 libclang:
 	@if ! dpkg -s libclang-dev >/dev/null 2>&1; then \
 		echo "installing libclang-dev (needed by bindgen)"; \
@@ -26,19 +57,10 @@ libtbb:
 		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libtbb12; \
 	fi
 
-$(VENV)/.installed: requirements.txt
-	python3 -m venv $(VENV)
-	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r requirements.txt
-	touch $@
+# Everything `make test` installs.
+setup: libclang libtbb $(VENV)/.test-installed
 
-fmus: setup
-	$(CARGO) run --release -p fmu-build
-
-demo: fmus
-	$(CARGO) build --release --bin ccc-tune
-	MPLBACKEND=Agg $(PYTHON) tests/fmpy/demo.py --tune
-
-lint: setup
+lint: libclang
 	$(CARGO) fmt --all -- --check
 	$(CARGO) clippy --workspace --all-targets --features contour-fmu/test-hooks -- -D warnings
 
@@ -46,13 +68,19 @@ test: setup lint
 	$(CARGO) test --workspace --features contour-fmu/test-hooks
 	$(PYTHON) -m pytest -q tests/fmpy tests/reference
 
-bench: setup
+# Regenerates src/fmi2/bindings.rs from the FMI 2.0 headers.
+bindings: libclang
+	$(CARGO) run -p xtask -- bindings
+
+# --- measurements -------------------------------------------------------------------------
+
+bench: fmus ccc-tune $(VENV)/.test-installed
 	$(CARGO) bench --bench fuzzy --bench controller
-	$(CARGO) build --release --bin ccc-tune --example fuzzy_timing
+	$(CARGO) build --release -p contour-fmu --example fuzzy_timing
 	$(PYTHON) benches/fuzzy_vs_skfuzzy.py
 	$(PYTHON) benches/tuning_vs_pyswarms_fmu.py
 	$(PYTHON) benches/pso_tables.py
 
 # The paper's PSO claim at its full budget (about 10 minutes).
-pso-claim: setup
-	$(CARGO) run --release --example pso_claim
+pso-claim:
+	$(CARGO) run --release -p contour-tune --example pso_claim

@@ -18,6 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
+from contour_fmu.repo import cargo_package
+
 REPO = Path(__file__).resolve().parents[1]
 SEEDS, SWARM, ITERATIONS = 20, 30, 200
 BOUNDS = {"sphere": 5.12, "rosenbrock": 5.0, "rastrigin": 5.12}
@@ -29,8 +31,9 @@ FUNCTIONS = {
 
 
 def example(name, *args):
-    done = subprocess.run(["cargo", "run", "--quiet", "--release", "--example", name, "--", *map(str, args)],
-                          cwd=REPO, check=True, capture_output=True, text=True)
+    package = cargo_package(name, "example", REPO)  # the PSO examples live in the tuner's crate
+    done = subprocess.run(["cargo", "run", "--quiet", "--release", "-p", package, "--example", name, "--",
+                           *map(str, args)], cwd=REPO, check=True, capture_output=True, text=True)
     return json.loads(done.stdout)
 
 

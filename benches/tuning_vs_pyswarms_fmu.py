@@ -4,7 +4,7 @@
 objective (mean |true contour error|), timed on a reduced budget and scaled up to the
 same 5000 evaluations. Prints both wall times and their ratio (target >= 100).
 
-Run from the repository root after `make fmus` and `cargo build --release --bin ccc-tune`:
+Run from the repository root after `make fmus` and building ccc-tune (`make bench` does both):
     .venv/bin/python benches/tuning_vs_pyswarms_fmu.py [--particles 4] [--iters 2]
 """
 
@@ -12,17 +12,16 @@ import argparse
 import logging
 import os
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
+from contour_fmu.master import closed_loop
+from contour_fmu.reference_paths import ContourReference
+
 REPO = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(REPO / "tests" / "fmpy"))
-from master import closed_loop  # noqa: E402
-from reference_paths import ContourReference  # noqa: E402
 
 # The default search box of ccc-tune (src/tuning/objective.rs, docs/design.md §4.4).
 SWARM, ITERATIONS, LOWER, UPPER = 50, 100, [0.0] * 5, [10.0, 10.0, 340.0, 6800.0, 3.8]

@@ -12,11 +12,15 @@ from pathlib import Path
 
 import pytest
 
+from contour_fmu.repo import cargo_package
+
 REPO = Path(__file__).resolve().parents[1]
 
 
 def _cargo_example(name, *args):
-    cmd = ["cargo", "run", "--quiet", "--release", "--example", name, "--", *map(str, args)]
+    # -p: the example may live in any crate of the workspace (the PSO examples in the tuner's).
+    package = cargo_package(name, "example", REPO)
+    cmd = ["cargo", "run", "--quiet", "--release", "-p", package, "--example", name, "--", *map(str, args)]
     done = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, env=os.environ.copy())
     if done.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed:\n{done.stderr}")
@@ -25,7 +29,7 @@ def _cargo_example(name, *args):
 
 @pytest.fixture(scope="session")
 def rust_json():
-    """Run `cargo run --example NAME -- ARGS` and parse its standard output as JSON."""
+    """Run `cargo run -p PACKAGE --example NAME -- ARGS` and parse its standard output as JSON."""
 
     def run(name, *args):
         return json.loads(_cargo_example(name, *args))

@@ -1,6 +1,6 @@
 """Issue 4: the closed loop PathInterpolator2D -> ContourCCC2D <- XYServoPlant packed into
 ONE FMU with fmpy's container (fmpy.container_fmu), simulated with fmpy.simulate_fmu and
-compared with the Python master (master.py) on the same three FMUs.
+compared with the Python master (contour_fmu.master) on the same three FMUs.
 
 Coupling scheme of fmpy's container: JACOBI (parallel), not Gauss-Seidel.
 How it was established:
@@ -29,17 +29,15 @@ import json
 import shutil
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
-from container_build import COMPONENTS, build_container
-from master import closed_loop
+from contour_fmu.container_build import COMPONENTS, build_container
+from contour_fmu.master import closed_loop
 
-HERE = Path(__file__).resolve().parent
 STEP, STOP = 1e-3, 2.0
 N = int(round(STOP / STEP))
 TOL = 1e-9  # mm
@@ -142,11 +140,10 @@ def test_container_contour_error_with_and_without_ccc(container):
 
 
 PARALLEL_RUN = """
-import json, sys
-sys.path.insert(0, {here!r})
+import json
 import numpy as np
 from fmpy import simulate_fmu
-from container_build import build_container
+from contour_fmu.container_build import build_container
 fmu = build_container({fmus!r}, {work!r}, parallel_do_step=True)
 r = simulate_fmu(str(fmu), stop_time={stop!r}, output_interval={step!r})
 print(json.dumps({{c: r[c].tolist() for c in ("plant.pos.x", "plant.pos.y")}}))
@@ -157,7 +154,7 @@ def test_container_parallel_do_step(container, fmus, tmp_path):
     """parallelDoStep=true would step the components on a thread pool: still Jacobi, so the
     same trajectory. fmpy 0.3.32's runtime aborts instead (a Rust panic, "not yet
     implemented", in fmi2DoStep), hence the subprocess and the xfail."""
-    code = PARALLEL_RUN.format(here=str(HERE), fmus=str(fmus), work=str(tmp_path), stop=STOP, step=STEP)
+    code = PARALLEL_RUN.format(fmus=str(fmus), work=str(tmp_path), stop=STOP, step=STEP)
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     if done.returncode != 0:
         if "not yet implemented" in done.stderr:

@@ -1,9 +1,10 @@
 """Issue 4: the closed loop PathInterpolator2D -> ContourCCC2D <- XYServoPlant in libcosim
 (libcosimpy: three CosimLocalSlave, six connect_real_variables, 1 ms fixed step), run in a
-subprocess (cosim_closed_loop.py) and compared with master.closed_loop(scheme="jacobi").
+subprocess (contour_fmu.cosim_closed_loop) and compared with
+contour_fmu.master.closed_loop(scheme="jacobi").
 
 libcosim's fixed-step algorithm steps all slaves from t_k on the inputs they hold and then
-transfers outputs to inputs at the step boundary t_k+1: the Jacobi scheme of master.py.
+transfers outputs to inputs at the step boundary t_k+1: the Jacobi scheme of the master.
 Time alignment: libcosim counts integer nanoseconds; its time-series observer samples after
 each step, sample n (step number n, n = 1..N) at n * 1_000_000 ns being the state at t_n,
 which is master's after[n - 1].
@@ -12,21 +13,19 @@ Agreement is not bit for bit (about 4e-14 mm on the positions): libcosim calls d
 t_k = k * 1e6 / 1e9 and h = t_k+1 - t_k, time points converted from integer ns, so h differs
 from 1e-3 in its last bits at some steps, and the plant's exact discretisation depends on h.
 Replaying the Jacobi loop with those t_k and h reproduces libcosim exactly (checked by hand;
-master.py always passes k * step and step)."""
+the master always passes k * step and step)."""
 
 import json
 import math
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from master import closed_loop
-from reference_paths import paper_circle_distance as circle_error
+from contour_fmu.master import closed_loop
+from contour_fmu.reference_paths import paper_circle_distance as circle_error
 
-HERE = Path(__file__).resolve().parent
 STEP_NS, STEPS = 1_000_000, 2000  # 1 ms for 2 s
 STEP, STOP = STEP_NS * 1e-9, STEPS * STEP_NS * 1e-9
 POSITIONS = ("plant.pos.x", "plant.pos.y")
@@ -35,7 +34,7 @@ TOL = 1e-6  # mm
 
 def run_libcosim(fmus, assignments=()):
     done = subprocess.run(
-        [sys.executable, str(HERE / "cosim_closed_loop.py"), str(fmus), str(STEP_NS), str(STEPS),
+        [sys.executable, "-m", "contour_fmu.cosim_closed_loop", str(fmus), str(STEP_NS), str(STEPS),
          *assignments],
         capture_output=True, text=True, timeout=120,
     )

@@ -10,8 +10,8 @@ import math
 import numpy as np
 import pytest
 
-import demo
-from master import closed_loop
+from contour_fmu import demo
+from contour_fmu.master import closed_loop
 
 LARGE_KP = {"fuzzy.ke": 3.0, "fuzzy.kde": 0.5, "fuzzy.kp": 300.0, "fuzzy.ki": 0.0, "fuzzy.kd": 3.0}
 CONTROLLERS = {"paper factors": {}, "large kp": LARGE_KP, "no CCC": {"ccc.enable": False}}

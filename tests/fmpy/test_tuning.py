@@ -7,17 +7,18 @@ import subprocess
 import numpy as np
 import pytest
 
-import demo
-from conftest import REPO
-from tuned import start_values
+from contour_fmu import demo, repo
+from contour_fmu.tuned import start_values
+from conftest import REPO, target_dir
 
 PAPER = {"fuzzy.ke": 1.0, "fuzzy.kde": 1.2, "fuzzy.kp": 87.0, "fuzzy.ki": 8.5, "fuzzy.kd": 4.0}
 
 
 @pytest.fixture(scope="session")
 def ccc_tune():
-    subprocess.run(["cargo", "build", "--quiet", "--release", "--bin", "ccc-tune"], cwd=REPO, check=True)
-    from conftest import target_dir
+    package = repo.cargo_package("ccc-tune", "bin", REPO)
+    subprocess.run(["cargo", "build", "--quiet", "--release", "-p", package, "--bin", "ccc-tune"],
+                   cwd=REPO, check=True)
     return str(target_dir() / "release" / "ccc-tune")
 
 

@@ -14,10 +14,10 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
-import demo
+from contour_fmu import demo
+from contour_fmu.master import closed_loop
+from contour_fmu.reference_paths import ContourReference
 from fmu_log import CapturedLog
-from master import closed_loop
-from reference_paths import ContourReference
 
 CONTROLLER_OUTPUTS = ["u.x", "u.y", "contourError", "err.x", "err.y", "ccc.Kp", "ccc.Ki", "ccc.Kd"]
 

@@ -1,10 +1,10 @@
 """The Rust NURBS evaluator (point, first and second derivative) against geomdl.
 
-The built-in curves are rebuilt here from the control points listed in docs/design.md §4.6 (not from
-the Rust output), so the test also checks the Rust data entry. Rational evaluation is
-checked on the exact 9-point unit circle and on a random degree-4 NURBS with random
-weights and a non-uniform knot vector, written to a JSON file and loaded by the Rust file
-loader.
+The built-in curves are rebuilt from the control points listed in docs/design.md §4.6
+(contour_fmu.reference_paths, not from the Rust output), so the test also checks the Rust
+data entry. Rational evaluation is checked on the exact 9-point unit circle and on a random
+degree-4 NURBS with random weights and a non-uniform knot vector, written to a JSON file and
+loaded by the Rust file loader.
 """
 
 import json
@@ -13,19 +13,9 @@ import random
 
 import numpy as np
 import pytest
-from geomdl import NURBS
 
-INFINITY = [
-    (0, 0), (4.5, 4.5), (18.1, 21.5), (41.5, 19.0), (42.1, -19.4), (17.2, -20.1), (0, 0),
-    (-17.2, 20.1), (-42.1, 19.4), (-41.5, -19.0), (-18.1, -21.5), (-4.5, -4.5), (0, 0),
-]
-TRIDENT = [
-    (40.2, -0.1), (39.2, 4.5), (30.9, 7.7), (19.0, 7.5), (7.0, 3.7), (-3.5, -1.3),
-    (-13.4, -10.5), (-19.9, -17.8), (-25.5, -34.2), (-11.3, -36.1), (-4.8, -22.6),
-    (-0.7, -12.6), (0.3, 0), (-0.7, 12.6), (-4.8, 22.6), (-11.3, 36.1), (-25.5, 34.2),
-    (-19.9, 17.8), (-13.4, 10.5), (-3.5, 1.3), (7.0, -3.7), (19.0, -7.5), (30.9, -7.7),
-    (39.2, -4.5), (40.2, 0.1),
-]
+from contour_fmu.reference_paths import INFINITY, TRIDENT, clamped_uniform, geomdl_curve
+
 S = math.sqrt(2) / 2
 UNIT_CIRCLE = dict(
     degree=2,
@@ -33,20 +23,6 @@ UNIT_CIRCLE = dict(
     control_points=[(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1), (1, 0)],
     weights=[1, S, 1, S, 1, S, 1, S, 1],
 )
-
-
-def clamped_uniform(n, p):
-    spans = n - p
-    return [0.0] * (p + 1) + [k / spans for k in range(1, spans)] + [1.0] * (p + 1)
-
-
-def geomdl_curve(degree, knots, ctrl, weights=None):
-    c = NURBS.Curve()
-    c.degree = degree
-    c.ctrlpts = [list(map(float, p)) for p in ctrl]
-    c.weights = [1.0] * len(ctrl) if weights is None else [float(w) for w in weights]
-    c.knotvector = list(knots)
-    return c
 
 
 def compare(rust, curve, tol=1e-10):

@@ -4,14 +4,13 @@ contour_loop.py (scipy), and is not needlessly tighter than that."""
 
 import json
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 from fmpy import read_model_description
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from contour_loop import critical  # noqa: E402
+from contour_fmu.repo import cargo_package
+from contour_loop import critical
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -24,7 +23,8 @@ LARGEST_INCREMENT = {"kp": 8 / 3, "ki": 2.0, "kd": 1.0}
 @pytest.fixture(scope="module")
 def box(tmp_path_factory):
     out = tmp_path_factory.mktemp("box") / "box.json"
-    subprocess.run(["cargo", "run", "--quiet", "--release", "--bin", "ccc-tune", "--",
+    package = cargo_package("ccc-tune", "bin", REPO)
+    subprocess.run(["cargo", "run", "--quiet", "--release", "-p", package, "--bin", "ccc-tune", "--",
                     "--swarm", "1", "--iters", "1", "--out", str(out)],
                    cwd=REPO, check=True, capture_output=True)
     settings = json.loads(out.read_text())["settings"]

@@ -3,13 +3,13 @@ ecospy package) and prints the trajectories as one line of JSON.
 
 Kept in its own process: ecos is native code that can take the interpreter down on a broken
 FMU, and it loads its own copy of each FMU.
-usage: python ecos_closed_loop.py FMU_DIR STEP STEPS [UNIT.VARIABLE=VALUE ...]
+usage: python -m contour_fmu.ecos_closed_loop FMU_DIR STEP STEPS [UNIT.VARIABLE=VALUE ...]
 
 Values are typed by their text: true/false -> Boolean, an integer -> Integer, a number ->
 Real, anything else -> String (ecospy picks the setter from the Python type). They go into
 an ecos parameter set applied in initialization mode; this is also how the plant's pos0.*
 get the path's start point (ecos connections are transferred at every step, so they cannot
-carry an output onto a fixed parameter once, as master.py's PATH_START does).
+carry an output onto a fixed parameter once, as contour_fmu.master's PATH_START does).
 
 The printed object holds
 - "initial": {"unit.variable": value} after ecos' init() (outputs at t_0);
@@ -24,9 +24,9 @@ from pathlib import Path
 
 from ecospy import EcosLib, EcosSimulation, EcosSimulationStructure, SimulationListener
 
-from wiring import CLOSED_LOOP_CONNECTIONS
+from .wiring import CLOSED_LOOP_CONNECTIONS
 
-UNITS = {  # instance name -> FMU file, in master.closed_loop's order
+UNITS = {  # instance name -> FMU file, in contour_fmu.master.closed_loop's order
     "controller": "ContourCCC2D.fmu",
     "plant": "XYServoPlant.fmu",
     "interpolator": "PathInterpolator2D.fmu",

@@ -29,7 +29,7 @@ from fmpy.container_fmu.config import Component, Connection
 from fmpy.model_description import (CoSimulation, DefaultExperiment, ModelDescription,
                                     ModelVariable, Unknown)
 
-from wiring import CLOSED_LOOP_CONNECTIONS
+from .wiring import CLOSED_LOOP_CONNECTIONS
 
 _FMI3_TYPES = {"Real": "Float64", "Integer": "Int32", "Enumeration": "Int32"}
 
@@ -110,7 +110,7 @@ def build_container(fmu_dir, workdir, step=1e-3, stop=2.0, order=tuple(COMPONENT
         modelName="ContourLoop",
         instantiationToken="{" + str(uuid.uuid4()) + "}",
         description="PathInterpolator2D -> ContourCCC2D <- XYServoPlant in an fmpy container",
-        generationTool="tests/fmpy/container_build.py (fmpy.container_fmu)",
+        generationTool="contour_fmu.container_build (fmpy.container_fmu)",
         variableNamingConvention="structured",
         coSimulation=CoSimulation(modelIdentifier="container_fmu", fixedInternalStepSize=step,
                                   canHandleVariableCommunicationStepSize=False),

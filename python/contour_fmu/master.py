@@ -19,7 +19,7 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-from wiring import CLOSED_LOOP_CONNECTIONS, PATH_START
+from .wiring import CLOSED_LOOP_CONNECTIONS, PATH_START
 
 SCHEMES = ("gauss-seidel", "jacobi")
 

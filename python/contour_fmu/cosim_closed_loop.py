@@ -2,7 +2,7 @@
 (libcosimpy) and prints the trajectories as one line of JSON.
 
 Kept in its own process: libcosim can take the interpreter down on a broken FMU.
-usage: python cosim_closed_loop.py FMU_DIR STEP_NS STEPS [UNIT.VARIABLE=VALUE ...]
+usage: python -m contour_fmu.cosim_closed_loop FMU_DIR STEP_NS STEPS [UNIT.VARIABLE=VALUE ...]
 
 The printed object holds
 - "time_ns": the execution's final time (integer ns);
@@ -23,9 +23,9 @@ from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 from libcosimpy.CosimObserver import CosimObserver
 from libcosimpy.CosimSlave import CosimLocalSlave
 
-from wiring import CLOSED_LOOP_CONNECTIONS
+from .wiring import CLOSED_LOOP_CONNECTIONS
 
-UNITS = {  # instance name -> FMU file, as in master.closed_loop
+UNITS = {  # instance name -> FMU file, as in contour_fmu.master.closed_loop
     "interpolator": "PathInterpolator2D.fmu",
     "controller": "ContourCCC2D.fmu",
     "plant": "XYServoPlant.fmu",

@@ -1,20 +1,48 @@
-"""True contour error for the demo and the closed-loop tests, computed independently of
-the Rust code: the built-in paths are rebuilt here (closed forms for circle, line and
-arc; geomdl for the NURBS of docs/design.md §4.6), sampled densely, and each point is projected
-onto the segments next to its nearest sample (about 1e-9 mm from the exact distance at 200 001 samples).
+"""The built-in paths rebuilt in Python, and the true contour error computed from them,
+independently of the Rust code.
+
+The NURBS `infinity` and `trident` come from the control points listed in docs/design.md
+§4.6 (cubic, clamped uniform knots; evaluated with geomdl), the circle, line and arc from
+their closed forms. For the true contour error each path is sampled densely and every
+point is projected onto the segments next to its nearest sample (about 1e-9 mm from the
+exact distance at 200 001 samples).
 """
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
+from geomdl import NURBS
 from scipy.spatial import cKDTree
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "reference"))
-from test_nurbs_geomdl import INFINITY, TRIDENT, clamped_uniform, geomdl_curve  # noqa: E402
-
+# Control points (mm) of the built-in NURBS paths, docs/design.md §4.6.
+INFINITY = [
+    (0, 0), (4.5, 4.5), (18.1, 21.5), (41.5, 19.0), (42.1, -19.4), (17.2, -20.1), (0, 0),
+    (-17.2, 20.1), (-42.1, 19.4), (-41.5, -19.0), (-18.1, -21.5), (-4.5, -4.5), (0, 0),
+]
+TRIDENT = [
+    (40.2, -0.1), (39.2, 4.5), (30.9, 7.7), (19.0, 7.5), (7.0, 3.7), (-3.5, -1.3),
+    (-13.4, -10.5), (-19.9, -17.8), (-25.5, -34.2), (-11.3, -36.1), (-4.8, -22.6),
+    (-0.7, -12.6), (0.3, 0), (-0.7, 12.6), (-4.8, 22.6), (-11.3, 36.1), (-25.5, 34.2),
+    (-19.9, 17.8), (-13.4, 10.5), (-3.5, 1.3), (7.0, -3.7), (19.0, -7.5), (30.9, -7.7),
+    (39.2, -4.5), (40.2, 0.1),
+]
 SAMPLES = 200_001
+
+
+def clamped_uniform(n, p):
+    """The clamped uniform knot vector on [0, 1] of n control points and degree p."""
+    spans = n - p
+    return [0.0] * (p + 1) + [k / spans for k in range(1, spans)] + [1.0] * (p + 1)
+
+
+def geomdl_curve(degree, knots, ctrl, weights=None):
+    """A geomdl NURBS curve (unit weights unless given)."""
+    c = NURBS.Curve()
+    c.degree = degree
+    c.ctrlpts = [list(map(float, p)) for p in ctrl]
+    c.weights = [1.0] * len(ctrl) if weights is None else [float(w) for w in weights]
+    c.knotvector = list(knots)
+    return c
 
 
 def _circle(centre, radius, start, sweep, n):

@@ -1,21 +1,27 @@
-"""The paper's comparison, through the FMUs: PathInterpolator2D -> ContourCCC2D <-
-XYServoPlant, stepped by the fixed-step master in master.py (fmpy's FMU2Slave), on the
-circle, the infinity curve and the trident: without CCC, with the fuzzy-PID CCC and the
-paper's factors, and with factors tuned by PSO (`ccc-tune`, applied as start values).
+"""The paper's comparison of contour error with and without CCC, through the FMUs.
+
+PathInterpolator2D -> ContourCCC2D <- XYServoPlant, stepped by the fixed-step master of
+contour_fmu.master (fmpy's FMU2Slave), on the circle, the infinity curve and the trident:
+without CCC, with the fuzzy-PID CCC and the paper's factors, and with factors tuned by PSO
+(`ccc-tune`, applied as start values).
 
 Every controller also runs on the mirror image of each path (about the x axis, so the
 circle turns clockwise): a controller must not care about the direction of travel, and
 the table shows both. Prints a table like the paper's Tables 4-5 (max and mean |true
-contour error| on the path and on its mirror, the reduction), and writes to out/: one CSV time series per run, one PNG per path (path
-tracking and contour error vs time), the PSO fitness histories (standard vs improved,
-like the paper's Figures 10 and 13), and the FMI cross-check files of ContourCCC2D
-(out/cross-check/ContourCCC2D/: _in.csv, _ref.csv, _ref.opt) from the fuzzy circle run.
+contour error| on the path and on its mirror, the reduction), and writes to out/: one CSV
+time series per run, one PNG per path (path tracking and contour error vs time), the PSO
+fitness histories (standard vs improved, like the paper's Figures 10 and 13), and the FMI
+cross-check files of ContourCCC2D (out/cross-check/ContourCCC2D/: _in.csv, _ref.csv,
+_ref.opt) from the fuzzy circle run.
 
-usage: python tests/fmpy/demo.py [--fmu-dir DIR] [--out DIR]
-                                 [--tune | --params tuned.json] [--ccc-tune PROGRAM]
+usage: python -m contour_fmu.demo [--fmu-dir DIR] [--out DIR]
+                                  [--tune | --params tuned.json] [--ccc-tune PROGRAM]
 
 --tune runs ccc-tune (improved and standard PSO, the paper's budget, fitness = max
 |true contour error|) on each path; --params applies one ccc-tune result to every path.
+The defaults are in the checkout <repo> (contour_fmu.repo: $CONTOUR_FMU_REPO, else the
+working directory or a parent of it, else the checkout the package is installed from in
+editable mode): <repo>/target/fmu, <repo>/out, <repo>/target/release/ccc-tune.
 """
 
 import argparse
@@ -23,21 +29,15 @@ import csv
 import json
 import math
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-from master import closed_loop  # noqa: E402
-from reference_paths import ContourReference  # noqa: E402
+from . import repo
+from .master import closed_loop
+from .reference_paths import INFINITY, TRIDENT, ContourReference, clamped_uniform
+from .tuned import start_values
 
-sys.path.insert(0, str(HERE.parent / "reference"))
-from test_nurbs_geomdl import INFINITY, TRIDENT, clamped_uniform  # noqa: E402
-from tuned import start_values  # noqa: E402
-
-REPO = HERE.parents[1]
 STEP = 1e-3
 
 # (path, feed mm/s): the paper's circle at its own feed (2 s per turn); the NURBS at a
@@ -156,15 +156,54 @@ def plot(out, path, runs):
     plt.close(fig)
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--fmu-dir", type=Path, default=REPO / "target" / "fmu")
-    parser.add_argument("--out", type=Path, default=REPO / "out")
+FMUS = ("PathInterpolator2D.fmu", "ContourCCC2D.fmu", "XYServoPlant.fmu")
+
+
+def build_ccc_tune():
+    """The cargo command that builds ccc-tune, in whichever crate of the workspace it is."""
+    try:
+        return f"cargo build --release -p {repo.cargo_package('ccc-tune')} --bin ccc-tune"
+    except (OSError, subprocess.SubprocessError, LookupError, repo.RepoNotFound):
+        return "cargo build --release --bin ccc-tune"
+
+
+def parse_args(argv=None):
+    """The options, with the defaults resolved in the checkout (only those needed: with
+    --fmu-dir and --out given, no checkout is needed unless --tune runs ccc-tune)."""
+    parser = argparse.ArgumentParser(
+        prog="python -m contour_fmu.demo", description=__doc__.splitlines()[0],
+        epilog=f"<repo> is the checkout: ${repo.ENV}, else the working directory or a parent of "
+               "it, else the checkout the package is installed from in editable mode; "
+               "$CARGO_TARGET_DIR replaces <repo>/target.")
+    parser.add_argument("--fmu-dir", type=Path, help="the FMUs (default: <repo>/target/fmu)")
+    parser.add_argument("--out", type=Path, help="the output folder (default: <repo>/out)")
     choice = parser.add_mutually_exclusive_group()
     choice.add_argument("--tune", action="store_true", help="tune each path with ccc-tune")
     choice.add_argument("--params", type=Path, help="a ccc-tune JSON applied to every path")
-    parser.add_argument("--ccc-tune", type=Path, default=REPO / "target" / "release" / "ccc-tune")
+    parser.add_argument("--ccc-tune", type=Path,
+                        help="the tuner, for --tune (default: <repo>/target/release/ccc-tune)")
     args = parser.parse_args(argv)
+    try:
+        args.fmu_dir = args.fmu_dir or repo.fmu_dir()
+        args.out = args.out or repo.out_dir()
+        if args.tune:
+            args.ccc_tune = args.ccc_tune or repo.ccc_tune()
+    except repo.RepoNotFound as e:
+        parser.error(str(e))
+    missing = [name for name in FMUS if not (args.fmu_dir / name).is_file()]
+    if missing:
+        parser.error(f"no {', '.join(missing)} in {args.fmu_dir}: build the FMUs with "
+                     "`cargo run --release -p fmu-build` (or `make fmus`), or give --fmu-dir")
+    if args.tune and not args.ccc_tune.is_file():
+        parser.error(f"no ccc-tune at {args.ccc_tune}: build it with `{build_ccc_tune()}` "
+                     "or give --ccc-tune")
+    if args.params and not args.params.is_file():
+        parser.error(f"no parameter file {args.params}")
+    return args
+
+
+def main(argv=None):
+    args = parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
 
     rows = []

@@ -1,0 +1,18 @@
+"""contour-fmu's Python side: run the FMUs that `fmu-build` packages (PathInterpolator2D,
+ContourCCC2D, XYServoPlant) in a closed loop.
+
+Modules (imported on demand; this package imports nothing itself, so `wiring` stays usable
+without fmpy):
+
+- wiring: the paper's loop as a list of connections, shared by every master;
+- master: a fixed-step Gauss-Seidel or Jacobi master on fmpy's FMU2Slave, closed_loop();
+- tuned: a ccc-tune result as ContourCCC2D start values;
+- reference_paths: the built-in paths rebuilt in Python and the true contour error;
+- demo: the paper's comparison through the FMUs (python -m contour_fmu.demo);
+- container_build: the loop packed into one FMU with fmpy's container;
+- cosim_closed_loop, ecos_closed_loop: the loop in libcosim and in ecos (run as
+  python -m contour_fmu.cosim_closed_loop / .ecos_closed_loop);
+- repo: where the checkout, its FMUs and ccc-tune are.
+"""
+
+__version__ = "0.1.0"

@@ -1,0 +1,117 @@
+"""The contour_fmu package (python/) as installed: the tests import this checkout's code,
+its pins agree with requirements/, it finds the checkout from anywhere, and the demo's
+command line answers without a run."""
+
+import importlib.metadata
+import re
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+import contour_fmu
+from contour_fmu import repo
+from conftest import REPO
+
+PIN = re.compile(r"^([A-Za-z0-9._-]+)==([^\s#;]+)")
+
+
+def canonical(name):
+    return re.sub(r"[-_.]+", "-", name).lower()
+
+
+def pins(filename):
+    """{name: version} of a requirements file, following -r."""
+    found = {}
+    for line in (REPO / "requirements" / filename).read_text().splitlines():
+        line = line.split(" #", 1)[0].strip()
+        if not line or line.startswith("#"):
+            continue
+        if line.startswith("-r "):
+            found.update(pins(line[3:].strip()))
+            continue
+        match = PIN.match(line)
+        assert match, f"requirements/{filename}: not pinned with ==: {line!r}"
+        found[canonical(match[1])] = match[2]
+    return found
+
+
+def pyproject():
+    return tomllib.loads((REPO / "python" / "pyproject.toml").read_text())["project"]
+
+
+def test_the_tests_import_this_checkouts_package():
+    assert Path(contour_fmu.__file__).resolve().parent == REPO / "python" / "contour_fmu"
+    assert importlib.metadata.version("contour-fmu") == pyproject()["version"] == contour_fmu.__version__
+
+
+@pytest.mark.parametrize("filename, declared", [
+    ("run.txt", lambda p: p["dependencies"]),
+    ("test.txt", lambda p: p["dependencies"] + p["optional-dependencies"]["test"]),
+])
+def test_pyproject_pins_are_the_requirements_pins(filename, declared):
+    locked = pins(filename)
+    for requirement in declared(pyproject()):
+        match = PIN.match(requirement)
+        assert match, f"python/pyproject.toml: not pinned with ==: {requirement!r}"
+        assert locked.get(canonical(match[1])) == match[2], requirement
+
+
+def test_the_venv_holds_the_pinned_versions():
+    for name, version in pins("test.txt").items():
+        assert importlib.metadata.version(name) == version, name
+
+
+def test_the_checkout_is_found_from_a_subfolder_from_outside_and_by_name(tmp_path, monkeypatch):
+    monkeypatch.delenv(repo.ENV, raising=False)
+    assert repo.find_root(REPO / "tests" / "fmpy") == REPO
+    # Outside any checkout: the one the package is installed from (editable).
+    assert repo.find_root(tmp_path) == REPO
+    monkeypatch.setenv(repo.ENV, str(REPO))
+    assert repo.find_root(tmp_path) == REPO
+    monkeypatch.setenv(repo.ENV, str(tmp_path))
+    with pytest.raises(repo.RepoNotFound, match=repo.ENV):
+        repo.find_root()
+
+
+def test_default_paths_follow_cargo_target_dir(tmp_path, monkeypatch):
+    monkeypatch.delenv(repo.ENV, raising=False)
+    monkeypatch.chdir(REPO)
+    monkeypatch.delenv("CARGO_TARGET_DIR", raising=False)
+    assert repo.fmu_dir() == REPO / "target" / "fmu"
+    assert repo.ccc_tune() == REPO / "target" / "release" / "ccc-tune"
+    assert repo.out_dir() == REPO / "out"
+    monkeypatch.setenv("CARGO_TARGET_DIR", str(tmp_path))
+    assert repo.fmu_dir() == tmp_path / "fmu"
+
+
+def test_cargo_targets_are_found_in_their_crates():
+    assert repo.cargo_package("fmu-build", "bin", REPO) == "fmu-build"
+    assert repo.cargo_package("nurbs_dump", "example", REPO) == "contour-fmu"
+    assert repo.cargo_package("ccc-tune", "bin", REPO) in ("contour-fmu", "contour-tune")
+    with pytest.raises(LookupError):
+        repo.cargo_package("no-such-target", "bin", REPO)
+
+
+def demo(*args, cwd):
+    return subprocess.run([sys.executable, "-m", "contour_fmu.demo", *args], cwd=cwd,
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_demo_help_runs_outside_the_checkout(tmp_path):
+    done = demo("--help", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    for option in ("--fmu-dir", "--out", "--tune", "--params", "--ccc-tune"):
+        assert option in done.stdout
+
+
+def test_demo_refuses_missing_fmus_and_tuner_before_running(fmu_dir, tmp_path):
+    out = tmp_path / "out"
+    done = demo("--fmu-dir", str(tmp_path), "--out", str(out), cwd=tmp_path)
+    assert done.returncode == 2 and "fmu-build" in done.stderr, done.stderr
+    done = demo("--fmu-dir", str(fmu_dir), "--out", str(out), "--tune",
+                "--ccc-tune", str(tmp_path / "ccc-tune"), cwd=REPO)
+    assert done.returncode == 2 and "--bin ccc-tune" in done.stderr, done.stderr
+    assert not out.exists()
