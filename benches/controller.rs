@@ -11,6 +11,7 @@ use std::hint::black_box;
 
 use contour_fmu::contour::FreeCurveEstimator;
 use contour_fmu::control::{CccConfig, CccMode, ControllerConfig, CrossCoupledController};
+use contour_fmu::geometry::Vector2;
 use contour_fmu::sim::{SimConfig, Simulator};
 use criterion::{criterion_group, criterion_main, Criterion};
 
@@ -28,7 +29,7 @@ fn bench_controller(c: &mut Criterion) {
         // (reference, actual) pairs of the closed loop in this mode, 2 s on the circle.
         let sim = Simulator::new(SimConfig::paper_circle().with_mode(mode)).unwrap();
         let trace = sim.run().trace;
-        let samples: Vec<([f64; 2], [f64; 2])> = trace
+        let samples: Vec<(Vector2, Vector2)> = trace
             .reference
             .iter()
             .copied()

@@ -54,7 +54,7 @@ fn main() {
         json!({
             "ts": c.ts,
             "feed": c.feed,
-            "plant": c.plant,
+            "plant": { "x": c.plant.axes[0], "y": c.plant.axes[1] },
             "axis": c.controller.axis,
             "mode": format!("{:?}", c.controller.ccc.mode),
             "trace": result.trace,

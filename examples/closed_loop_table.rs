@@ -27,9 +27,9 @@ fn run(config: SimConfig) -> (Metrics, f64) {
     loop {
         let before = run.plant().clone();
         let Some(r) = run.next() else { break };
-        peak = peak
-            .max(before.x.current(r.u[0]).abs())
-            .max(before.y.current(r.u[1]).abs());
+        for (axis, &u) in before.axes.iter().zip(r.u.iter()) {
+            peak = peak.max(axis.current(u).abs());
+        }
     }
     (run.metrics(), peak)
 }

@@ -50,8 +50,8 @@ fn main() {
             let span = if rng.next() < 0.8 { 2.0 } else { 20.0 };
             let off = (2.0 * rng.next() - 1.0) * span;
             let p = [e.p[0] - off * e.d1[1] / s, e.p[1] + off * e.d1[0] / s];
-            let g = true_error(&path, p);
-            let h = idx.error(p, u);
+            let g = true_error(&path, p.into());
+            let h = idx.error(p.into(), u);
             json!({
                 "p": p,
                 "error": g.error, "u": g.u, "foot": g.foot, "normal": g.normal,

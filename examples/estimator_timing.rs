@@ -35,7 +35,7 @@ fn main() {
     let mut sum = 0.0;
     let t = Instant::now();
     for (s, p) in samples.iter().zip(&actual) {
-        sum += idx.error(*p, s.u).error;
+        sum += idx.error((*p).into(), s.u).error;
     }
     println!(
         "index, hint = reference u: {:.3} µs/sample",
@@ -45,7 +45,7 @@ fn main() {
     let t = Instant::now();
     let mut hint = 0.0;
     for p in &actual {
-        let r = idx.error(*p, hint);
+        let r = idx.error((*p).into(), hint);
         hint = r.u;
         sum += r.error;
     }
@@ -57,7 +57,7 @@ fn main() {
     let t = Instant::now();
     let mut est = FreeCurveEstimator::default();
     for (s, p) in samples.iter().zip(&actual) {
-        sum += est.estimate(s.point, *p).error;
+        sum += est.estimate(s.point, (*p).into()).error;
     }
     println!(
         "free-curve estimator: {:.3} µs/sample",
@@ -67,7 +67,7 @@ fn main() {
     let t = Instant::now();
     let m = 200;
     for p in actual.iter().step_by(actual.len() / m) {
-        sum += true_error(&path, *p).error;
+        sum += true_error(&path, (*p).into()).error;
     }
     println!(
         "global brute force: {:.1} µs/query",

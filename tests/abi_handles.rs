@@ -11,8 +11,8 @@ mod common;
 use common::*;
 use contour_fmu::models::{fault_probe as probe, xy_servo_plant as plant};
 
-const POS_X: u32 = plant::POS_X as u32;
-const U_X: u32 = plant::U_X as u32;
+const POS_X: u32 = plant::POS.at(0).vr() as u32;
+const U_X: u32 = plant::U.at(0).vr() as u32;
 
 /// A block of memory that is not an instance or a state of ours, filled with a pattern
 /// that would look plausible to a careless check (the library's old "live" tag).
@@ -265,7 +265,7 @@ fn stored_states_can_be_freed_after_a_fatal_error() {
     i.start();
     let (_, mut first) = i.get_state();
     let (_, second) = i.get_state();
-    assert_eq!(i.set_boolean(probe::PANIC as u32, true), OK);
+    assert_eq!(i.set_boolean(probe::PANIC.vr() as u32, true), OK);
     assert_eq!(i.step(0.0, 0.1), FATAL);
     // Nothing but freeing is allowed now ...
     assert_eq!(i.set_state(first), ERROR);

@@ -12,8 +12,10 @@ mod common;
 use common::*;
 use contour_fmu::contour::{Estimator, FreeCurveEstimator};
 use contour_fmu::control::{ControllerConfig, CrossCoupledController};
+use contour_fmu::geometry::Vector2;
 use contour_fmu::models::{
-    contour_ccc_2d as ccc, geometry, path_interpolator_2d as interp, xy_servo_plant as plant, Value,
+    contour_ccc_2d as ccc, line_arc_parameters as geometry, path_interpolator_2d as interp,
+    xy_servo_plant as plant, Value,
 };
 
 /// A Ts that appears nowhere else in the state.
@@ -22,10 +24,10 @@ const TS: f64 = 0.00125;
 const RADIUS: f64 = 17.25;
 
 const INPUTS: [u32; 4] = [
-    ccc::REF_X as u32,
-    ccc::REF_Y as u32,
-    ccc::POS_X as u32,
-    ccc::POS_Y as u32,
+    ccc::REF.at(0).vr() as u32,
+    ccc::REF.at(1).vr() as u32,
+    ccc::POS.at(0).vr() as u32,
+    ccc::POS.at(1).vr() as u32,
 ];
 
 fn held_inputs(k: usize) -> [f64; 4] {
@@ -44,10 +46,10 @@ fn controller_state(arc: bool) -> (Instance, Vec<u8>) {
     let i = Instance::new(&ccc::INFO);
     assert_eq!(i.setup(0.0, None), OK);
     assert_eq!(i.enter_init(), OK);
-    assert_eq!(i.set_reals(&[ccc::TS as u32], &[TS]), OK);
+    assert_eq!(i.set_reals(&[ccc::TS.vr() as u32], &[TS]), OK);
     if arc {
-        assert_eq!(i.set_integer(ccc::ESTIMATOR as u32, 3), OK);
-        let r = (ccc::GEOMETRY + geometry::ARC_R) as u32;
+        assert_eq!(i.set_integer(ccc::ESTIMATOR.vr() as u32, 3), OK);
+        let r = ccc::GEOMETRY.at(geometry::ARC_R).vr() as u32;
         assert_eq!(i.set_reals(&[r], &[RADIUS]), OK);
     }
     assert_eq!(i.exit_init(), OK, "{}", i.last_error());
@@ -73,7 +75,7 @@ fn controller_x_integral() -> f64 {
             .unwrap();
     for k in 0..30 {
         let x = held_inputs(k);
-        c.sample([x[0], x[1]], [x[2], x[3]]);
+        c.sample(Vector2::new(x[0], x[1]), Vector2::new(x[2], x[3]));
     }
     c.axes()[0].integral()
 }
@@ -122,8 +124,8 @@ fn controller_states_with_bad_clock_pid_or_radius_are_refused() {
     let periods = find_f64(&model, TS);
     assert_eq!(
         periods.len(),
-        5,
-        "config, two axis PIDs, contour PID, clock"
+        7,
+        "config, two axis PIDs, contour PID, two per-axis contour PIDs, clock"
     );
     let clock = *periods.last().unwrap();
     for bad in [0.0, -TS, f64::NAN] {
@@ -167,13 +169,13 @@ fn controller_states_with_bad_clock_pid_or_radius_are_refused() {
     refused(
         &i,
         &bytes,
-        |e| e.values.set(ccc::AXIS_GAINS, Value::Real(-1.0)),
+        |e| e.values.set(ccc::AXIS_GAINS.at(0).vr(), Value::Real(-1.0)),
         "the FMU state is invalid: variable 'axis.x.Kp' = -1 is below its minimum 0",
     );
     refused(
         &i,
         &bytes,
-        |e| e.values.set(ccc::ESTIMATOR, Value::Integer(7)),
+        |e| e.values.set(ccc::ESTIMATOR.vr(), Value::Integer(7)),
         "variable 'estimator' = 7 is not a value of its enumeration",
     );
 
@@ -199,9 +201,9 @@ fn interpolator_states_with_a_bad_path_or_clock_are_refused() {
     let i = Instance::new(&interp::INFO);
     assert_eq!(i.setup(0.0, None), OK);
     assert_eq!(i.enter_init(), OK);
-    assert_eq!(i.set_string(interp::PATH as u32, "arc"), OK);
-    let r = (interp::GEOMETRY + geometry::ARC_R) as u32;
-    assert_eq!(i.set_reals(&[r, interp::TS as u32], &[RADIUS, TS]), OK);
+    assert_eq!(i.set_string(interp::PATH.vr() as u32, "arc"), OK);
+    let r = interp::GEOMETRY.at(geometry::ARC_R).vr() as u32;
+    assert_eq!(i.set_reals(&[r, interp::TS.vr() as u32], &[RADIUS, TS]), OK);
     assert_eq!(i.exit_init(), OK, "{}", i.last_error());
     for k in 0..20 {
         assert_eq!(i.step(k as f64 * TS, TS), OK);
@@ -239,11 +241,11 @@ fn interpolator_states_with_a_bad_path_or_clock_are_refused() {
 fn plant_states_with_bad_axis_values_are_refused() {
     let i = Instance::new(&plant::INFO);
     i.start();
-    assert_eq!(i.set_reals(&[plant::U_X as u32], &[12.5]), OK);
+    assert_eq!(i.set_reals(&[plant::U.at(0).vr() as u32], &[12.5]), OK);
     for k in 0..5 {
         assert_eq!(i.step(k as f64 * 0.01, 0.01), OK);
     }
-    let pos_x = i.get_real(plant::POS_X as u32);
+    let pos_x = i.get_real(plant::POS.at(0).vr() as u32);
     let (_, mut state) = i.get_state();
     let (_, bytes) = i.serialize(state);
     resealed_is_accepted(&i, &bytes);
@@ -292,21 +294,27 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
     let (_, interpolator_bytes) = interpolator.serialize(state);
     interpolator.free_state(&mut state);
 
-    for (i, bytes, model) in [
-        (&controller, &controller_bytes, "ContourCCC2D"),
-        (&plant_instance, &plant_bytes, "XYServoPlant"),
-        (&interpolator, &interpolator_bytes, "PathInterpolator2D"),
+    // The models' current layout versions: ContourCCC2D 2 (the controller became N-axis),
+    // XYServoPlant 2 (each axis's lead became a transmission), PathInterpolator2D 1.
+    for (i, bytes, model, version) in [
+        (&controller, &controller_bytes, "ContourCCC2D", 2u16),
+        (&plant_instance, &plant_bytes, "XYServoPlant", 2),
+        (&interpolator, &interpolator_bytes, "PathInterpolator2D", 1),
     ] {
         let (_, envelope) = open_state(bytes);
-        assert_eq!(&envelope.model[..2], &[1, 0], "{model}: layout version 1");
+        assert_eq!(
+            &envelope.model[..2],
+            &version.to_le_bytes(),
+            "{model}: layout version {version}"
+        );
         refused(
             i,
             bytes,
             |e| e.model[..2].copy_from_slice(&0u16.to_le_bytes()),
             &format!(
                 "the {model} state has internal layout version 0, this build reads layout \
-                 version 1 only: it was saved by an older build of contour-fmu and cannot be \
-                 restored"
+                 version {version} only: it was saved by an older build of contour-fmu and \
+                 cannot be restored"
             ),
         );
         // The envelope of the states before per-model layouts (format 1).

@@ -10,29 +10,31 @@ use std::collections::BTreeMap;
 use common::*;
 use contour_fmu::contour::{Estimator, FreeCurveEstimator};
 use contour_fmu::control::{ControllerConfig, CrossCoupledController};
+use contour_fmu::geometry::Vector2;
 use contour_fmu::models::{
-    contour_ccc_2d as ccc, geometry, path_interpolator_2d as interp, ModelInfo, Start,
+    contour_ccc_2d as ccc, line_arc_parameters as geometry, path_interpolator_2d as interp,
+    ModelInfo, Start,
 };
 use contour_fmu::path::{builtin, Interpolator};
 
 const INPUTS: [u32; 4] = [
-    ccc::REF_X as u32,
-    ccc::REF_Y as u32,
-    ccc::POS_X as u32,
-    ccc::POS_Y as u32,
+    ccc::REF.at(0).vr() as u32,
+    ccc::REF.at(1).vr() as u32,
+    ccc::POS.at(0).vr() as u32,
+    ccc::POS.at(1).vr() as u32,
 ];
 /// u.x, u.y, contourError, err.x, err.y, ccc.Kp, ccc.Ki, ccc.Kd.
 const OUTPUTS: [u32; 8] = [
-    ccc::U_X as u32,
-    ccc::U_Y as u32,
-    ccc::CONTOUR_ERROR as u32,
-    ccc::ERR_X as u32,
-    ccc::ERR_Y as u32,
-    ccc::CCC_KP as u32,
-    ccc::CCC_KI as u32,
-    ccc::CCC_KD as u32,
+    ccc::U.at(0).vr() as u32,
+    ccc::U.at(1).vr() as u32,
+    ccc::CONTOUR_ERROR.vr() as u32,
+    ccc::ERR.at(0).vr() as u32,
+    ccc::ERR.at(1).vr() as u32,
+    ccc::CCC_GAINS.at(0).vr() as u32,
+    ccc::CCC_GAINS.at(1).vr() as u32,
+    ccc::CCC_GAINS.at(2).vr() as u32,
 ];
-const REF: [u32; 2] = [interp::REF_X as u32, interp::REF_Y as u32];
+const REF: [u32; 2] = [interp::REF.at(0).vr() as u32, interp::REF.at(1).vr() as u32];
 
 /// Piecewise-constant inputs, changing every 5 ms (a communication point of every step
 /// size used here): a circle and a point lagging inside it.
@@ -82,7 +84,7 @@ fn controller_reference(samples: usize) -> Vec<Vec<f64>> {
     (0..samples)
         .map(|n| {
             let x = held_inputs(n as f64 * 1e-3);
-            let out = controller.sample([x[0], x[1]], [x[2], x[3]]);
+            let out = controller.sample(Vector2::new(x[0], x[1]), Vector2::new(x[2], x[3]));
             vec![
                 out.u[0],
                 out.u[1],
@@ -136,8 +138,8 @@ fn start_interpolator(path: &str, feed: f64) -> Instance {
     let i = Instance::new(&interp::INFO);
     assert_eq!(i.setup(0.0, None), OK);
     assert_eq!(i.enter_init(), OK);
-    assert_eq!(i.set_string(interp::PATH as u32, path), OK);
-    assert_eq!(i.set_reals(&[interp::FEED as u32], &[feed]), OK);
+    assert_eq!(i.set_string(interp::PATH.vr() as u32, path), OK);
+    assert_eq!(i.set_reals(&[interp::FEED.vr() as u32], &[feed]), OK);
     assert_eq!(i.exit_init(), OK, "{}", i.last_error());
     i
 }
@@ -145,7 +147,7 @@ fn start_interpolator(path: &str, feed: f64) -> Instance {
 fn interpolator_outputs(i: &Instance) -> (f64, f64, bool) {
     let (s, v) = i.get_reals(&REF);
     assert_eq!(s, OK);
-    let (s, done) = i.get_boolean(interp::DONE as u32);
+    let (s, done) = i.get_boolean(interp::DONE.vr() as u32);
     assert_eq!(s, OK);
     (v[0], v[1], done)
 }
@@ -268,7 +270,7 @@ fn interpolator_state_restores_bit_for_bit_in_place_and_in_a_fresh_instance() {
     // The restored instance carries the path: it is the infinity, not the start value's
     // circle.
     let (s, path) = {
-        let (s, _, text) = fresh.get_string(interp::PATH as u32);
+        let (s, _, text) = fresh.get_string(interp::PATH.vr() as u32);
         (s, text)
     };
     assert_eq!((s, path.as_str()), (OK, "infinity"));
@@ -337,23 +339,29 @@ fn out_of_range_parameters_are_refused_when_set_and_the_old_value_kept() {
     let i = Instance::new(&ccc::INFO);
     assert_eq!(i.setup(0.0, None), OK);
     assert_eq!(i.enter_init(), OK);
-    let kp = ccc::AXIS_GAINS as u32;
-    let kp0 = ccc::CCC_GAINS0 as u32;
-    let estimator = ccc::ESTIMATOR as u32;
+    let kp = ccc::AXIS_GAINS.at(0).vr() as u32;
+    let kp0 = ccc::CCC_GAINS0.at(0).vr() as u32;
+    let estimator = ccc::ESTIMATOR.vr() as u32;
 
     assert_eq!(i.set_reals(&[kp], &[-1.0]), ERROR);
     assert_eq!(
         i.last_error(),
         "fmi2SetReal: variable 'axis.x.Kp' = -1 is below its minimum 0"
     );
-    assert_eq!(i.get_real(kp), real_start(ccc::AXIS_GAINS, &ccc::INFO));
+    assert_eq!(
+        i.get_real(kp),
+        real_start(ccc::AXIS_GAINS.at(0).vr(), &ccc::INFO)
+    );
 
     assert_eq!(i.set_reals(&[kp0], &[f64::NAN]), ERROR);
     assert_eq!(
         i.last_error(),
         "fmi2SetReal: variable 'ccc.Kp0' refuses the non-finite value NaN"
     );
-    assert_eq!(i.get_real(kp0), real_start(ccc::CCC_GAINS0, &ccc::INFO));
+    assert_eq!(
+        i.get_real(kp0),
+        real_start(ccc::CCC_GAINS0.at(0).vr(), &ccc::INFO)
+    );
 
     // The estimator is an enumeration, set with fmi2SetInteger.
     for bad in [0, 4, -1] {
@@ -378,7 +386,10 @@ fn out_of_range_parameters_are_refused_when_set_and_the_old_value_kept() {
     // All or nothing: a call with one bad value stores none.
     let ki = kp + 1;
     assert_eq!(i.set_reals(&[ki, kp], &[7.0, -2.0]), ERROR);
-    assert_eq!(i.get_real(ki), real_start(ccc::AXIS_GAINS + 1, &ccc::INFO));
+    assert_eq!(
+        i.get_real(ki),
+        real_start(ccc::AXIS_GAINS.at(1).vr(), &ccc::INFO)
+    );
     assert_eq!(i.exit_init(), OK, "{}", i.last_error());
 }
 
@@ -391,42 +402,42 @@ fn inconsistent_parameters_are_refused_at_the_end_of_initialization() {
     let cases: Vec<(&str, Setter, Setter, &str)> = vec![
         (
             "ContourCCC2D",
-            |i| i.set_reals(&[ccc::TS as u32], &[0.0]),
-            |i| i.set_reals(&[ccc::TS as u32], &[1e-3]),
+            |i| i.set_reals(&[ccc::TS.vr() as u32], &[0.0]),
+            |i| i.set_reals(&[ccc::TS.vr() as u32], &[1e-3]),
             "parameter 'Ts' must be at least 1e-6 s (got 0)",
         ),
         (
             "ContourCCC2D",
-            |i| i.set_reals(&[ccc::CCC_LIMIT as u32], &[0.0]),
-            |i| i.set_reals(&[ccc::CCC_LIMIT as u32], &[50.0]),
+            |i| i.set_reals(&[ccc::CCC_LIMIT.vr() as u32], &[0.0]),
+            |i| i.set_reals(&[ccc::CCC_LIMIT.vr() as u32], &[50.0]),
             "parameter ccc.limit = 0 is invalid: must be finite and > 0 when set",
         ),
         (
             "ContourCCC2D",
             |i| {
-                let r = (ccc::GEOMETRY + geometry::ARC_R) as u32;
-                i.set_integer(ccc::ESTIMATOR as u32, 3)
+                let r = ccc::GEOMETRY.at(geometry::ARC_R).vr() as u32;
+                i.set_integer(ccc::ESTIMATOR.vr() as u32, 3)
                     .max(i.set_reals(&[r], &[0.0]))
             },
-            |i| i.set_reals(&[(ccc::GEOMETRY + geometry::ARC_R) as u32], &[5.0]),
+            |i| i.set_reals(&[ccc::GEOMETRY.at(geometry::ARC_R).vr() as u32], &[5.0]),
             "parameters 'arc.*': invalid path: arc radius must be > 0, got 0",
         ),
         (
             "PathInterpolator2D",
-            |i| i.set_reals(&[interp::FEED as u32], &[-5.0]),
-            |i| i.set_reals(&[interp::FEED as u32], &[5.0]),
+            |i| i.set_reals(&[interp::FEED.vr() as u32], &[-5.0]),
+            |i| i.set_reals(&[interp::FEED.vr() as u32], &[5.0]),
             "parameter 'feed' must be > 0 (got -5)",
         ),
         (
             "PathInterpolator2D",
-            |i| i.set_reals(&[interp::TS as u32], &[1e-9]),
-            |i| i.set_reals(&[interp::TS as u32], &[2e-3]),
+            |i| i.set_reals(&[interp::TS.vr() as u32], &[1e-9]),
+            |i| i.set_reals(&[interp::TS.vr() as u32], &[2e-3]),
             "parameter 'Ts' must be at least 1e-6 s (got 0.000000001)",
         ),
         (
             "PathInterpolator2D",
-            |i| i.set_string(interp::PATH as u32, "spiral"),
-            |i| i.set_string(interp::PATH as u32, "line"),
+            |i| i.set_string(interp::PATH.vr() as u32, "spiral"),
+            |i| i.set_string(interp::PATH.vr() as u32, "line"),
             "parameter 'path': unknown path 'spiral'",
         ),
     ];

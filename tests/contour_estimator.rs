@@ -53,6 +53,7 @@
 use contour_fmu::contour::{
     true_error, ContourEstimator, Estimator, EstimatorKind, FreeCurveEstimator, TrueErrorIndex,
 };
+use contour_fmu::geometry::Vector2;
 use contour_fmu::path::{builtin, Curve, Interpolator, Path};
 
 const TS: f64 = 1e-3;
@@ -88,7 +89,7 @@ struct Geometry {
     kappa_slope: f64,
 }
 
-fn seg_dist(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+fn seg_dist(p: Vector2, a: Vector2, b: Vector2) -> f64 {
     let (abx, aby) = (b[0] - a[0], b[1] - a[1]);
     let l2 = abx * abx + aby * aby;
     let t = if l2 > 0.0 {
@@ -188,10 +189,10 @@ struct Stats {
     brute_checked: usize,
 }
 
-fn normal_at(path: &Path, u: f64) -> ([f64; 2], [f64; 2]) {
+fn normal_at(path: &Path, u: f64) -> (Vector2, Vector2) {
     let e = path.eval(u);
     let s = e.d1[0].hypot(e.d1[1]);
-    (e.p, [-e.d1[1] / s, e.d1[0] / s])
+    (e.p, Vector2::new(-e.d1[1] / s, e.d1[0] / s))
 }
 
 fn run(
@@ -229,7 +230,7 @@ fn run(
                     st.clipped += 1;
                     continue;
                 }
-                let p = [c[0] - d * n[0], c[1] - d * n[1]]; // d right of travel
+                let p = Vector2::new(c[0] - d * n[0], c[1] - d * n[1]); // d right of travel
                 let e = est.estimate(refs[k], p);
                 let t = geo.index.error(p, u);
                 // The nearest point of the whole path is the constructed foot: never on
@@ -410,7 +411,7 @@ fn exact_estimators_match_true_error_on_their_paths() {
             let u = k as f64 / 200.0;
             let (c, n) = normal_at(&path, u);
             for d in [-0.3, 0.02, 1.5] {
-                let p = [c[0] - d * n[0], c[1] - d * n[1]]; // d right of travel
+                let p = Vector2::new(c[0] - d * n[0], c[1] - d * n[1]); // d right of travel
                 let e = est.estimate(path.point((u + 0.01).min(1.0)), p);
                 let t = true_error(&path, p);
                 assert!(

@@ -1,13 +1,15 @@
-//! Two-axis cross-coupled controller (src/control/ccc.rs): the correction is n·U_c with
-//! U_c recomputed here from the docs/design.md §4.2 formula, Off mode is the bare axis loops, fuzzy
-//! gains follow Kp0 + kpf·ΔKp′ from the engine, configuration errors name the parameter,
-//! state survives serde, and on a closed loop the CCC actually removes contour error.
+//! Two-axis cross-coupled controller (src/control/cross_coupled.rs, ccc_law.rs and
+//! config.rs): the correction is n·U_c with U_c recomputed here from the docs/design.md
+//! §4.2 formula, Off mode is the bare axis loops, fuzzy gains follow Kp0 + kpf·ΔKp′ from the
+//! engine, configuration errors name the parameter, state survives serde, and on a closed
+//! loop the CCC actually removes contour error.
 
 use contour_fmu::contour::{ContourEstimate, ContourEstimator};
 use contour_fmu::control::{
     CccConfig, CccLaw, CccMode, ConfigError, ControllerConfig, CrossCoupledController, FuzzyEngine,
-    FuzzyFactors, PidGains,
+    FuzzyFactor, FuzzyFactors, Gain, Parameter, PidGains,
 };
+use contour_fmu::geometry::Vector2;
 use serde::{Deserialize, Serialize};
 
 /// Exact contour error of a circle (docs/design.md §4.1), computed here independently.
@@ -19,13 +21,13 @@ struct CircleEstimator {
 }
 
 impl ContourEstimator for CircleEstimator {
-    fn estimate(&mut self, _reference: [f64; 2], actual: [f64; 2]) -> ContourEstimate {
+    fn estimate(&mut self, _reference: Vector2, actual: Vector2) -> ContourEstimate {
         let d = [actual[0] - self.centre[0], actual[1] - self.centre[1]];
         let rho = d[0].hypot(d[1]);
         let s = if self.ccw { 1.0 } else { -1.0 };
         ContourEstimate {
             error: s * (rho - self.radius),
-            normal: [-s * d[0] / rho, -s * d[1] / rho],
+            normal: Vector2::new(-s * d[0] / rho, -s * d[1] / rho),
         }
     }
     fn reset(&mut self) {}
@@ -50,7 +52,7 @@ impl Scripted {
 }
 
 impl ContourEstimator for Scripted {
-    fn estimate(&mut self, _reference: [f64; 2], _actual: [f64; 2]) -> ContourEstimate {
+    fn estimate(&mut self, _reference: Vector2, _actual: Vector2) -> ContourEstimate {
         let e = self.script[self.next % self.script.len()];
         self.next += 1;
         self.calls += 1;
@@ -64,7 +66,7 @@ impl ContourEstimator for Scripted {
 fn est(error: f64, angle: f64) -> ContourEstimate {
     ContourEstimate {
         error,
-        normal: [angle.cos(), angle.sin()],
+        normal: Vector2::new(angle.cos(), angle.sin()),
     }
 }
 
@@ -104,11 +106,11 @@ fn controller(mode: CccMode, gains0: PidGains) -> CrossCoupledController<Scripte
 fn off_mode_is_pure_axis_loops() {
     let mut c = controller(CccMode::Off, PidGains::new(100.0, 5000.0, 1.0));
     for (e, r, p) in script() {
-        let out = c.sample(r, p);
+        let out = c.sample(r.into(), p.into());
         let ex = r[0] - p[0];
         let ey = r[1] - p[1];
-        assert_eq!(out.following_error, [ex, ey]);
-        assert_eq!(out.u, [28.5 * ex, 31.0 * ey]);
+        assert_eq!(out.following_error, Vector2::new(ex, ey));
+        assert_eq!(out.u, Vector2::new(28.5 * ex, 31.0 * ey));
         assert_eq!(out.gains, (0.0, 0.0, 0.0));
         assert_eq!(out.contour, e); // the estimate is still reported
     }
@@ -122,7 +124,7 @@ fn fixed_mode_correction_is_normal_times_uc() {
     let mut sum = 0.0;
     let mut prev: Option<f64> = None;
     for (e, r, p) in script() {
-        let out = c.sample(r, p);
+        let out = c.sample(r.into(), p.into());
         let eps = e.error;
         sum += eps;
         let deps = prev.map_or(0.0, |q| eps - q);
@@ -149,7 +151,7 @@ fn fuzzy_gains_follow_the_engine() {
     let (mut sum, mut prev) = (0.0, None::<f64>);
     let mut clamped = 0;
     for (e, r, p) in script() {
-        let out = c.sample(r, p);
+        let out = c.sample(r.into(), p.into());
         let eps = e.error;
         let deps = prev.map_or(0.0, |q| eps - q);
         prev = Some(eps);
@@ -184,7 +186,7 @@ fn fuzzy_gains_are_plain_at_zero_error() {
         Scripted::new(vec![est(0.0, 0.0)]),
     )
     .unwrap();
-    let out = c.sample([0.0, 0.0], [0.0, 0.0]);
+    let out = c.sample(Vector2::new(0.0, 0.0), Vector2::new(0.0, 0.0));
     let g0 = CccConfig::default().gains0;
     assert!(close(out.gains.0, g0.kp));
     assert!(close(out.gains.1, g0.ki));
@@ -239,11 +241,11 @@ fn non_finite_estimate_gives_no_correction_and_keeps_state() {
         est(0.01, 0.0),
         ContourEstimate {
             error: f64::NAN,
-            normal: [1.0, 0.0],
+            normal: Vector2::new(1.0, 0.0),
         },
         ContourEstimate {
             error: 0.01,
-            normal: [f64::NAN, 0.0],
+            normal: Vector2::new(f64::NAN, 0.0),
         },
         est(0.01, 0.0),
     ];
@@ -256,15 +258,15 @@ fn non_finite_estimate_gives_no_correction_and_keeps_state() {
         ..ControllerConfig::default()
     };
     let mut c = CrossCoupledController::new(config, Scripted::new(script)).unwrap();
-    let first = c.sample([0.0, 0.0], [0.0, 0.0]);
+    let first = c.sample(Vector2::new(0.0, 0.0), Vector2::new(0.0, 0.0));
     assert!(close(first.u[0], 100.0 * 0.01 + 1000.0 * 0.01 * 1e-3));
     for _ in 0..2 {
-        let out = c.sample([0.0, 0.0], [0.0, 0.0]);
-        assert_eq!(out.u, [0.0, 0.0]);
+        let out = c.sample(Vector2::new(0.0, 0.0), Vector2::new(0.0, 0.0));
+        assert_eq!(out.u, Vector2::new(0.0, 0.0));
         assert_eq!(out.gains, (0.0, 0.0, 0.0));
     }
     assert_eq!(c.law().pid().integral(), 0.01 * 1e-3);
-    let last = c.sample([0.0, 0.0], [0.0, 0.0]);
+    let last = c.sample(Vector2::new(0.0, 0.0), Vector2::new(0.0, 0.0));
     assert!(close(last.u[0], 100.0 * 0.01 + 1000.0 * 0.02 * 1e-3));
 }
 
@@ -281,8 +283,8 @@ fn correction_is_limited_with_anti_windup() {
     };
     let mut c = CrossCoupledController::new(config, Scripted::new(vec![est(0.05, 0.0)])).unwrap();
     for _ in 0..1000 {
-        let out = c.sample([0.0, 0.0], [0.0, 0.0]);
-        assert_eq!(out.u, [2.0, 0.0]); // Kp·ε alone is 5 mm/s
+        let out = c.sample(Vector2::new(0.0, 0.0), Vector2::new(0.0, 0.0));
+        assert_eq!(out.u, Vector2::new(2.0, 0.0)); // Kp·ε alone is 5 mm/s
     }
     assert_eq!(c.law().pid().integral(), 0.0); // never integrated while saturated
 }
@@ -291,83 +293,86 @@ fn correction_is_limited_with_anti_windup() {
 fn validate_names_the_offending_parameter() {
     let base = ControllerConfig::default();
     assert_eq!(base.validate(), Ok(()));
-    let cases: Vec<(ControllerConfig, &str)> = vec![
-        (ControllerConfig { ts: 0.0, ..base }, "Ts"),
-        (ControllerConfig { ts: -1e-3, ..base }, "Ts"),
+    let cases: Vec<(ControllerConfig, Parameter)> = vec![
+        (ControllerConfig { ts: 0.0, ..base }, Parameter::Ts),
+        (ControllerConfig { ts: -1e-3, ..base }, Parameter::Ts),
         (
             ControllerConfig {
                 ts: f64::NAN,
                 ..base
             },
-            "Ts",
+            Parameter::Ts,
         ),
         (
             ControllerConfig {
                 ts: f64::INFINITY,
                 ..base
             },
-            "Ts",
+            Parameter::Ts,
         ),
         (
             ControllerConfig {
                 axis: [PidGains::p(-1.0), PidGains::p(28.5)],
                 ..base
             },
-            "axis.x.Kp",
+            Parameter::AxisGain(0, Gain::Kp),
         ),
         (
             ControllerConfig {
                 axis: [PidGains::p(28.5), PidGains::new(28.5, f64::NAN, 0.0)],
                 ..base
             },
-            "axis.y.Ki",
+            Parameter::AxisGain(1, Gain::Ki),
         ),
         (
             ControllerConfig {
                 axis_limit: Some(0.0),
                 ..base
             },
-            "axis.limit",
+            Parameter::AxisLimit,
         ),
     ];
-    let ccc_cases: Vec<(CccConfig, &str)> = vec![
+    let ccc_cases: Vec<(CccConfig, Parameter)> = vec![
         (
             CccConfig {
                 gains0: PidGains::new(-5.0, 0.0, 0.0),
                 ..base.ccc
             },
-            "ccc.Kp0",
+            Parameter::ContourGain(Gain::Kp),
         ),
         (
             CccConfig {
                 gains0: PidGains::new(1.0, f64::INFINITY, 0.0),
                 ..base.ccc
             },
-            "ccc.Ki0",
+            Parameter::ContourGain(Gain::Ki),
         ),
         (
             CccConfig {
                 gains0: PidGains::new(1.0, 1.0, -0.1),
                 ..base.ccc
             },
-            "ccc.Kd0",
+            Parameter::ContourGain(Gain::Kd),
         ),
         (
             CccConfig {
                 limit: Some(f64::NAN),
                 ..base.ccc
             },
-            "ccc.limit",
+            Parameter::ContourLimit,
         ),
     ];
     type Edit = fn(&mut FuzzyFactors);
-    let fuzzy_cases: [(Edit, &str); 6] = [
-        (|f| f.ke = -1.0, "fuzzy.ke"),
-        (|f| f.kde = -0.5, "fuzzy.kde"),
-        (|f| f.kpf = -87.0, "fuzzy.kp"),
-        (|f| f.kif = f64::NAN, "fuzzy.ki"),
-        (|f| f.kdf = -4.0, "fuzzy.kd"),
-        (|f| f.ke = f64::NEG_INFINITY, "fuzzy.ke"),
+    let fuzzy_cases: [(Edit, Parameter); 6] = [
+        (|f| f.ke = -1.0, Parameter::Fuzzy(FuzzyFactor::Ke)),
+        (|f| f.kde = -0.5, Parameter::Fuzzy(FuzzyFactor::Kde)),
+        (|f| f.kpf = -87.0, Parameter::Fuzzy(FuzzyFactor::Kpf)),
+        (|f| f.kif = f64::NAN, Parameter::Fuzzy(FuzzyFactor::Kif)),
+        (|f| f.kdf = -4.0, Parameter::Fuzzy(FuzzyFactor::Kdf)),
+        (
+            |f| f.ke = f64::NEG_INFINITY,
+            Parameter::Fuzzy(FuzzyFactor::Ke),
+        ),
     ];
     let mut all = cases;
     for (ccc, name) in ccc_cases {
@@ -381,7 +386,7 @@ fn validate_names_the_offending_parameter() {
     for (cfg, name) in all {
         let err: ConfigError = cfg.validate().unwrap_err();
         assert_eq!(err.parameter, name, "{err}");
-        assert!(err.to_string().contains(name));
+        assert!(err.to_string().contains(&name.to_string()));
         let estimator = CircleEstimator {
             centre: [0.0, 0.0],
             radius: 1.0,
@@ -434,7 +439,7 @@ fn closed_loop_max_error(c: &mut CrossCoupledController<CircleEstimator>) -> f64
     let mut p = circle_point(0.0);
     let mut worst: f64 = 0.0;
     for k in 0..2000 {
-        let out = c.sample(circle_point(k as f64 * ts), p);
+        let out = c.sample(circle_point(k as f64 * ts).into(), p.into());
         if k >= 1000 {
             worst = worst.max(out.contour.error.abs());
         }
@@ -471,7 +476,7 @@ fn reset_and_serde_restore_reproduce_the_run() {
             .map(|k| {
                 let t = k as f64 * 1e-3;
                 let p = circle_point(t - 0.02); // a lagging "actual" point
-                c.sample(circle_point(t), [p[0] + 1e-3, p[1]])
+                c.sample(circle_point(t).into(), Vector2::new(p[0] + 1e-3, p[1]))
             })
             .collect::<Vec<_>>()
     };

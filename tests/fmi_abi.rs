@@ -10,13 +10,13 @@ mod common;
 use common::*;
 use contour_fmu::models::{fault_probe as probe, xy_servo_plant as plant};
 
-const U_X: u32 = plant::U_X as u32;
-const U_Y: u32 = plant::U_Y as u32;
-const POS_X: u32 = plant::POS_X as u32;
-const POS_Y: u32 = plant::POS_Y as u32;
-const VEL_X: u32 = plant::VEL_X as u32;
+const U_X: u32 = plant::U.at(0).vr() as u32;
+const U_Y: u32 = plant::U.at(1).vr() as u32;
+const POS_X: u32 = plant::POS.at(0).vr() as u32;
+const POS_Y: u32 = plant::POS.at(1).vr() as u32;
+const VEL_X: u32 = plant::VEL.at(0).vr() as u32;
 const X_J: u32 = 6;
-const POS0_X: u32 = plant::POS0_X as u32;
+const POS0_X: u32 = plant::POS0.at(0).vr() as u32;
 
 // ---------------------------------------------------------------------------------------
 // State machine
@@ -74,11 +74,11 @@ fn probe_in(mode: Mode) -> Probe {
         StepComplete => {}
         Terminated => assert_eq!(i.terminate(), OK),
         Error => {
-            assert_eq!(i.set_boolean(probe::FAIL as u32, true), OK);
+            assert_eq!(i.set_boolean(probe::FAIL.vr() as u32, true), OK);
             assert_eq!(i.step(0.0, 0.1), ERROR);
         }
         Fatal => {
-            assert_eq!(i.set_boolean(probe::PANIC as u32, true), OK);
+            assert_eq!(i.set_boolean(probe::PANIC.vr() as u32, true), OK);
             assert_eq!(i.step(0.0, 0.1), FATAL);
         }
         _ => unreachable!(),
@@ -142,50 +142,50 @@ fn functions() -> Vec<(&'static str, Call, &'static [Mode], Answer)> {
         ("fmi2Reset", |p| p.i.reset(), ALIVE, Fine),
         (
             "fmi2GetReal",
-            |p| p.i.get_reals(&[probe::GAIN as u32]).0,
+            |p| p.i.get_reals(&[probe::GAIN.vr() as u32]).0,
             GET,
             Fine,
         ),
         (
             "fmi2GetInteger",
-            |p| p.i.get_integer(probe::STEPS as u32).0,
+            |p| p.i.get_integer(probe::STEPS.vr() as u32).0,
             GET,
             Fine,
         ),
         (
             "fmi2GetBoolean",
-            |p| p.i.get_boolean(probe::FAIL as u32).0,
+            |p| p.i.get_boolean(probe::FAIL.vr() as u32).0,
             GET,
             Fine,
         ),
         (
             "fmi2GetString",
-            |p| p.i.get_string(probe::LABEL as u32).0,
+            |p| p.i.get_string(probe::LABEL.vr() as u32).0,
             GET,
             Fine,
         ),
         (
             "fmi2SetReal",
             // A tunable parameter: settable in all three modes.
-            |p| p.i.set_reals(&[probe::GAIN as u32], &[2.0]),
+            |p| p.i.set_reals(&[probe::GAIN.vr() as u32], &[2.0]),
             SET,
             Fine,
         ),
         (
             "fmi2SetInteger",
-            |p| p.i.set_integer(probe::LEVEL as u32, 3),
+            |p| p.i.set_integer(probe::LEVEL.vr() as u32, 3),
             SET,
             Fine,
         ),
         (
             "fmi2SetBoolean",
-            |p| p.i.set_boolean(probe::FAIL as u32, false),
+            |p| p.i.set_boolean(probe::FAIL.vr() as u32, false),
             SET,
             Fine,
         ),
         (
             "fmi2SetString",
-            |p| p.i.set_string(probe::NOTE as u32, "x"),
+            |p| p.i.set_string(probe::NOTE.vr() as u32, "x"),
             SET,
             Fine,
         ),
@@ -361,7 +361,7 @@ fn functions() -> Vec<(&'static str, Call, &'static [Mode], Answer)> {
             |p| {
                 p.i.free();
                 // No status (void): the instance must be gone, so a call on it is refused.
-                let (s, _) = p.i.get_reals(&[probe::GAIN as u32]);
+                let (s, _) = p.i.get_reals(&[probe::GAIN.vr() as u32]);
                 assert_eq!(s, ERROR);
                 OK
             },
@@ -839,7 +839,7 @@ fn parameters_are_range_checked() {
 fn tunable_parameters_are_checked_by_the_model_and_restored_when_refused() {
     let i = Instance::new(&probe::INFO);
     i.start();
-    let gain = probe::GAIN as u32;
+    let gain = probe::GAIN.vr() as u32;
     assert_eq!(i.set_reals(&[gain], &[5.0]), OK);
     assert_eq!(i.set_reals(&[gain], &[12.0]), ERROR);
     assert!(i.last_error().contains("'gain' must be < 10"));
@@ -876,12 +876,12 @@ fn a_panic_in_a_model_becomes_fatal_and_the_instance_refuses_further_work() {
     let mut i = Instance::new(&probe::INFO);
     i.start();
     assert_eq!(i.step(0.0, 0.1), OK);
-    assert_eq!(i.set_boolean(probe::PANIC as u32, true), OK);
+    assert_eq!(i.set_boolean(probe::PANIC.vr() as u32, true), OK);
     assert_eq!(i.step(0.1, 0.1), FATAL);
     let fatal = i.messages(FATAL);
     assert_eq!(fatal.len(), 1);
     assert!(fatal[0].contains("fmi2DoStep: internal error (panic): FaultProbe: injected panic"));
-    assert_eq!(i.get_integer(probe::STEPS as u32).0, ERROR);
+    assert_eq!(i.get_integer(probe::STEPS.vr() as u32).0, ERROR);
     assert_eq!(i.reset(), ERROR);
     // Other instances are unaffected.
     let other = Instance::new(&probe::INFO);
@@ -897,7 +897,7 @@ fn a_failing_step_moves_to_error_and_a_saved_state_recovers() {
     assert_eq!(i.step(0.0, 0.1), OK);
     let (s, mut state) = i.get_state();
     assert_eq!(s, OK);
-    assert_eq!(i.set_boolean(probe::FAIL as u32, true), OK);
+    assert_eq!(i.set_boolean(probe::FAIL.vr() as u32, true), OK);
     assert_eq!(i.step(0.1, 0.1), ERROR);
     assert!(i.last_error().contains("FaultProbe: injected failure"));
     assert_eq!(i.step(0.1, 0.1), ERROR);
@@ -905,9 +905,9 @@ fn a_failing_step_moves_to_error_and_a_saved_state_recovers() {
         .last_error()
         .contains("illegal call sequence (state Error)"));
     assert_eq!(i.set_state(state), OK);
-    assert_eq!(i.get_boolean(probe::FAIL as u32), (OK, false));
+    assert_eq!(i.get_boolean(probe::FAIL.vr() as u32), (OK, false));
     assert_eq!(i.step(0.1, 0.1), OK);
-    assert_eq!(i.get_integer(probe::STEPS as u32), (OK, 2));
+    assert_eq!(i.get_integer(probe::STEPS.vr() as u32), (OK, 2));
     assert_eq!(i.free_state(&mut state), OK);
     assert!(state.is_null());
 }
@@ -917,8 +917,8 @@ fn strings_stay_valid_until_the_next_call() {
     let i = Instance::new(&probe::INFO);
     assert_eq!(i.setup(0.0, None), OK);
     assert_eq!(i.enter_init(), OK);
-    assert_eq!(i.set_string(probe::LABEL as u32, "spindle ✓"), OK);
-    let (s, ptr, text) = i.get_string(probe::ECHO as u32);
+    assert_eq!(i.set_string(probe::LABEL.vr() as u32, "spindle ✓"), OK);
+    let (s, ptr, text) = i.get_string(probe::ECHO.vr() as u32);
     assert_eq!((s, text.as_str()), (OK, "spindle ✓"));
     // Still readable after the caller's own work, before the next call.
     let again = unsafe { std::ffi::CStr::from_ptr(ptr) }

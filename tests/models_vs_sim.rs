@@ -145,9 +145,9 @@ fn run_models(name: &str, config: &SimConfig, samples: usize) -> (Trace, Vec<boo
         interpolator.step(t, h);
 
         trace.t.push(t);
-        trace.reference.push(reference);
-        trace.actual.push(actual);
-        trace.u.push([out[0], out[1]]);
+        trace.reference.push(reference.into());
+        trace.actual.push(actual.into());
+        trace.u.push([out[0], out[1]].into());
         trace.estimated_error.push(out[2]);
         trace.gains.push([out[3], out[4], out[5]]);
     }
@@ -171,9 +171,17 @@ fn compare(name: &str, mode: CccMode) -> Trace {
         let check = |what: &str, a: &[f64], b: &[f64]| {
             assert_eq!(bits(a), bits(b), "{label}: {what} at k={k}: {a:?} vs {b:?}");
         };
-        check("reference", &got.reference[k], &expected.reference[k]);
-        check("actual", &got.actual[k], &expected.actual[k]);
-        check("u", &got.u[k], &expected.u[k]);
+        check(
+            "reference",
+            got.reference[k].as_slice(),
+            expected.reference[k].as_slice(),
+        );
+        check(
+            "actual",
+            got.actual[k].as_slice(),
+            expected.actual[k].as_slice(),
+        );
+        check("u", got.u[k].as_slice(), expected.u[k].as_slice());
         check(
             "contour error",
             &[got.estimated_error[k]],

@@ -16,6 +16,7 @@ use contour_fmu::contour::{
 use contour_fmu::control::{
     CccConfig, CccMode, ControllerConfig, CrossCoupledController, FuzzyEngine,
 };
+use contour_fmu::geometry::Vector2;
 use contour_fmu::path::{builtin, Curve, Interpolator};
 use contour_fmu::sim::{SimConfig, Simulator};
 
@@ -175,20 +176,20 @@ fn allocations_during(f: impl FnOnce()) -> u64 {
 struct Circle;
 
 impl ContourEstimator for Circle {
-    fn estimate(&mut self, _reference: [f64; 2], p: [f64; 2]) -> ContourEstimate {
+    fn estimate(&mut self, _reference: Vector2, p: Vector2) -> ContourEstimate {
         let d = [p[0] + 10.0, p[1]];
         let rho = d[0].hypot(d[1]);
         ContourEstimate {
             error: rho - 10.0,
-            normal: [-d[0] / rho, -d[1] / rho],
+            normal: Vector2::new(-d[0] / rho, -d[1] / rho),
         }
     }
     fn reset(&mut self) {}
 }
 
-fn point(t: f64) -> [f64; 2] {
+fn point(t: f64) -> Vector2 {
     let a = std::f64::consts::PI * t;
-    [10.0 * a.cos() - 10.0, 10.0 * a.sin()]
+    Vector2::new(10.0 * a.cos() - 10.0, 10.0 * a.sin())
 }
 
 #[test]
@@ -226,7 +227,7 @@ fn sample_and_fuzzy_evaluation_do_not_allocate() {
         let count = allocations_during(|| {
             for k in 0..5_000 {
                 let out = controller.sample(black_box(point(k as f64 * ts)), black_box(p));
-                p = [p[0] + out.u[0] * ts, p[1] + out.u[1] * ts];
+                p = Vector2::new(p[0] + out.u[0] * ts, p[1] + out.u[1] * ts);
             }
             controller.reset();
             black_box(controller.sample(point(0.0), point(0.0)));
@@ -264,7 +265,7 @@ fn path_estimator_and_true_error_do_not_allocate() {
                 let lag = refs[k.saturating_sub(35)];
                 let d = path.eval(lag.u).d1;
                 let s = 0.1 / d[0].hypot(d[1]);
-                let p = [lag.point[0] - d[1] * s, lag.point[1] + d[0] * s];
+                let p = Vector2::new(lag.point[0] - d[1] * s, lag.point[1] + d[0] * s);
                 let est = estimator.estimate(black_box(refs[k].point), black_box(p));
                 let truth = index.error(black_box(p), hint);
                 hint = truth.u;

@@ -86,7 +86,10 @@ fn true_error_is_the_distance_to_the_segment_and_ccc_reduces_it() {
         let l = lag(28.5);
         (l - direction * l.dot(&direction)).norm_squared().sqrt()
     };
-    assert!((e_off - expected).abs() < 1e-6 * expected, "{e_off} vs {expected}");
+    assert!(
+        (e_off - expected).abs() < 1e-6 * expected,
+        "{e_off} vs {expected}"
+    );
     assert!(e_on < 1e-9, "with CCC {e_on} mm vs {e_off} mm without");
 }
 
@@ -98,8 +101,8 @@ fn in_the_xy_plane_the_run_is_the_planar_run() {
     let (a, b) = ([2.0, 1.0], [42.0, 31.0]);
     for mode in [CccMode::Off, CccMode::Fixed, CccMode::Fuzzy] {
         let three = {
-            let mut c = SimConfig::new(line3([a[0], a[1], 0.0], [b[0], b[1], 0.0]), FEED)
-                .with_mode(mode);
+            let mut c =
+                SimConfig::new(line3([a[0], a[1], 0.0], [b[0], b[1], 0.0]), FEED).with_mode(mode);
             c.plant.axes[1].inertia *= 1.5;
             Simulator::new(c).unwrap().run()
         };
@@ -112,12 +115,21 @@ fn in_the_xy_plane_the_run_is_the_planar_run() {
         for k in 0..two.trace.len() {
             let xy = |v: V3| Vector2::new(v[0], v[1]);
             let close = |x: Vector2, y: Vector2| (x - y).amax() <= 1e-10 * (1.0 + y.amax());
-            assert!(close(xy(three.trace.actual[k]), two.trace.actual[k]), "{mode:?} k={k}");
-            assert!(close(xy(three.trace.u[k]), two.trace.u[k]), "{mode:?} k={k}");
+            assert!(
+                close(xy(three.trace.actual[k]), two.trace.actual[k]),
+                "{mode:?} k={k}"
+            );
+            assert!(
+                close(xy(three.trace.u[k]), two.trace.u[k]),
+                "{mode:?} k={k}"
+            );
             assert_eq!(three.trace.actual[k][2], 0.0);
             assert_eq!(three.trace.u[k][2], 0.0);
             let (e3, e2) = (three.trace.estimated_error[k], two.trace.estimated_error[k]);
-            assert!((e3.abs() - e2.abs()).abs() <= 1e-12, "{mode:?} k={k}: {e3} vs {e2}");
+            assert!(
+                (e3.abs() - e2.abs()).abs() <= 1e-12,
+                "{mode:?} k={k}: {e3} vs {e2}"
+            );
         }
         let (m3, m2) = (three.metrics, two.metrics);
         assert!((m3.max_abs_error - m2.max_abs_error).abs() < 1e-12);
@@ -152,7 +164,13 @@ fn permuting_the_axes_permutes_the_run() {
     assert_eq!(original.trace.len(), permuted.trace.len());
     for k in 0..original.trace.len() {
         let close = |x: V3, y: V3| (x - y).amax() <= 1e-12 * (1.0 + x.amax());
-        assert!(close(perm(original.trace.actual[k]), permuted.trace.actual[k]), "k={k}");
-        assert!(close(perm(original.trace.u[k]), permuted.trace.u[k]), "k={k}");
+        assert!(
+            close(perm(original.trace.actual[k]), permuted.trace.actual[k]),
+            "k={k}"
+        );
+        assert!(
+            close(perm(original.trace.u[k]), permuted.trace.u[k]),
+            "k={k}"
+        );
     }
 }

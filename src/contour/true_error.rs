@@ -473,7 +473,7 @@ mod tests {
                 let e = path.eval(u);
                 let n = geometry::perp(&(e.d1 * (1.0 / geometry::norm(&e.d1))));
                 let off = (rnd() - 0.5) * if rnd() < 0.8 { 0.4 } else { 20.0 };
-                let p = (e.p + (n * off));
+                let p = e.p + n * off;
                 let g = true_error(&path, p);
                 for hint in [u, rnd(), 0.0] {
                     let h = idx.error(p, hint);

@@ -100,6 +100,11 @@ impl<E: ContourEstimator<D>, const D: usize> CrossCoupledController<E, D> {
         &self.law
     }
 
+    /// The per-axis contour PIDs, used for D ≥ 3 (state inspection).
+    pub fn contour_axes(&self) -> &[Pid; D] {
+        &self.contour_axes
+    }
+
     /// The position controllers, in axis order (state inspection).
     pub fn axes(&self) -> &[Pid; D] {
         &self.axes

@@ -184,7 +184,7 @@ impl SavedState for State {
         let config = controller.config();
         config
             .validate()
-            .map_err(|e| format!("controller configuration: {e}"))?;
+            .map_err(|e| format!("controller configuration: {}", config_message(e)))?;
         if self.clock.period() != config.ts {
             return Err(format!(
                 "sample clock period {} s differs from the controller's Ts = {} s",
@@ -196,6 +196,9 @@ impl SavedState for State {
             check_pid(&format!("{} position loop", axis.label), pid, config.ts)?;
         }
         check_pid("contour PID", controller.law().pid(), config.ts)?;
+        for (axis, pid) in XY.iter().zip(controller.contour_axes()) {
+            check_pid(&format!("{} contour PID", axis.label), pid, config.ts)?;
+        }
         state_check::all_positive(self, "radius").map_err(|e| format!("estimator: {e}"))?;
         state_check::all_finite(self)
     }

@@ -298,7 +298,7 @@ mod tests {
             ts,
         )
         .unwrap();
-        assert_eq!(it.point(), Vector2::new(0.0, 0.0).into());
+        assert_eq!(it.point(), Vector2::new(0.0, 0.0));
         for k in 1..2000 {
             let s = it.step();
             let t = k as f64 * ts;

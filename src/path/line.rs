@@ -86,8 +86,8 @@ mod tests {
     fn evaluates_3_4_5() {
         let l = Line::new(Vector2::new(1.0, 1.0), Vector2::new(4.0, 5.0)).unwrap();
         assert_eq!(l.length(), 5.0);
-        assert_eq!(l.point(0.5), Vector2::new(2.5, 3.0).into());
-        assert_eq!(l.eval(2.0).p, Vector2::new(4.0, 5.0).into());
+        assert_eq!(l.point(0.5), Vector2::new(2.5, 3.0));
+        assert_eq!(l.eval(2.0).p, Vector2::new(4.0, 5.0));
         let d = l.direction();
         assert!((d[0] - 0.6).abs() < 1e-15 && (d[1] - 0.8).abs() < 1e-15);
     }
