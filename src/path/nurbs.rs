@@ -338,11 +338,12 @@ impl<const D: usize> Curve<D> for Nurbs<D> {
             let i = s + j - p;
             let b = nj * self.weights[i];
             w += b;
-            for (ad, cd) in a.iter_mut().zip(self.ctrl[i].iter()) {
-                *ad += b * cd;
+            let c = &self.ctrl[i];
+            for d in 0..D {
+                a[d] += b * c[d];
             }
         }
-        Vector::from_fn(|d, _| a[d] / w)
+        Vector::from(a) / w
     }
 
     fn length_between(&self, u0: f64, u1: f64) -> f64 {
