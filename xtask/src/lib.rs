@@ -81,9 +81,20 @@ fn builder(root: &Path) -> Result<Builder, Error> {
 }
 
 fn generate_one(builder: Builder, path: &'static str) -> Result<Output, Error> {
-    let bindings = builder
-        .generate()
-        .map_err(|e| Error(format!("bindgen failed for {path}: {e}")))?;
+    // clang-sys panics when it cannot load libclang; say what to install instead.
+    let generated = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| builder.generate()))
+        .map_err(|panic| {
+        let why = panic
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| panic.downcast_ref::<&str>().copied())
+            .unwrap_or("unknown cause");
+        Error(format!(
+            "bindgen could not run for {path} ({why}); it needs libclang \
+                 (Debian: apt-get install libclang-dev, or `make bindings`)"
+        ))
+    })?;
+    let bindings = generated.map_err(|e| Error(format!("bindgen failed for {path}: {e}")))?;
     Ok(Output {
         path,
         contents: bindings.to_string(),
