@@ -8,7 +8,9 @@ use std::sync::{Mutex, OnceLock};
 
 use contour_fmu::models::{ModelInfo, Values};
 // Generated from third_party/fmi2/ by `cargo run -p xtask -- bindings` (kept as bindgen
-// wrote it): the FMI 2.0 types and `Fmi2Binding`, the dlopen'ed library's functions.
+// wrote it): `Fmi2Binding`, the dlopen'ed library's functions; the FMI 2.0 types are the
+// library's own.
+pub use contour_fmu::fmi2::bindings::*;
 #[rustfmt::skip]
 mod fmi2_library;
 pub use fmi2_library::*;

@@ -126,16 +126,20 @@ pub fn generate() -> Result<Vec<Output>, Error> {
         "the FMI 2.0 types, constants, callback-functions struct and fmi2...TYPE typedefs.",
     );
 
-    // The ABI tests' view: the same types plus `Fmi2Binding`, which dlopens a built FMU
-    // library (with libloading) and calls its fmi2* functions as an importer would.
+    // The ABI tests' view: `Fmi2Binding`, which dlopens a built FMU library (with
+    // libloading) and calls its fmi2* functions as an importer would. The types are the
+    // library's own (contour_fmu::fmi2::bindings), not a second copy.
     let test_library = with_preamble(
         builder(&root)?
             .allowlist_function("fmi2.*")
+            .blocklist_type("fmi2.*")
+            .blocklist_var("fmi2.*")
             .dynamic_library_name("Fmi2Binding")
             .dynamic_link_require_all(false),
-        "the FMI 2.0 types and `Fmi2Binding`, which loads an FMU's library and calls it.",
+        "`Fmi2Binding`, which loads an FMU's library and calls it (types from the library).",
     )
-    .raw_line("#![allow(clippy::missing_safety_doc, clippy::too_many_arguments)]");
+    .raw_line("#![allow(clippy::missing_safety_doc, clippy::too_many_arguments)]")
+    .raw_line("use contour_fmu::fmi2::bindings::*;");
 
     Ok(vec![
         generate_one(library, "src/fmi2/bindings.rs")?,
