@@ -13,7 +13,7 @@
 //! `estimator` parameter is not set: its default is the free-curve estimator the simulator
 //! uses.
 //!
-//! Coupling (as `tests/fmpy/master.py` in its Gauss-Seidel scheme, and README): at each
+//! Coupling (as `contour_fmu.master` (python/) in its Gauss-Seidel scheme, and README): at each
 //! step the controller reads ref (interpolator output) and pos (plant output) at t_k and
 //! steps, the plant reads the controller's u and steps over [t_k, t_k+1), then the
 //! interpolator steps. The plant's `pos0.*` get the interpolator's initial output (the path

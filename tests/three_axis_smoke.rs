@@ -65,7 +65,10 @@ fn true_error_is_the_distance_to_the_segment_and_ccc_reduces_it() {
             assert!((t.true_error[k] - d).abs() < 1e-12, "k={k}");
             // Exact line estimator: the estimate is the distance to the infinite line,
             // equal to the truth while the foot lies within the segment.
-            assert!(t.estimated_error[k] <= t.true_error[k] + 1e-12);
+            assert!(
+                t.estimated_error[k].abs() <= t.true_error[k] + 1e-12,
+                "k={k}"
+            );
         }
     }
     // Without coupling the offset F·d_z·(1/20 − 1/28.5) stays for the whole line; the

@@ -10,11 +10,13 @@ use crate::geometry::Vector;
 /// `error · normal` is the error vector from the actual point to its foot point on the
 /// path. In the plane `error` is signed (positive when the actual point lies right of the
 /// direction of travel) and `normal` is the path's left unit normal, so both stay smooth
-/// when the tool crosses the path; in higher dimensions `error` is the distance (≥ 0) and
-/// `normal` the unit vector toward the path.
+/// when the tool crosses the path. In space an estimator measures the distance and the
+/// unit vector toward the path and signs them continuously from sample to sample
+/// ([`ContinuousSign`](super::ContinuousSign)), so the error changes sign where the tool
+/// crosses the path, as in the plane.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ContourEstimate<const D: usize = 2> {
-    /// Contour error, mm: signed in the plane, the distance otherwise.
+    /// Contour error, mm, signed (see above).
     pub error: f64,
     /// Unit direction such that `error · normal` points from the actual point to the path.
     pub normal: Vector<D>,

@@ -39,6 +39,13 @@ impl<const D: usize> SpatialLineEstimator<D> {
 impl<const D: usize> ContourEstimator<D> for SpatialLineEstimator<D> {
     fn estimate(&mut self, _reference: Vector<D>, actual: Vector<D>) -> ContourEstimate<D> {
         let to_foot = self.foot(&actual) - actual;
+        if !geometry::is_finite(&to_foot) {
+            // A NaN or infinite position has no contour error to report, only NaN.
+            return ContourEstimate {
+                error: f64::NAN,
+                normal: to_foot,
+            };
+        }
         let error = geometry::norm(&to_foot);
         let normal = geometry::unit(&to_foot).unwrap_or_else(Vector::zeros);
         self.sign.orient(ContourEstimate { error, normal })
@@ -63,6 +70,10 @@ mod tests {
         assert!((est.vector() - Vector::<3>::new(0.0, -3.0, -4.0)).amax() < 1e-15);
         let on = e.estimate(r, Vector::<3>::new(7.0, 0.0, 0.0));
         assert_eq!((on.error, on.vector()), (0.0, Vector::<3>::zeros()));
+        let nan = e.estimate(r, Vector::<3>::new(f64::NAN, 1.0, 0.0));
+        assert!(nan.error.is_nan());
+        let inf = e.estimate(r, Vector::<3>::new(0.0, f64::INFINITY, 0.0));
+        assert!(inf.error.is_nan());
     }
 
     #[test]

@@ -25,7 +25,8 @@ use crate::path::{Arc, Curve, Line, Path};
 /// Exact contour error of one point.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrueError<const D: usize = 2> {
-    /// Distance to the path, mm; in the plane signed, positive right of travel.
+    /// Distance to the path, mm; for a planar [`Path`] signed, positive right of travel
+    /// (a path type without sides, e.g. a spatial line, reports the distance).
     pub error: f64,
     /// Unit direction with `error · normal` from the point to the foot point (in the
     /// plane: the path's left unit normal there).

@@ -127,7 +127,9 @@ impl<E: ContourEstimator<D>, const D: usize> CrossCoupledController<E, D> {
             if self.law.config().mode != CccMode::Off {
                 if D <= 2 {
                     u += n * step.correction;
-                } else {
+                } else if contour.error.is_finite() {
+                    // (A non-finite error gave no gains above; it must not reach the
+                    // per-axis integrals either.)
                     let error = contour.vector();
                     for (i, pid) in self.contour_axes.iter_mut().enumerate() {
                         pid.set_gains(step.gains);
@@ -151,5 +153,93 @@ impl<E: ContourEstimator<D>, const D: usize> CrossCoupledController<E, D> {
         self.contour_axes.iter_mut().for_each(Pid::reset);
         self.law.reset();
         self.estimator.reset();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contour::SpatialLineEstimator;
+    use crate::path::Line;
+
+    type V3 = Vector<3>;
+
+    /// An estimator that replays given (error, normal) pairs.
+    #[derive(Clone, Debug)]
+    struct Replay(Vec<ContourEstimate<3>>, usize);
+
+    impl ContourEstimator<3> for Replay {
+        fn estimate(&mut self, _r: V3, _p: V3) -> ContourEstimate<3> {
+            self.1 += 1;
+            self.0[self.1 - 1]
+        }
+        fn reset(&mut self) {
+            self.1 = 0;
+        }
+    }
+
+    fn fixed_config() -> ControllerConfig<3> {
+        let mut config = ControllerConfig::<3>::DEFAULT;
+        config.ccc.mode = CccMode::Fixed;
+        config
+    }
+
+    #[test]
+    fn in_space_the_correction_is_a_pid_per_axis_on_the_error_vector() {
+        // Kp0 = 100, Ki0 = 5000, Kd0 = 0, Ts = 1 ms, axis Kp = 28.5: with R = P the
+        // position loops give 0, and the correction is Kp·e + Ki·Σe·Ts per axis.
+        let e = |error, n: [f64; 3]| ContourEstimate {
+            error,
+            normal: V3::from(n),
+        };
+        let samples = vec![e(0.01, [0.0, 0.6, 0.8]), e(-0.02, [0.0, 0.6, 0.8])];
+        let mut c = CrossCoupledController::new(fixed_config(), Replay(samples, 0)).unwrap();
+        let p = V3::new(1.0, 2.0, 3.0);
+        let u1 = c.sample(p, p).u;
+        let v1 = V3::new(0.0, 0.006, 0.008);
+        let expected1 = v1 * 100.0 + v1 * (5000.0 * 1e-3);
+        assert!((u1 - expected1).amax() < 1e-12, "{u1:?} vs {expected1:?}");
+        let u2 = c.sample(p, p).u;
+        let v2 = V3::new(0.0, -0.012, -0.016);
+        let expected2 = v2 * 100.0 + (v1 + v2) * (5000.0 * 1e-3);
+        assert!((u2 - expected2).amax() < 1e-12, "{u2:?} vs {expected2:?}");
+    }
+
+    #[test]
+    fn in_space_a_non_finite_error_gives_no_correction_and_keeps_state() {
+        let e = |error| ContourEstimate {
+            error,
+            normal: V3::new(1.0, 0.0, 0.0),
+        };
+        let samples = vec![e(0.01), e(f64::NAN), e(f64::INFINITY), e(0.01)];
+        let mut c = CrossCoupledController::new(fixed_config(), Replay(samples, 0)).unwrap();
+        let p = V3::zeros();
+        let first = c.sample(p, p).u;
+        let integrals = c.contour_axes().each_ref().map(|pid| pid.integral());
+        for _ in 0..2 {
+            let out = c.sample(p, p);
+            assert_eq!(out.u, V3::zeros());
+            assert_eq!(
+                c.contour_axes().each_ref().map(|pid| pid.integral()),
+                integrals
+            );
+        }
+        let last = c.sample(p, p).u;
+        assert!(last[0].is_finite() && last[0] > first[0]);
+        c.reset();
+        assert!(c.contour_axes().iter().all(|pid| pid.integral() == 0.0));
+    }
+
+    #[test]
+    fn one_axis_has_no_contour_error_and_no_correction() {
+        let line = Line::<1>::new([0.0], [10.0]).unwrap();
+        let mut c = CrossCoupledController::new(
+            ControllerConfig::<1>::DEFAULT,
+            SpatialLineEstimator::new(&line),
+        )
+        .unwrap();
+        let out = c.sample(Vector::<1>::new(2.0), Vector::<1>::new(1.5));
+        assert_eq!(out.contour.error, 0.0);
+        assert_eq!(out.u[0], 28.5 * 0.5);
     }
 }

@@ -15,6 +15,10 @@ use crate::control::{
     CccConfig, CccMode, ConfigError, ControllerConfig, CrossCoupledController, FuzzyFactor,
     FuzzyFactors, Gain, Parameter, Pid, PidGains,
 };
+use crate::geometry::{Vector, Vector2};
+
+/// The three contour gains in use, as one block.
+type Vector3 = Vector<3>;
 
 /// The `estimator` parameter's type: an FMI Enumeration (importers show a drop-down), in
 /// the order of [`EstimatorKind::ALL`] (values 1, 2, 3).
@@ -275,8 +279,9 @@ fn config(values: &Values) -> ControllerConfig {
     }
 }
 
-/// The variable that sets a configuration value.
-fn variable_of(parameter: Parameter) -> &'static Variable {
+/// The variable that sets a configuration value, if one does (the FMU never sets an
+/// axis limit).
+fn variable_of(parameter: Parameter) -> Option<&'static Variable> {
     let gain = |g: Gain| match g {
         Gain::Kp => 0,
         Gain::Ki => 1,
@@ -284,28 +289,30 @@ fn variable_of(parameter: Parameter) -> &'static Variable {
     };
     let vr = match parameter {
         Parameter::Ts => TS.vr(),
-        Parameter::AxisGain(axis, g) => AXIS_GAINS.vr() + 3 * axis + gain(g),
-        // Not an FMU parameter (the FMU never sets an axis limit); the contour limit is
-        // the nearest thing a user can act on.
-        Parameter::AxisLimit | Parameter::ContourLimit => CCC_LIMIT.vr(),
-        Parameter::ContourGain(g) => CCC_GAINS0.vr() + gain(g),
-        Parameter::Fuzzy(f) => {
-            FUZZY_FACTORS.vr()
-                + match f {
-                    FuzzyFactor::Ke => 0,
-                    FuzzyFactor::Kde => 1,
-                    FuzzyFactor::Kpf => 2,
-                    FuzzyFactor::Kif => 3,
-                    FuzzyFactor::Kdf => 4,
-                }
-        }
+        Parameter::AxisGain(axis, g) => AXIS_GAINS.at(3 * axis + gain(g)).vr(),
+        Parameter::AxisLimit => return None,
+        Parameter::ContourLimit => CCC_LIMIT.vr(),
+        Parameter::ContourGain(g) => CCC_GAINS0.at(gain(g)).vr(),
+        Parameter::Fuzzy(f) => FUZZY_FACTORS
+            .at(match f {
+                FuzzyFactor::Ke => 0,
+                FuzzyFactor::Kde => 1,
+                FuzzyFactor::Kpf => 2,
+                FuzzyFactor::Kif => 3,
+                FuzzyFactor::Kdf => 4,
+            })
+            .vr(),
     };
-    &VARIABLES[vr]
+    Some(&VARIABLES[vr])
 }
 
-/// A configuration error in the FMU's own parameter names.
+/// A configuration error in the FMU's own parameter names (the library's name for a value
+/// no parameter sets).
 fn config_message(e: ConfigError) -> String {
-    e.message_for(&variable_of(e.parameter).name.to_string())
+    match variable_of(e.parameter) {
+        Some(v) => e.message_for(&v.name.to_string()),
+        None => e.to_string(),
+    }
 }
 
 /// The estimator kind the `estimator` value selects.
@@ -346,9 +353,10 @@ impl Model for ContourCcc2D {
             controller,
             clock: SampleClock::new(start_time, config.ts),
         });
-        for vr in U.vr()..CCC_GAINS.vr() + 3 {
-            values.set_real(vr, 0.0);
-        }
+        U.set(values, &Vector2::zeros());
+        CONTOUR_ERROR.set(values, 0.0);
+        ERR.set(values, &Vector2::zeros());
+        CCC_GAINS.set(values, &Vector3::zeros());
         Ok(())
     }
 
@@ -362,7 +370,7 @@ impl Model for ContourCcc2D {
             CONTOUR_ERROR.set(values, out.contour.error);
             ERR.set(values, &out.following_error);
             let (kp, ki, kd) = out.gains;
-            CCC_GAINS.set(values, &[kp, ki, kd].into());
+            CCC_GAINS.set(values, &Vector3::new(kp, ki, kd));
         }
         Ok(())
     }

@@ -4,8 +4,8 @@
 
 use std::fmt;
 
-/// Up to three static strings read as one.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// Up to three static strings read as one (compared and hashed as the joined text).
+#[derive(Clone, Copy, Debug)]
 pub struct Text {
     parts: [&'static str; 3],
 }
@@ -23,14 +23,24 @@ impl Text {
         Text { parts: [a, b, c] }
     }
 
-    /// Length in bytes of the joined text.
-    pub fn len(&self) -> usize {
-        self.parts.iter().map(|p| p.len()).sum()
+    /// The joined text's bytes.
+    fn bytes(&self) -> impl Iterator<Item = u8> + '_ {
+        self.parts.iter().flat_map(|p| p.bytes())
     }
+}
 
-    /// True when every part is empty.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
+impl PartialEq for Text {
+    fn eq(&self, other: &Text) -> bool {
+        self.bytes().eq(other.bytes())
+    }
+}
+
+impl Eq for Text {}
+
+impl std::hash::Hash for Text {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.parts.iter().for_each(|p| state.write(p.as_bytes()));
+        state.write_u8(0xff);
     }
 }
 
@@ -70,7 +80,12 @@ mod tests {
         assert_eq!(t, "axis.x.Kp");
         assert_ne!(t, "axis.x.K");
         assert_ne!(t, "axis.x.Kpp");
-        assert_eq!(t.len(), 9);
         assert_eq!(Text::plain("Ts"), "Ts");
+        // Equal texts are equal however they are split, and hash alike.
+        let whole = Text::plain("axis.x.Kp");
+        assert_eq!(t, whole);
+        assert_ne!(t, Text::plain("axis.y.Kp"));
+        let set: std::collections::HashSet<Text> = [t, whole].into_iter().collect();
+        assert_eq!(set.len(), 1);
     }
 }

@@ -25,7 +25,23 @@ pub struct Int(pub Vr);
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Str(pub Vr);
 
+/// Compile-time check that a declaration's variable has its handle's type.
+const fn expect(variable: Variable, real: bool, integer: bool, boolean: bool) -> Variable {
+    let ok = match variable.start {
+        Start::Real(_) => real,
+        Start::Integer(_) => integer,
+        Start::Boolean(_) => boolean,
+        Start::String(_) => !(real || integer || boolean),
+    };
+    assert!(ok, "a handle's kind differs from its variable's type");
+    variable
+}
+
 impl Real {
+    /// `variable`, checked to be a Real (used by `variable_table!`).
+    pub const fn checked(variable: Variable) -> Variable {
+        expect(variable, true, false, false)
+    }
     pub const fn vr(self) -> Vr {
         self.0
     }
@@ -38,6 +54,15 @@ impl Real {
 }
 
 impl<const N: usize> Reals<N> {
+    /// `block`, checked to hold Reals only (used by `variable_table!`).
+    pub const fn checked(block: [Variable; N]) -> [Variable; N] {
+        let mut i = 0;
+        while i < N {
+            expect(block[i], true, false, false);
+            i += 1;
+        }
+        block
+    }
     /// The first value reference.
     pub const fn vr(self) -> Vr {
         self.0
@@ -61,6 +86,10 @@ impl<const N: usize> Reals<N> {
 }
 
 impl Bool {
+    /// `variable`, checked to be a Boolean (used by `variable_table!`).
+    pub const fn checked(variable: Variable) -> Variable {
+        expect(variable, false, false, true)
+    }
     pub const fn vr(self) -> Vr {
         self.0
     }
@@ -73,6 +102,10 @@ impl Bool {
 }
 
 impl Int {
+    /// `variable`, checked to be an Integer (used by `variable_table!`).
+    pub const fn checked(variable: Variable) -> Variable {
+        expect(variable, false, true, false)
+    }
     pub const fn vr(self) -> Vr {
         self.0
     }
@@ -82,6 +115,10 @@ impl Int {
 }
 
 impl Str {
+    /// `variable`, checked to be a String (used by `variable_table!`).
+    pub const fn checked(variable: Variable) -> Variable {
+        expect(variable, false, false, false)
+    }
     pub const fn vr(self) -> Vr {
         self.0
     }
@@ -318,7 +355,9 @@ pub const fn assemble<const N: usize>(blocks: &[&[Variable]]) -> [Variable; N] {
 ///
 /// Each line yields a `pub const` handle numbered after the previous ones (a `Reals<N>`
 /// block is given as `[Variable; N]`, any other as one `Variable`), `VARIABLE_COUNT`, and
-/// the static table, assembled with every value reference set from the numbering.
+/// the static table, assembled with every value reference set from the numbering. A
+/// handle whose kind differs from its variable's type (`X: Real` over a Boolean) does not
+/// compile.
 macro_rules! variable_table {
     (static $table:ident; $($body:tt)*) => {
         $crate::models::variable_table::variable_table!(@handles 0usize; $($body)*);
@@ -348,11 +387,12 @@ macro_rules! variable_table {
         $crate::models::variable_table::variable_table!(@table $table [$($blocks,)* &{
             #[allow(unused_braces)]
             let block: [$crate::models::variables::Variable; $n] = $def;
-            block
+            $crate::models::variable_table::Reals::<$n>::checked(block)
         },] $($rest)*);
     };
     (@table $table:ident [$($blocks:expr,)*] $(#[$m:meta])* $name:ident : $kind:ident = $def:expr; $($rest:tt)*) => {
-        $crate::models::variable_table::variable_table!(@table $table [$($blocks,)* &[$def],] $($rest)*);
+        $crate::models::variable_table::variable_table!(@table $table [$($blocks,)*
+            &[$crate::models::variable_table::$kind::checked($def)],] $($rest)*);
     };
 }
 pub(crate) use variable_table;

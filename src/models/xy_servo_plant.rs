@@ -132,6 +132,10 @@ fn validate(table: &XyTable) -> Result<(), String> {
         axis.params()
             .validate()
             .map_err(|e| format!("axis {name}: {e}"))?;
+        // The FMU's parameters make ball screws only.
+        if !matches!(axis.params().transmission, Transmission::Linear { .. }) {
+            return Err(format!("axis {name}: a rotary transmission in an XY table"));
+        }
         state_check::all_finite(axis).map_err(|e| format!("axis {name}: {e}"))?;
         check_cached_transition(name, axis)?;
     }

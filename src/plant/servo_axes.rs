@@ -87,28 +87,41 @@ mod tests {
     use crate::plant::Transmission;
 
     #[test]
-    fn a_rotary_axis_follows_the_same_law_in_its_own_units() {
-        // Same drive, 10 mm lead vs a 50:1 gearbox: positions (mm vs rad) evolve alike,
-        // the motor current scales with motor angle per axis unit.
+    fn each_axis_is_its_own_servo_and_a_rotary_one_follows_the_same_law() {
+        // Axis by axis, the group equals a lone ServoAxis driven with that axis's command
+        // (so no command goes to the wrong axis); a 50:1 gearbox instead of the 10 mm
+        // screw gives the same trajectory in rad as in mm and scales the motor current
+        // by the motor angle per axis unit, 50 / (2π/10).
         let linear = AxisParams::PAPER;
         let rotary = AxisParams {
             transmission: Transmission::Rotary { ratio: 50.0 },
             ..AxisParams::PAPER
         };
-        let mut axes = ServoAxes::new(
-            ServoAxesParams {
-                axes: [linear, rotary, linear],
-            },
-            Vector::<3>::new(1.0, 1.0, -2.0),
-        );
-        for k in 0..200 {
+        let start = Vector::<3>::new(1.0, 1.0, -2.0);
+        let params = [linear, rotary, linear];
+        let mut axes = ServoAxes::new(ServoAxesParams { axes: params }, start);
+        let mut alone: [ServoAxis; 3] =
+            std::array::from_fn(|i| ServoAxis::new(params[i], start[i]));
+        let mut linear_twin = ServoAxis::new(linear, start[1]);
+        let command = |k: usize| {
             let v = (k as f64 * 0.01).sin();
-            axes.step(Vector::<3>::new(v, v, 2.0 * v), 1e-3);
+            Vector::<3>::new(v, 3.0 * v, -2.0 * v)
+        };
+        for k in 0..200 {
+            let u = command(k);
+            axes.step(u, 1e-3);
+            for (i, axis) in alone.iter_mut().enumerate() {
+                axis.step(u[i], 1e-3);
+            }
+            linear_twin.step(u[1], 1e-3);
         }
-        let p = axes.position();
-        assert_eq!(p[0], p[1]);
-        assert!((p[2] + 2.0 - 2.0 * (p[0] - 1.0)).abs() < 1e-12);
-        let (i_lin, i_rot) = (axes.axes[0].current(1.0), axes.axes[1].current(1.0));
+        for (i, axis) in alone.iter().enumerate() {
+            assert_eq!(axes.position()[i], axis.position());
+            assert_eq!(axes.velocity()[i], axis.velocity());
+        }
+        assert!((axes.position() - start).amax() > 0.01, "the axes moved");
+        assert_eq!(axes.position()[1], linear_twin.position());
+        let (i_lin, i_rot) = (linear_twin.current(1.0), axes.axes[1].current(1.0));
         assert!((i_rot / i_lin - 50.0 * 10.0 / (2.0 * std::f64::consts::PI)).abs() < 1e-9);
     }
 

@@ -37,14 +37,6 @@ impl Transmission {
         }
     }
 
-    /// The axis position's unit.
-    pub fn unit(&self) -> &'static str {
-        match self {
-            Transmission::Linear { .. } => "mm",
-            Transmission::Rotary { .. } => "rad",
-        }
-    }
-
     fn validate(&self) -> Result<(), String> {
         let (name, value) = match *self {
             Transmission::Linear { lead } => ("lead", lead),
