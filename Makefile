@@ -60,7 +60,7 @@ libtbb:
 # Everything `make test` installs.
 setup: libclang libtbb $(VENV)/.test-installed
 
-lint: libclang
+lint:
 	$(CARGO) fmt --all -- --check
 	$(CARGO) clippy --workspace --all-targets --features contour-fmu/test-hooks -- -D warnings
 

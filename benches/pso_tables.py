@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from contour_fmu.repo import cargo_package
+from contour_fmu.repo import TUNER_PACKAGE
 
 REPO = Path(__file__).resolve().parents[1]
 SEEDS, SWARM, ITERATIONS = 20, 30, 200
@@ -31,8 +31,7 @@ FUNCTIONS = {
 
 
 def example(name, *args):
-    package = cargo_package(name, "example", REPO)  # the PSO examples live in the tuner's crate
-    done = subprocess.run(["cargo", "run", "--quiet", "--release", "-p", package, "--example", name, "--",
+    done = subprocess.run(["cargo", "run", "--quiet", "--release", "-p", TUNER_PACKAGE, "--example", name, "--",
                            *map(str, args)], cwd=REPO, check=True, capture_output=True, text=True)
     return json.loads(done.stdout)
 

@@ -23,7 +23,7 @@ from contour_fmu.reference_paths import ContourReference
 
 REPO = Path(__file__).resolve().parents[1]
 
-# The default search box of ccc-tune (src/tuning/objective.rs, docs/design.md §4.4).
+# The default search box of ccc-tune (tuner/src/objective.rs, docs/design.md §4.4).
 SWARM, ITERATIONS, LOWER, UPPER = 50, 100, [0.0] * 5, [10.0, 10.0, 340.0, 6800.0, 3.8]
 
 

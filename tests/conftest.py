@@ -12,14 +12,12 @@ from pathlib import Path
 
 import pytest
 
-from contour_fmu.repo import cargo_package
+from contour_fmu.repo import LIBRARY_PACKAGE
 
 REPO = Path(__file__).resolve().parents[1]
 
 
-def _cargo_example(name, *args):
-    # -p: the example may live in any crate of the workspace (the PSO examples in the tuner's).
-    package = cargo_package(name, "example", REPO)
+def _cargo_example(name, *args, package=LIBRARY_PACKAGE):
     cmd = ["cargo", "run", "--quiet", "--release", "-p", package, "--example", name, "--", *map(str, args)]
     done = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, env=os.environ.copy())
     if done.returncode != 0:
@@ -29,9 +27,10 @@ def _cargo_example(name, *args):
 
 @pytest.fixture(scope="session")
 def rust_json():
-    """Run `cargo run -p PACKAGE --example NAME -- ARGS` and parse its standard output as JSON."""
+    """Run `cargo run -p PACKAGE --example NAME -- ARGS` (the library's crate unless
+    `package` says otherwise) and parse its standard output as JSON."""
 
-    def run(name, *args):
-        return json.loads(_cargo_example(name, *args))
+    def run(name, *args, package=LIBRARY_PACKAGE):
+        return json.loads(_cargo_example(name, *args, package=package))
 
     return run

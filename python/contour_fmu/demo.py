@@ -160,11 +160,8 @@ FMUS = ("PathInterpolator2D.fmu", "ContourCCC2D.fmu", "XYServoPlant.fmu")
 
 
 def build_ccc_tune():
-    """The cargo command that builds ccc-tune, in whichever crate of the workspace it is."""
-    try:
-        return f"cargo build --release -p {repo.cargo_package('ccc-tune')} --bin ccc-tune"
-    except (OSError, subprocess.SubprocessError, LookupError, repo.RepoNotFound):
-        return "cargo build --release --bin ccc-tune"
+    """The cargo command that builds ccc-tune."""
+    return f"cargo build --release -p {repo.TUNER_PACKAGE} --bin ccc-tune"
 
 
 def parse_args(argv=None):

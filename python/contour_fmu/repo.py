@@ -11,11 +11,8 @@ A checkout is a folder holding a Cargo.toml and python/pyproject.toml of the pro
 "contour-fmu". Cargo's CARGO_TARGET_DIR, when set, stands for <root>/target, as for cargo.
 """
 
-import json
 import os
-import subprocess
 import tomllib
-from functools import lru_cache
 from pathlib import Path
 
 ENV = "CONTOUR_FMU_REPO"
@@ -87,21 +84,7 @@ def ccc_tune():
     return target_dir() / "release" / "ccc-tune"
 
 
-@lru_cache(maxsize=None)
-def _workspace_targets(checkout):
-    done = subprocess.run(["cargo", "metadata", "--no-deps", "--format-version", "1"],
-                          cwd=checkout, capture_output=True, text=True, check=True)
-    return [(package["name"], target["name"], tuple(target["kind"]))
-            for package in json.loads(done.stdout)["packages"] for target in package["targets"]]
-
-
-def cargo_package(target, kind="bin", checkout=None):
-    """The workspace package that has the Cargo target `target` of kind `kind` ("bin",
-    "example", "bench", ...), for `cargo run -p PACKAGE --bin/--example TARGET`: callers
-    need not know which crate of the workspace holds a target."""
-    checkout = Path(checkout) if checkout is not None else root()
-    owners = [package for package, name, kinds in _workspace_targets(str(checkout))
-              if name == target and kind in kinds]
-    if len(owners) != 1:
-        raise LookupError(f"{len(owners)} workspace packages have the {kind} target {target!r}")
-    return owners[0]
+# The workspace crates that hold the cargo targets the Python side runs: the library
+# (the FMUs, the dump examples) and the tuner (ccc-tune, the PSO examples).
+LIBRARY_PACKAGE = "contour-fmu"
+TUNER_PACKAGE = "contour-tune"

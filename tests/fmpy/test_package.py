@@ -3,6 +3,7 @@ its pins agree with requirements/, it finds the checkout from anywhere, and the 
 command line answers without a run."""
 
 import importlib.metadata
+import json
 import re
 import subprocess
 import sys
@@ -87,12 +88,16 @@ def test_default_paths_follow_cargo_target_dir(tmp_path, monkeypatch):
     assert repo.fmu_dir() == tmp_path / "fmu"
 
 
-def test_cargo_targets_are_found_in_their_crates():
-    assert repo.cargo_package("fmu-build", "bin", REPO) == "fmu-build"
-    assert repo.cargo_package("nurbs_dump", "example", REPO) == "contour-fmu"
-    assert repo.cargo_package("ccc-tune", "bin", REPO) in ("contour-fmu", "contour-tune")
-    with pytest.raises(LookupError):
-        repo.cargo_package("no-such-target", "bin", REPO)
+def test_the_package_constants_name_the_crates_that_hold_the_targets():
+    # What cargo says, not what we wrote down: a renamed crate or moved target fails here.
+    done = subprocess.run(["cargo", "metadata", "--no-deps", "--format-version", "1"],
+                          cwd=REPO, capture_output=True, text=True, check=True)
+    targets = {(p["name"], t["name"]) for p in json.loads(done.stdout)["packages"]
+               for t in p["targets"]}
+    for target in ("ccc-tune", "pso_benchmarks", "pso_claim"):
+        assert (repo.TUNER_PACKAGE, target) in targets
+    for target in ("nurbs_dump", "fuzzy_dump", "closed_loop_dump"):
+        assert (repo.LIBRARY_PACKAGE, target) in targets
 
 
 def demo(*args, cwd):
@@ -113,5 +118,5 @@ def test_demo_refuses_missing_fmus_and_tuner_before_running(fmu_dir, tmp_path):
     assert done.returncode == 2 and "fmu-build" in done.stderr, done.stderr
     done = demo("--fmu-dir", str(fmu_dir), "--out", str(out), "--tune",
                 "--ccc-tune", str(tmp_path / "ccc-tune"), cwd=REPO)
-    assert done.returncode == 2 and "--bin ccc-tune" in done.stderr, done.stderr
+    assert done.returncode == 2 and "-p contour-tune --bin ccc-tune" in done.stderr, done.stderr
     assert not out.exists()

@@ -16,8 +16,7 @@ PAPER = {"fuzzy.ke": 1.0, "fuzzy.kde": 1.2, "fuzzy.kp": 87.0, "fuzzy.ki": 8.5, "
 
 @pytest.fixture(scope="session")
 def ccc_tune():
-    package = repo.cargo_package("ccc-tune", "bin", REPO)
-    subprocess.run(["cargo", "build", "--quiet", "--release", "-p", package, "--bin", "ccc-tune"],
+    subprocess.run(["cargo", "build", "--quiet", "--release", "-p", repo.TUNER_PACKAGE, "--bin", "ccc-tune"],
                    cwd=REPO, check=True)
     return str(target_dir() / "release" / "ccc-tune")
 

@@ -10,6 +10,7 @@ the improved-vs-standard comparison are benchmarks, not tests (`benches/pso_tabl
 
 import numpy as np
 import pytest
+from contour_fmu.repo import TUNER_PACKAGE
 
 SEEDS, SWARM, ITERATIONS = 20, 30, 200
 
@@ -24,7 +25,7 @@ TOLERANCE = {"sphere": 1e-8, "rosenbrock": 4.0, "rastrigin": 10.0}
 
 @pytest.mark.parametrize("name", FUNCTIONS)
 def test_pso_reaches_the_known_optima(rust_json, name):
-    ours = rust_json("pso_benchmarks", SEEDS, SWARM, ITERATIONS)[name]
+    ours = rust_json("pso_benchmarks", SEEDS, SWARM, ITERATIONS, package=TUNER_PACKAGE)[name]
     f = FUNCTIONS[name]
     for algorithm in ("standard", "improved"):
         runs = ours[algorithm]

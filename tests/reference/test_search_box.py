@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from fmpy import read_model_description
 
-from contour_fmu.repo import cargo_package
+from contour_fmu.repo import TUNER_PACKAGE
 from contour_loop import critical
 
 REPO = Path(__file__).resolve().parents[2]
@@ -23,8 +23,7 @@ LARGEST_INCREMENT = {"kp": 8 / 3, "ki": 2.0, "kd": 1.0}
 @pytest.fixture(scope="module")
 def box(tmp_path_factory):
     out = tmp_path_factory.mktemp("box") / "box.json"
-    package = cargo_package("ccc-tune", "bin", REPO)
-    subprocess.run(["cargo", "run", "--quiet", "--release", "-p", package, "--bin", "ccc-tune", "--",
+    subprocess.run(["cargo", "run", "--quiet", "--release", "-p", TUNER_PACKAGE, "--bin", "ccc-tune", "--",
                     "--swarm", "1", "--iters", "1", "--out", str(out)],
                    cwd=REPO, check=True, capture_output=True)
     settings = json.loads(out.read_text())["settings"]
