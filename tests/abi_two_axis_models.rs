@@ -99,6 +99,21 @@ fn controller_reference(samples: usize) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// Asserts that the coarser runs equal the finest (`runs[0]`) wherever their output
+/// times coincide (bit for bit); returns how many points were compared.
+fn compare_at_shared_points<T: PartialEq + std::fmt::Debug>(runs: &[BTreeMap<u64, T>]) -> usize {
+    let mut shared = 0;
+    for run in &runs[1..] {
+        for (t, out) in run {
+            if let Some(fine) = runs[0].get(t) {
+                assert_eq!(out, fine, "t = {t} us");
+                shared += 1;
+            }
+        }
+    }
+    shared
+}
+
 #[test]
 fn controller_outputs_do_not_depend_on_the_communication_step_and_match_the_library() {
     let stop = 0.1;
@@ -118,15 +133,7 @@ fn controller_outputs_do_not_depend_on_the_communication_step_and_match_the_libr
         assert_eq!(out, &reference[n - 1], "t = {t} us");
     }
     // The 2.5 and 5 ms runs give the same values at their points (5 ms apart in common).
-    let mut shared = 0;
-    for run in &runs[1..] {
-        for (t, out) in run {
-            if let Some(fine) = runs[0].get(t) {
-                assert_eq!(out, fine, "t = {t} us");
-                shared += 1;
-            }
-        }
-    }
+    let shared = compare_at_shared_points(&runs);
     assert_eq!(shared, 20 + 20);
     // The controller really acted: a velocity command and a fuzzy-adapted Kp.
     let last = &reference[99];
@@ -187,15 +194,7 @@ fn interpolator_outputs_do_not_depend_on_the_communication_step_and_match_the_li
             "t = {t} us"
         );
     }
-    let mut shared = 0;
-    for run in &runs[1..] {
-        for (t, out) in run {
-            if let Some(fine) = runs[0].get(t) {
-                assert_eq!(out, fine, "t = {t} us");
-                shared += 1;
-            }
-        }
-    }
+    let shared = compare_at_shared_points(&runs);
     assert_eq!(shared, 40 + 40);
     // 0.2 s at 40 mm/s: 8 mm along the path from the start point (40.2, -0.1).
     let (x, y, done) = runs[0][&200_000];

@@ -167,9 +167,7 @@ fn signed(p: Vector2, foot: Vector2, t: Vector2, u: f64) -> TrueError {
 
 /// Exact distance to a finite segment.
 fn line_true_error(l: &Line, p: Vector2) -> TrueError {
-    let a = l.start();
-    let d = l.end() - a;
-    let u = ((p - a).dot(&d) / d.dot(&d)).clamp(0.0, 1.0);
+    let u = l.nearest_parameter(&p);
     signed(p, l.point(u), l.direction(), u)
 }
 

@@ -25,26 +25,36 @@ pub struct Int(pub Vr);
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Str(pub Vr);
 
-/// Compile-time check that a declaration's variable has its handle's type.
-const fn expect(variable: Variable, real: bool, integer: bool, boolean: bool) -> Variable {
-    let ok = match variable.start {
-        Start::Real(_) => real,
-        Start::Integer(_) => integer,
-        Start::Boolean(_) => boolean,
-        Start::String(_) => !(real || integer || boolean),
+/// The compile-time type check and the value reference of a one-variable handle.
+macro_rules! scalar_handle {
+    ($handle:ident, $start:pat, $type_name:literal) => {
+        impl $handle {
+            /// `variable`, checked to have the handle's type (used by `variable_table!`).
+            pub const fn checked(variable: Variable) -> Variable {
+                assert!(
+                    matches!(variable.start, $start),
+                    concat!(
+                        "a ",
+                        stringify!($handle),
+                        " handle over a variable not of type ",
+                        $type_name
+                    )
+                );
+                variable
+            }
+            pub const fn vr(self) -> Vr {
+                self.0
+            }
+        }
     };
-    assert!(ok, "a handle's kind differs from its variable's type");
-    variable
 }
 
+scalar_handle!(Real, Start::Real(_), "Real");
+scalar_handle!(Bool, Start::Boolean(_), "Boolean");
+scalar_handle!(Int, Start::Integer(_), "Integer");
+scalar_handle!(Str, Start::String(_), "String");
+
 impl Real {
-    /// `variable`, checked to be a Real (used by `variable_table!`).
-    pub const fn checked(variable: Variable) -> Variable {
-        expect(variable, true, false, false)
-    }
-    pub const fn vr(self) -> Vr {
-        self.0
-    }
     pub fn get(self, values: &Values) -> f64 {
         values.real(self.0)
     }
@@ -58,7 +68,7 @@ impl<const N: usize> Reals<N> {
     pub const fn checked(block: [Variable; N]) -> [Variable; N] {
         let mut i = 0;
         while i < N {
-            expect(block[i], true, false, false);
+            Real::checked(block[i]);
             i += 1;
         }
         block
@@ -86,13 +96,6 @@ impl<const N: usize> Reals<N> {
 }
 
 impl Bool {
-    /// `variable`, checked to be a Boolean (used by `variable_table!`).
-    pub const fn checked(variable: Variable) -> Variable {
-        expect(variable, false, false, true)
-    }
-    pub const fn vr(self) -> Vr {
-        self.0
-    }
     pub fn get(self, values: &Values) -> bool {
         values.boolean(self.0)
     }
@@ -102,26 +105,12 @@ impl Bool {
 }
 
 impl Int {
-    /// `variable`, checked to be an Integer (used by `variable_table!`).
-    pub const fn checked(variable: Variable) -> Variable {
-        expect(variable, false, true, false)
-    }
-    pub const fn vr(self) -> Vr {
-        self.0
-    }
     pub fn get(self, values: &Values) -> i32 {
         values.integer(self.0)
     }
 }
 
 impl Str {
-    /// `variable`, checked to be a String (used by `variable_table!`).
-    pub const fn checked(variable: Variable) -> Variable {
-        expect(variable, false, false, false)
-    }
-    pub const fn vr(self) -> Vr {
-        self.0
-    }
     pub fn get(self, values: &Values) -> &str {
         values.string(self.0)
     }

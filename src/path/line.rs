@@ -36,6 +36,12 @@ impl<const D: usize> Line<D> {
         self.b
     }
 
+    /// Parameter of the segment's point nearest `p` (the foot point, or an end).
+    pub fn nearest_parameter(&self, p: &Vector<D>) -> f64 {
+        let d = self.b - self.a;
+        ((p - self.a).dot(&d) / d.dot(&d)).clamp(0.0, 1.0)
+    }
+
     /// Unit direction of travel.
     pub fn direction(&self) -> Vector<D> {
         let d = self.b - self.a;

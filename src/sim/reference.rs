@@ -50,9 +50,7 @@ impl<const D: usize> ReferencePath<D> for Line<D> {
     }
     /// Distance to the segment (not the infinite line: the truth counts overshoot).
     fn true_error(line: &Line<D>, p: Vector<D>, _hint: f64) -> TrueError<D> {
-        let a = line.start();
-        let d = line.end() - a;
-        let u = ((p - a).dot(&d) / d.dot(&d)).clamp(0.0, 1.0);
+        let u = line.nearest_parameter(&p);
         let foot = line.point(u);
         let error = crate::geometry::dist(&foot, &p);
         let normal = crate::geometry::unit(&(foot - p)).unwrap_or_else(Vector::zeros);

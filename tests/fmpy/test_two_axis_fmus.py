@@ -183,18 +183,24 @@ def test_interpolator_output_is_independent_of_the_communication_step(fmu_dir):
 # ---------------------------------------------------------------------------------------
 # FMU state of the controller covers the estimator history and the PID memories.
 
+def step_controller(slave, k0, k1, input_time):
+    """1 ms steps k0 … k1 - 1 of a controller with inputs held_inputs(input_time(k)); the
+    outputs after each step."""
+    inputs = [slave.vr[n] for n in ("ref.x", "ref.y", "pos.x", "pos.y")]
+    out = []
+    for k in range(k0, k1):
+        slave.fmu.setReal(inputs, held_inputs(input_time(k)))
+        slave.fmu.doStep(currentCommunicationPoint=k * 0.001, communicationStepSize=0.001)
+        out.append(slave.reals(CONTROLLER_OUTPUTS))
+    return np.array(out)
+
+
 def test_controller_state_restores_the_estimator_and_pid_memories(controller):
     c = controller
     c.fmu.exitInitializationMode()
-    inputs = [c.vr[n] for n in ("ref.x", "ref.y", "pos.x", "pos.y")]
 
     def go(k0, k1):
-        out = []
-        for k in range(k0, k1):
-            c.fmu.setReal(inputs, held_inputs(k * 0.005))
-            c.fmu.doStep(currentCommunicationPoint=k * 0.001, communicationStepSize=0.001)
-            out.append(c.reals(CONTROLLER_OUTPUTS))
-        return np.array(out)
+        return step_controller(c, k0, k1, lambda k: k * 0.005)
 
     go(0, 40)
     state = c.fmu.getFMUstate()
@@ -213,15 +219,9 @@ def test_a_saved_state_continues_in_a_fresh_instance_without_initialization(fmu_
     """fmusim's --initial-fmu-state-file: instantiate, deserialize, set, then step on."""
     c = controller
     c.fmu.exitInitializationMode()
-    inputs = [c.vr[n] for n in ("ref.x", "ref.y", "pos.x", "pos.y")]
 
     def go(slave, k0, k1):
-        out = []
-        for k in range(k0, k1):
-            slave.fmu.setReal(inputs, held_inputs(k * 0.001))
-            slave.fmu.doStep(currentCommunicationPoint=k * 0.001, communicationStepSize=0.001)
-            out.append(slave.reals(CONTROLLER_OUTPUTS))
-        return np.array(out)
+        return step_controller(slave, k0, k1, lambda k: k * 0.001)
 
     go(c, 0, 30)
     state = c.fmu.getFMUstate()
