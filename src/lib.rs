@@ -8,6 +8,7 @@ pub mod contour;
 pub mod control;
 pub mod fmi2;
 pub mod geometry;
+pub mod kinematics;
 pub mod models;
 pub mod path;
 pub mod plant;
