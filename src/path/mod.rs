@@ -8,6 +8,7 @@
 
 pub mod arc;
 pub mod builtin;
+pub mod cl_data;
 pub mod file;
 pub mod interpolator;
 pub mod line;
