@@ -45,6 +45,20 @@ impl ServoAxesParams<2> {
     }
 }
 
+impl ServoAxesParams<5> {
+    /// A small five-axis machine: X, Y, Z as the paper's axis, A and C on a trunnion
+    /// table ([`AxisParams::TRUNNION_A`], [`AxisParams::TRUNNION_C`]).
+    pub const TRUNNION: ServoAxesParams<5> = ServoAxesParams {
+        axes: [
+            AxisParams::PAPER,
+            AxisParams::PAPER,
+            AxisParams::PAPER,
+            AxisParams::TRUNNION_A,
+            AxisParams::TRUNNION_C,
+        ],
+    };
+}
+
 /// `D` servo axes driven by velocity commands.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ServoAxes<const D: usize> {
@@ -123,6 +137,31 @@ mod tests {
         assert_eq!(axes.position()[1], linear_twin.position());
         let (i_lin, i_rot) = (linear_twin.current(1.0), axes.axes[1].current(1.0));
         assert!((i_rot / i_lin - 50.0 * 10.0 / (2.0 * std::f64::consts::PI)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_trunnion_axes_have_a_first_order_50_hz_velocity_loop() {
+        // With the PI zero on the mechanical pole the velocity loop is exactly
+        // 1/(1 + s/314): from rest a unit velocity step gives v(t) = 1 − e^(−314·t) and
+        // x(t) = t − (1 − e^(−314·t))/314, in rad for A and C. (The paper's linear axis,
+        // with its rounded gains, is the same law to 0.1 %.)
+        let params = ServoAxesParams::<5>::TRUNNION;
+        params.validate().unwrap();
+        let mut axes = ServoAxes::new(params, Vector::<5>::zeros());
+        for k in 1..=50 {
+            axes.step(Vector::<5>::repeat(1.0), 2e-4);
+            let t = k as f64 * 2e-4;
+            let v = 1.0 - (-314.0 * t).exp();
+            let x = t - v / 314.0;
+            for i in 0..5 {
+                let tolerance = if i < 3 { 1e-3 } else { 1e-9 };
+                assert!((axes.velocity()[i] - v).abs() < tolerance, "axis {i} t={t}");
+                assert!(
+                    (axes.position()[i] - x).abs() < tolerance * t,
+                    "axis {i} t={t}"
+                );
+            }
+        }
     }
 
     #[test]
