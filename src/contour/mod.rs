@@ -7,6 +7,7 @@ pub mod choice;
 pub mod continuous_sign;
 pub mod estimate;
 pub mod free_curve;
+pub mod hmm;
 pub mod line;
 mod local_circle;
 pub mod spatial_line;
