@@ -72,7 +72,28 @@ pub struct HmmParams {
     pub angle_weight: f64,
 }
 
-/// The cost c(k, j) of segment `j` for the observation (`tip`, `second`) moving by `motion`.
+/// The cost of the segment with tips `r` and second points `s` for the observation
+/// (`tip`, `second`) that moved by `motion` since the previous sample.
+#[allow(clippy::too_many_arguments)]
+pub fn segment_cost(
+    params: &HmmParams,
+    r: [&Vector<3>; 2],
+    s: [&Vector<3>; 2],
+    tip: &Vector<3>,
+    second: &Vector<3>,
+    motion: &Vector<3>,
+) -> f64 {
+    let turn = if *motion == Vector::<3>::zeros() {
+        0.0
+    } else {
+        angle_between(motion, &(r[1] - r[0]))
+    };
+    segment_distance(tip, r[0], r[1])
+        + segment_distance(second, s[0], s[1])
+        + params.angle_weight * turn
+}
+
+/// The cost c(k, j) of segment `j` of `reference`.
 pub fn state_cost(
     reference: &ReferencePolyline,
     params: &HmmParams,
@@ -81,14 +102,15 @@ pub fn state_cost(
     second: &Vector<3>,
     motion: &Vector<3>,
 ) -> f64 {
-    let (r0, r1) = (&reference.tips[j], &reference.tips[j + 1]);
-    let (s0, s1) = (&reference.seconds[j], &reference.seconds[j + 1]);
-    let turn = if *motion == Vector::<3>::zeros() {
-        0.0
-    } else {
-        angle_between(motion, &(r1 - r0))
-    };
-    segment_distance(tip, r0, r1) + segment_distance(second, s0, s1) + params.angle_weight * turn
+    let (r, s) = (&reference.tips, &reference.seconds);
+    segment_cost(
+        params,
+        [&r[j], &r[j + 1]],
+        [&s[j], &s[j + 1]],
+        tip,
+        second,
+        motion,
+    )
 }
 
 /// The nearest segment of every sample (tip plus second-point distance), for comparison.

@@ -8,6 +8,7 @@ pub mod continuous_sign;
 pub mod estimate;
 pub mod free_curve;
 pub mod hmm;
+pub mod hmm_online;
 pub mod line;
 mod local_circle;
 pub mod spatial_line;
