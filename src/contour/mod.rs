@@ -11,6 +11,7 @@ pub mod hmm;
 pub mod hmm_online;
 pub mod line;
 mod local_circle;
+pub mod pose_error;
 pub mod spatial_line;
 pub mod true_error;
 

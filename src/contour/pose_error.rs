@@ -1,0 +1,130 @@
+//! The per-sample five-axis contour errors used for control (docs/design.md §5.3): the
+//! actual tool tip against its mapped reference segment — the error vector to the foot
+//! point — and the actual tool axis against the reference axis at that foot point,
+//! slerped between the segment's end axes.
+
+use crate::geometry::{self, Vector};
+use crate::kinematics::Pose;
+
+use super::hmm::angle_between;
+
+/// Spherical interpolation of unit vectors: the unit vector a fraction `t` of the way
+/// from `a` to `b` along the great circle; `None` for opposite vectors (no unique way).
+pub fn slerp(a: &Vector<3>, b: &Vector<3>, t: f64) -> Option<Vector<3>> {
+    let angle = angle_between(a, b);
+    if angle > std::f64::consts::PI - 1e-9 {
+        return None;
+    }
+    if angle < 1e-9 {
+        // sin θ ≈ θ: the linear blend, normalised, is exact to rounding here.
+        return geometry::unit(&(a * (1.0 - t) + b * t));
+    }
+    let s = angle.sin();
+    Some(a * (((1.0 - t) * angle).sin() / s) + b * ((t * angle).sin() / s))
+}
+
+/// Contour errors of one pose against one reference segment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PoseError {
+    /// From the actual tip to the foot point on the segment, mm.
+    pub tip: Vector<3>,
+    /// Angle from the actual tool axis to the reference axis at the foot point, rad.
+    pub orientation: f64,
+    /// Rotation axis (unit) turning the actual axis onto the reference one, times the
+    /// angle: the orientation part of the error 6-vector (zero when aligned).
+    pub rotation: Vector<3>,
+    /// Where the foot point lies on the segment, 0 … 1.
+    pub fraction: f64,
+}
+
+/// The errors of `actual` against the segment from pose `r0` to pose `r1` (tips joined
+/// by a straight line, axes by slerp). `None` when the segment's axes are opposite or an
+/// input is not finite.
+pub fn foot_point_error(r0: &Pose, r1: &Pose, actual: &Pose) -> Option<PoseError> {
+    let finite = [r0.tip, r0.axis, r1.tip, r1.axis, actual.tip, actual.axis]
+        .iter()
+        .all(geometry::is_finite);
+    if !finite {
+        return None;
+    }
+    let d = r1.tip - r0.tip;
+    let len2 = d.dot(&d);
+    let fraction = if len2 > 0.0 {
+        ((actual.tip - r0.tip).dot(&d) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let foot = r0.tip + d * fraction;
+    let reference_axis = slerp(&r0.axis, &r1.axis, fraction)?;
+    let actual_axis = geometry::unit(&actual.axis)?;
+    let orientation = angle_between(&actual_axis, &reference_axis);
+    let rotation = geometry::unit(&actual_axis.cross(&reference_axis))
+        .map_or(Vector::zeros(), |axis| axis * orientation);
+    Some(PoseError {
+        tip: foot - actual.tip,
+        orientation,
+        rotation,
+        fraction,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    type V3 = Vector<3>;
+
+    #[test]
+    fn slerp_follows_the_great_circle() {
+        let (z, x) = (V3::z(), V3::x());
+        for t in [0.0, 0.25, 0.5, 0.9, 1.0] {
+            let v = slerp(&z, &x, t).unwrap();
+            let a = t * std::f64::consts::FRAC_PI_2;
+            assert!((v - V3::new(a.sin(), 0.0, a.cos())).amax() < 1e-15, "t={t}");
+        }
+        assert!(slerp(&z, &-z, 0.5).is_none());
+        assert_eq!(slerp(&z, &z, 0.3), Some(z));
+    }
+
+    #[test]
+    fn tip_and_orientation_errors_by_hand() {
+        // Segment along x from the origin to (10, 0, 0), the axis turning from +z to +x.
+        let r0 = Pose {
+            tip: V3::zeros(),
+            axis: V3::z(),
+        };
+        let r1 = Pose {
+            tip: V3::new(10.0, 0.0, 0.0),
+            axis: V3::x(),
+        };
+        // Actual tip above x = 2.5 by (0, 3, 4): foot at 1/4, tip error (0, −3, −4).
+        // The reference axis there is 22.5° from z toward x; the actual axis is z.
+        let actual = Pose {
+            tip: V3::new(2.5, 3.0, 4.0),
+            axis: V3::z(),
+        };
+        let e = foot_point_error(&r0, &r1, &actual).unwrap();
+        assert!((e.fraction - 0.25).abs() < 1e-15);
+        assert!((e.tip - V3::new(0.0, -3.0, -4.0)).amax() < 1e-15);
+        let expected = std::f64::consts::FRAC_PI_8;
+        assert!((e.orientation - expected).abs() < 1e-15);
+        // Turning z toward x is a rotation about +y.
+        assert!((e.rotation - V3::new(0.0, expected, 0.0)).amax() < 1e-15);
+        // Beyond the segment's end the foot is the end point.
+        let past = Pose {
+            tip: V3::new(14.0, 0.0, 0.0),
+            axis: V3::x(),
+        };
+        let e = foot_point_error(&r0, &r1, &past).unwrap();
+        assert_eq!(
+            (e.fraction, e.orientation, e.rotation),
+            (1.0, 0.0, V3::zeros())
+        );
+        assert!((e.tip - V3::new(-4.0, 0.0, 0.0)).amax() < 1e-15);
+        let nan = Pose {
+            tip: V3::new(f64::NAN, 0.0, 0.0),
+            axis: V3::z(),
+        };
+        assert!(foot_point_error(&r0, &r1, &nan).is_none());
+    }
+}
