@@ -140,6 +140,18 @@ impl TableTiltingAc {
     }
 }
 
+/// Joint increments for a workpiece-frame correction `e` (tip mm, orientation rad) by
+/// damped least squares, Δq = Jᵀ·(J·Jᵀ + μ²·I)⁻¹·e (docs/design.md §5.4): the
+/// least-squares solution for μ = 0 where J has full rank, kept bounded near the A = 0
+/// singularity by μ > 0. Computed in the equal form (JᵀJ + μ²·I)⁻¹·Jᵀ·e: J is 6 × 5, so
+/// J·Jᵀ is always singular and the 6 × 6 system loses digits as μ → 0, while the 5 × 5
+/// one is positive definite wherever J has full rank. `None` when Cholesky fails (μ = 0
+/// at a singular pose).
+pub fn damped_least_squares(jacobian: &Jacobian, e: &Vector<6>, mu: f64) -> Option<Joints> {
+    let system = jacobian.transpose() * jacobian + SMatrix::<f64, 5, 5>::identity() * (mu * mu);
+    Some(system.cholesky()?.solve(&(jacobian.transpose() * e)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -291,5 +303,27 @@ mod tests {
         let rank = |q: Joints| m.jacobian(&q).svd(false, false).rank(1e-9);
         assert_eq!(rank(Joints::new(1.0, 2.0, 3.0, 0.4, 1.0)), 5);
         assert_eq!(rank(Joints::new(1.0, 2.0, 3.0, 0.0, 1.0)), 4);
+    }
+
+    #[test]
+    fn damped_least_squares_is_the_pseudo_inverse_without_damping_and_bounded_with_it() {
+        let m = machine();
+        let e = Vector::<6>::new(0.1, -0.2, 0.05, 0.01, -0.02, 0.003);
+        // Full rank: μ → 0 gives the Moore–Penrose solution (nalgebra's SVD pseudo-inverse).
+        let q = Joints::new(1.0, 2.0, 3.0, 0.6, 0.4);
+        let j = m.jacobian(&q);
+        let pinv = j.pseudo_inverse(1e-12).unwrap() * e;
+        let dls = damped_least_squares(&j, &e, 0.0).unwrap();
+        assert!((dls - pinv).amax() < 1e-9, "{dls:?} vs {pinv:?}");
+        // Near A = 0 the undamped solution blows up in C; the damped one stays bounded by
+        // |e|/(2μ) (the largest gain of σ/(σ² + μ²)).
+        let near = Joints::new(1.0, 2.0, 3.0, 1e-7, 0.4);
+        let j = m.jacobian(&near);
+        let mu = 0.05;
+        let dq = damped_least_squares(&j, &e, mu).unwrap();
+        let bound = crate::geometry::norm(&e) / (2.0 * mu);
+        assert!(crate::geometry::norm(&dq) <= bound * (1.0 + 1e-9), "{dq:?}");
+        let free = j.pseudo_inverse(1e-30).unwrap() * e;
+        assert!(crate::geometry::norm(&free) > 100.0 * bound);
     }
 }
