@@ -13,6 +13,8 @@ pub mod file;
 pub mod interpolator;
 pub mod line;
 pub mod nurbs;
+pub mod polyline;
+pub mod tool_path;
 
 use std::fmt;
 

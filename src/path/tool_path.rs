@@ -1,0 +1,171 @@
+//! Five-axis references: the tool tip's path with the tool axis along it, in the
+//! workpiece frame (docs/design.md §5.3a). Two shapes: a pair of curves (the tip, and the
+//! point `length` mm up the tool axis) or a sequence of poses joined by straight tip
+//! moves with the axis slerped in between (CL data, sampled built-ins).
+
+use super::polyline::Polyline;
+use super::{Curve, Nurbs, PathError};
+use crate::contour::pose_error::slerp;
+use crate::geometry::{self, Vector};
+use crate::kinematics::Pose;
+
+/// Samples per turn of the sampled built-ins: chordal deviation below 10 nm for them.
+const SAMPLES_PER_TURN: usize = 4000;
+
+/// A five-axis reference.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ToolPath {
+    /// The tip curve and the curve of the point `length` mm up the tool axis, on the same
+    /// parameter.
+    Curves {
+        tip: Nurbs<3>,
+        second: Nurbs<3>,
+        length: f64,
+    },
+    /// Poses in order: tips joined by straight moves, axes by slerp.
+    Poses {
+        tips: Polyline<3>,
+        axes: Vec<Vector<3>>,
+    },
+}
+
+impl ToolPath {
+    /// From poses (at least two, consecutive tips distinct, axes nonzero; normalised).
+    pub fn from_poses(poses: &[Pose]) -> Result<Self, PathError> {
+        let tips = Polyline::new(poses.iter().map(|p| p.tip).collect())?;
+        let axes = poses
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                geometry::unit(&p.axis).ok_or_else(|| {
+                    PathError::invalid(format!("tool axis {i} is zero or not finite"))
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        if let Some(i) = axes
+            .windows(2)
+            .position(|w| slerp(&w[0], &w[1], 0.5).is_none())
+        {
+            return Err(PathError::invalid(format!(
+                "tool axes {i} and {} are opposite: no unique turn between them",
+                i + 1
+            )));
+        }
+        Ok(ToolPath::Poses { tips, axes })
+    }
+
+    /// The pose at parameter `u` of the tip curve.
+    pub fn pose_at(&self, u: f64) -> Pose {
+        match self {
+            ToolPath::Curves { tip, second, .. } => {
+                let p = tip.point(u);
+                let axis = geometry::unit(&(second.point(u) - p)).unwrap_or_else(Vector::z);
+                Pose { tip: p, axis }
+            }
+            ToolPath::Poses { tips, axes } => {
+                let (i, t) = tips.locate(u);
+                let axis = slerp(&axes[i], &axes[i + 1], t).unwrap_or(axes[i]);
+                Pose {
+                    tip: tips.point(u),
+                    axis,
+                }
+            }
+        }
+    }
+
+    /// A helix of radius 20 mm and pitch 5 mm, two turns, with the tool tilted 20° from
+    /// the helix axis toward its centre line.
+    pub fn tilted_helix() -> ToolPath {
+        let n = 2 * SAMPLES_PER_TURN;
+        let tilt = 20f64.to_radians();
+        let poses: Vec<Pose> = (0..=n)
+            .map(|i| {
+                let t = i as f64 / SAMPLES_PER_TURN as f64 * std::f64::consts::TAU;
+                let (s, c) = t.sin_cos();
+                Pose {
+                    tip: Vector::<3>::new(20.0 * c, 20.0 * s, 5.0 * t / std::f64::consts::TAU),
+                    axis: Vector::<3>::new(-tilt.sin() * c, -tilt.sin() * s, tilt.cos()),
+                }
+            })
+            .collect();
+        ToolPath::from_poses(&poses).expect("built-in helix is valid")
+    }
+
+    /// A figure eight in the plane z = 0 (40 × 20 mm, x = 20 sin t, y = 10 sin 2t) whose
+    /// two loops cross at the origin; the tool leans 15°·cos t about y, so where the tips
+    /// meet (t = 0 and π) the axes differ by 30°.
+    pub fn figure_eight() -> ToolPath {
+        let n = 2 * SAMPLES_PER_TURN;
+        let poses: Vec<Pose> = (0..=n)
+            .map(|i| {
+                let t = i as f64 / n as f64 * std::f64::consts::TAU;
+                let lean = 15f64.to_radians() * t.cos();
+                Pose {
+                    tip: Vector::<3>::new(20.0 * t.sin(), 10.0 * (2.0 * t).sin(), 0.0),
+                    axis: Vector::<3>::new(lean.sin(), 0.0, lean.cos()),
+                }
+            })
+            .collect();
+        ToolPath::from_poses(&poses).expect("built-in figure eight is valid")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contour::hmm::angle_between;
+
+    type V3 = Vector<3>;
+
+    #[test]
+    fn poses_are_slerped_between_vertices() {
+        let path = ToolPath::from_poses(&[
+            Pose {
+                tip: V3::zeros(),
+                axis: V3::z(),
+            },
+            Pose {
+                tip: V3::new(10.0, 0.0, 0.0),
+                axis: V3::new(2.0, 0.0, 0.0),
+            },
+        ])
+        .unwrap();
+        let pose = path.pose_at(0.5);
+        assert_eq!(pose.tip, V3::new(5.0, 0.0, 0.0));
+        let half = std::f64::consts::FRAC_PI_4;
+        assert!((pose.axis - V3::new(half.sin(), 0.0, half.cos())).amax() < 1e-15);
+        let opposite = ToolPath::from_poses(&[
+            Pose {
+                tip: V3::zeros(),
+                axis: V3::z(),
+            },
+            Pose {
+                tip: V3::x(),
+                axis: -V3::z(),
+            },
+        ]);
+        assert!(opposite.unwrap_err().to_string().contains("opposite"));
+    }
+
+    #[test]
+    fn the_built_ins_have_their_designed_shape() {
+        let helix = ToolPath::tilted_helix();
+        for u in [0.0, 1234.5, 8000.0] {
+            let p = helix.pose_at(u);
+            assert!(
+                (p.tip[0].hypot(p.tip[1]) - 20.0).abs() < 1e-5,
+                "radius at {u}"
+            );
+            assert!((angle_between(&p.axis, &V3::z()) - 20f64.to_radians()).abs() < 1e-6);
+        }
+        let end = helix.pose_at(8000.0).tip;
+        assert!((end - V3::new(20.0, 0.0, 10.0)).amax() < 1e-9);
+
+        // The figure eight passes the origin at t = 0, π (and 2π) with the tool leaning
+        // +15°, −15° (and +15°).
+        let eight = ToolPath::figure_eight();
+        let (start, middle) = (eight.pose_at(0.0), eight.pose_at(4000.0));
+        assert!(start.tip.amax() < 1e-12 && middle.tip.amax() < 1e-9);
+        assert!((angle_between(&start.axis, &middle.axis) - 30f64.to_radians()).abs() < 1e-9);
+    }
+}
