@@ -11,6 +11,7 @@ pub mod builtin;
 pub mod cl_data;
 pub mod file;
 pub mod interpolator;
+pub mod joint_reference;
 pub mod line;
 pub mod nurbs;
 pub mod polyline;
