@@ -3,6 +3,9 @@
 //! point `length` mm up the tool axis) or a sequence of poses joined by straight tip
 //! moves with the axis slerped in between (CL data, sampled built-ins).
 
+use serde::Deserialize;
+
+use super::nurbs::NurbsData;
 use super::polyline::Polyline;
 use super::{Curve, Nurbs, PathError};
 use crate::contour::pose_error::slerp;
@@ -29,7 +32,62 @@ pub enum ToolPath {
     },
 }
 
+/// The JSON form: `{"tip": NURBS, "second": NURBS, "length": L}`, each NURBS as in a
+/// planar path file but with 3-D control points; `second` is the curve of the point `L`
+/// mm up the tool axis and must share the tip curve's parameter range.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ToolPathFile {
+    tip: NurbsData<3>,
+    second: NurbsData<3>,
+    length: f64,
+}
+
 impl ToolPath {
+    /// Parses the JSON form; `name` is used in messages.
+    pub fn parse_json(text: &str, name: &str) -> Result<Self, PathError> {
+        let fail = |line: usize, column: usize, message: String| PathError::File {
+            file: name.to_string(),
+            line,
+            column,
+            message,
+        };
+        let file: ToolPathFile = serde_json::from_str(text).map_err(|e| {
+            fail(
+                e.line(),
+                e.column(),
+                format!("wrong five-axis path file: {e}"),
+            )
+        })?;
+        let curve = |data: NurbsData<3>, which: &str| {
+            Nurbs::try_from(data).map_err(|e| fail(0, 0, format!("{which}: {e}")))
+        };
+        let (tip, second) = (curve(file.tip, "tip")?, curve(file.second, "second")?);
+        if tip.param_range() != second.param_range() {
+            return Err(fail(
+                0,
+                0,
+                format!(
+                    "tip and second curves have different parameter ranges {:?} and {:?}",
+                    tip.param_range(),
+                    second.param_range()
+                ),
+            ));
+        }
+        if !(file.length.is_finite() && file.length > 0.0) {
+            return Err(fail(
+                0,
+                0,
+                format!("length must be > 0 mm, got {}", file.length),
+            ));
+        }
+        Ok(ToolPath::Curves {
+            tip,
+            second,
+            length: file.length,
+        })
+    }
+
     /// From poses (at least two, consecutive tips distinct, axes nonzero; normalised).
     pub fn from_poses(poses: &[Pose]) -> Result<Self, PathError> {
         let tips = Polyline::new(poses.iter().map(|p| p.tip).collect())?;
@@ -145,6 +203,37 @@ mod tests {
             },
         ]);
         assert!(opposite.unwrap_err().to_string().contains("opposite"));
+    }
+
+    #[test]
+    fn reads_the_two_curve_json_form() {
+        // A straight tip move with the second point 100 mm up a tool tilting from +z
+        // toward +x: at the middle the axis is the normalised mean.
+        let text = r#"{
+            "tip": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0, 0], [10, 0, 0]]},
+            "second": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0, 100], [110, 0, 0]]},
+            "length": 100
+        }"#;
+        let path = ToolPath::parse_json(text, "tilt.json").unwrap();
+        let pose = path.pose_at(0.5);
+        assert_eq!(pose.tip, V3::new(5.0, 0.0, 0.0));
+        let half = std::f64::consts::FRAC_PI_4;
+        assert!((pose.axis - V3::new(half.sin(), 0.0, half.cos())).amax() < 1e-15);
+        let bad = text.replace(
+            "[0, 0, 1, 1], \"control_points\": [[0, 0, 100]",
+            "[0, 0, 2, 2], \"control_points\": [[0, 0, 100]",
+        );
+        let e = ToolPath::parse_json(&bad, "tilt.json")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("tilt.json") && e.contains("parameter ranges"),
+            "{e}"
+        );
+        let e = ToolPath::parse_json("{\"tip\": 1}", "x.json")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("x.json:1:"), "{e}");
     }
 
     #[test]
