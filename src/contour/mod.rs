@@ -6,6 +6,7 @@ pub mod arc;
 pub mod choice;
 pub mod continuous_sign;
 pub mod estimate;
+pub mod evaluation;
 pub mod free_curve;
 pub mod hmm;
 pub mod hmm_online;
