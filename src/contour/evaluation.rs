@@ -6,7 +6,7 @@
 //! gives the tip error ‖p(t*) − R_i‖ and the orientation error ∠(o(t*), O_i).
 
 use super::hmm::angle_between;
-use crate::geometry::{self, Vector};
+use crate::geometry;
 use crate::kinematics::{Joints, Pose, TableTiltingAc};
 
 /// mm of tip travel per rad of tool rotation over a whole reference (R of §5.3): makes
@@ -106,6 +106,8 @@ pub fn evaluate(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    use crate::geometry::Vector;
 
     type V3 = Vector<3>;
 
