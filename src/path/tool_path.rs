@@ -150,17 +150,24 @@ impl ToolPath {
     }
 
     /// A figure eight in the plane z = 0 (40 × 20 mm, x = 20 sin t, y = 10 sin 2t) whose
-    /// two loops cross at the origin; the tool leans 15°·cos t about y, so where the tips
-    /// meet (t = 0 and π) the axes differ by 30°.
+    /// two loops cross at the origin. The tool is tilted 25° toward +y and leans 15°·cos t
+    /// toward ±x, so where the tips meet (t = 0 and π) the axes differ by 2·asin(sin 15°·
+    /// cos 25°) ≈ 27.2°; the tilt keeps the tool off the C axis (A ≥ 25°), where C would
+    /// have to turn half a revolution at once.
     pub fn figure_eight() -> ToolPath {
         let n = 2 * SAMPLES_PER_TURN;
         let poses: Vec<Pose> = (0..=n)
             .map(|i| {
                 let t = i as f64 / n as f64 * std::f64::consts::TAU;
                 let lean = 15f64.to_radians() * t.cos();
+                let tilt = 25f64.to_radians();
                 Pose {
                     tip: Vector::<3>::new(20.0 * t.sin(), 10.0 * (2.0 * t).sin(), 0.0),
-                    axis: Vector::<3>::new(lean.sin(), 0.0, lean.cos()),
+                    axis: Vector::<3>::new(
+                        lean.sin() * tilt.cos(),
+                        tilt.sin(),
+                        lean.cos() * tilt.cos(),
+                    ),
                 }
             })
             .collect();
@@ -251,10 +258,16 @@ mod tests {
         assert!((end - V3::new(20.0, 0.0, 10.0)).amax() < 1e-9);
 
         // The figure eight passes the origin at t = 0, π (and 2π) with the tool leaning
-        // +15°, −15° (and +15°).
+        // +15°, −15° (and +15°) out of its 25° tilt toward +y.
         let eight = ToolPath::figure_eight();
         let (start, middle) = (eight.pose_at(0.0), eight.pose_at(4000.0));
         assert!(start.tip.amax() < 1e-12 && middle.tip.amax() < 1e-9);
-        assert!((angle_between(&start.axis, &middle.axis) - 30f64.to_radians()).abs() < 1e-9);
+        let expected = 2.0 * (15f64.to_radians().sin() * 25f64.to_radians().cos()).asin();
+        assert!((angle_between(&start.axis, &middle.axis) - expected).abs() < 1e-9);
+        // Never along the C axis: A stays ≥ 25° (less than 1e-9 lost to the chords).
+        for i in 0..=8000 {
+            let a = angle_between(&eight.pose_at(i as f64).axis, &V3::z());
+            assert!(a > 25f64.to_radians() - 1e-9, "A = {a} at {i}");
+        }
     }
 }
