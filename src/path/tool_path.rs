@@ -152,7 +152,7 @@ impl ToolPath {
     /// A figure eight in the plane z = 0 (40 × 20 mm, x = 20 sin t, y = 10 sin 2t) whose
     /// two loops cross at the origin. The tool is tilted 25° toward +y and leans 15°·cos t
     /// toward ±x, so where the tips meet (t = 0 and π) the axes differ by 2·asin(sin 15°·
-    /// cos 25°) ≈ 27.2°; the tilt keeps the tool off the C axis (A ≥ 25°), where C would
+    /// cos 25°) ≈ 27.1°; the tilt keeps the tool off the C axis (A ≥ 25°), where C would
     /// have to turn half a revolution at once.
     pub fn figure_eight() -> ToolPath {
         let n = 2 * SAMPLES_PER_TURN;
