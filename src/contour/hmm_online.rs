@@ -9,6 +9,7 @@
 
 use super::hmm::{segment_cost, HmmParams};
 use crate::geometry::Vector;
+use crate::kinematics::Pose;
 
 /// The online decoder.
 #[derive(Clone, Debug)]
@@ -17,8 +18,10 @@ pub struct OnlineMapper {
     length: f64,
     band: usize,
     lag: usize,
-    /// The newest `band + 1` reference tips and second points (index mod `band + 1`).
+    /// The newest `band + 1` reference tips, unit axes and second points (index mod
+    /// `band + 1`).
     tips: Vec<Vector<3>>,
+    axes: Vec<Vector<3>>,
     seconds: Vec<Vector<3>>,
     references: usize,
     /// C(k, j) of the latest sample for j in `valid` (index j mod band).
@@ -43,6 +46,7 @@ impl OnlineMapper {
             band,
             lag,
             tips: vec![Vector::zeros(); band + 1],
+            axes: vec![Vector::zeros(); band + 1],
             seconds: vec![Vector::zeros(); band + 1],
             references: 0,
             cost: vec![f64::INFINITY; band],
@@ -58,8 +62,28 @@ impl OnlineMapper {
     pub fn push_reference(&mut self, tip: Vector<3>, axis: Vector<3>) {
         let slot = self.references % (self.band + 1);
         self.tips[slot] = tip;
+        self.axes[slot] = axis;
         self.seconds[slot] = tip + axis * self.length;
         self.references += 1;
+    }
+
+    /// Reference points pushed so far.
+    pub fn references(&self) -> usize {
+        self.references
+    }
+
+    /// The end poses of segment `j` while it is still held (one of the `band` newest).
+    pub fn segment(&self, j: usize) -> Option<(Pose, Pose)> {
+        let held = self.references.saturating_sub(self.band + 1);
+        if j < held || j + 1 >= self.references {
+            return None;
+        }
+        let ring = self.band + 1;
+        let pose = |i: usize| Pose {
+            tip: self.tips[i % ring],
+            axis: self.axes[i % ring],
+        };
+        Some((pose(j), pose(j + 1)))
     }
 
     /// Samples mapped so far.
@@ -236,5 +260,14 @@ mod tests {
         }
         assert_eq!(committed, n - lag);
         assert!(online.mapped(lag + 1).is_none());
+        // The band's segments are held with their poses, older ones are gone.
+        let newest = tips.len() - 2;
+        let (a, b) = online.segment(newest).unwrap();
+        assert_eq!(
+            (a.tip, b.tip, b.axis),
+            (tips[newest], tips[newest + 1], axes[newest + 1])
+        );
+        assert!(online.segment(newest + 1 - band).is_some());
+        assert!(online.segment(newest - band).is_none() && online.segment(newest + 1).is_none());
     }
 }
