@@ -46,12 +46,17 @@ pub struct TableTiltingAc {
     pub c_pivot: Vector<3>,
 }
 
+impl TableTiltingAc {
+    /// Both axes through the origin (LinuxCNC's convention).
+    pub const ORIGIN: TableTiltingAc = TableTiltingAc {
+        a_pivot: Vector::<3>::new(0.0, 0.0, 0.0),
+        c_pivot: Vector::<3>::new(0.0, 0.0, 0.0),
+    };
+}
+
 impl Default for TableTiltingAc {
     fn default() -> Self {
-        TableTiltingAc {
-            a_pivot: Vector::zeros(),
-            c_pivot: Vector::zeros(),
-        }
+        Self::ORIGIN
     }
 }
 

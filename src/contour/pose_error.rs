@@ -68,6 +68,41 @@ pub fn foot_point_error(r0: &Pose, r1: &Pose, actual: &Pose) -> Option<PoseError
     })
 }
 
+/// The segment nearest the tip `tip` among the neighbours of the mapped segment
+/// `mapped`: walks from it toward decreasing tip distance while the distance decreases
+/// (`segment(i)` gives segment i's end poses, `None` outside what is held).
+///
+/// The mapping weighs the second point and the motion direction too, so with an
+/// orientation error it may settle a few segments beside the one under the tip; the foot
+/// point on that segment would be clamped to its end and overstate the tip error. The
+/// mapping picks the branch, this picks the foot on it.
+pub fn nearest_segment_near(
+    segment: impl Fn(usize) -> Option<(Pose, Pose)>,
+    mapped: usize,
+    tip: &Vector<3>,
+) -> usize {
+    let distance = |i: usize| {
+        segment(i).map_or(f64::INFINITY, |(a, b)| {
+            super::hmm::segment_distance(tip, &a.tip, &b.tip)
+        })
+    };
+    let (mut best, mut d) = (mapped, distance(mapped));
+    for step in [1isize, -1] {
+        loop {
+            let Some(next) = best.checked_add_signed(step) else {
+                break;
+            };
+            let dn = distance(next);
+            if dn < d {
+                (best, d) = (next, dn);
+            } else {
+                break;
+            }
+        }
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -126,5 +161,27 @@ mod tests {
             axis: V3::z(),
         };
         assert!(foot_point_error(&r0, &r1, &nan).is_none());
+    }
+
+    #[test]
+    fn the_foot_moves_to_the_segment_under_the_tip() {
+        // Unit segments along x; a tip above x = 7.3 mapped to segment 3 (or 11) walks to
+        // segment 7; segments outside 2 … 12 are not held.
+        let pose = |x: f64| Pose {
+            tip: V3::new(x, 0.0, 0.0),
+            axis: V3::z(),
+        };
+        let held = |i: usize| {
+            (2..=12)
+                .contains(&i)
+                .then(|| (pose(i as f64), pose(i as f64 + 1.0)))
+        };
+        let tip = V3::new(7.3, 0.2, 0.0);
+        assert_eq!(nearest_segment_near(held, 3, &tip), 7);
+        assert_eq!(nearest_segment_near(held, 11, &tip), 7);
+        assert_eq!(nearest_segment_near(held, 7, &tip), 7);
+        // Beyond what is held it stops at the edge.
+        assert_eq!(nearest_segment_near(held, 10, &V3::new(15.0, 0.0, 0.0)), 12);
+        assert_eq!(nearest_segment_near(held, 4, &V3::new(-3.0, 0.0, 0.0)), 2);
     }
 }

@@ -4,11 +4,13 @@
 //! law per contour error) apply its output along their own directions.
 
 use serde::{Deserialize, Serialize};
+use serde_big_array::BigArray;
 
 use super::config::ConfigError;
 use super::config::{check, CccConfig, CccMode, FuzzyFactors, Parameter};
 use super::fuzzy::{FuzzyEngine, FuzzyOutput};
 use super::pid::{Pid, PidGains};
+use crate::geometry::{self, Vector};
 
 /// The normalised fuzzy inputs (E′, EC′) for contour error `error` (mm) and its change
 /// `delta` (mm per sample), before the engine's ±3 clamp:
@@ -130,5 +132,98 @@ impl CccLaw {
     pub fn reset(&mut self) {
         self.pid.reset();
         self.pid.set_gains(self.config.gains0);
+    }
+}
+
+/// The contour law applied to an error vector: the scalar law schedules the gains from the
+/// error's size (and keeps its own PID for callers that want the scalar correction), and
+/// one PID per component, with those gains, gives the correction vector.
+///
+/// Why per component: in space the direction of the error turns (the normal space of a
+/// curve is a plane, an orientation error has two directions), and an integral of the
+/// magnitude along whatever direction the error has now mixes directions up and chatters;
+/// per component the integrals hold any steady correction vector.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VectorLaw<const D: usize> {
+    law: CccLaw,
+    #[serde(with = "BigArray")]
+    components: [Pid; D],
+}
+
+impl<const D: usize> VectorLaw<D> {
+    /// A law with sample period `ts` (s).
+    pub fn new(config: CccConfig, ts: f64) -> Result<Self, ConfigError> {
+        let law = CccLaw::new(config, ts)?;
+        Ok(Self {
+            components: [(); D].map(|_| Pid::new(config.gains0, ts, config.limit)),
+            law,
+        })
+    }
+
+    /// The scalar law (scheduling state).
+    pub fn law(&self) -> &CccLaw {
+        &self.law
+    }
+
+    /// Advances the scalar law alone with the signed contour error `error` (its own
+    /// correction is the scalar one; the components are left alone).
+    pub fn update_scalar(&mut self, error: f64) -> CccStep {
+        self.law.update(error)
+    }
+
+    /// The per-component PIDs (state inspection).
+    pub fn components(&self) -> &[Pid; D] {
+        &self.components
+    }
+
+    /// Advances one sample: gains scheduled from `size` (the error's magnitude, or the
+    /// signed scalar the scheduling should see), correction per component of `error`.
+    /// Off mode, or a non-finite size or vector, gives a zero correction and leaves the
+    /// component integrals untouched.
+    pub fn update(&mut self, size: f64, error: &Vector<D>) -> (Vector<D>, CccStep) {
+        let step = self.law.update(size);
+        if self.law.config().mode == CccMode::Off
+            || !size.is_finite()
+            || !geometry::is_finite(error)
+        {
+            return (Vector::zeros(), step);
+        }
+        let components = &mut self.components;
+        let correction = Vector::from_fn(|i, _| {
+            components[i].set_gains(step.gains);
+            components[i].update(error[i])
+        });
+        (correction, step)
+    }
+
+    /// [`VectorLaw::update`] with the integrals held in the plane normal to the unit
+    /// vector `along` (the path's tangent for a tip error, the tool axis for an
+    /// orientation error): before the update their component along it is removed.
+    ///
+    /// The error has no component along `along`, but an integral of it does once the
+    /// direction turns (the path bends, the tool tilts): kept, that stale part would
+    /// push the tool along the path — the position loops' business — or spin it about
+    /// its own axis. In the plane this is what the scalar law's integral along the
+    /// turning normal does by construction.
+    pub fn update_normal_to(
+        &mut self,
+        size: f64,
+        error: &Vector<D>,
+        along: &Vector<D>,
+    ) -> (Vector<D>, CccStep) {
+        if geometry::is_finite(along) {
+            let integral = Vector::<D>::from_fn(|i, _| self.components[i].integral());
+            let normal = integral - along * integral.dot(along);
+            for (pid, value) in self.components.iter_mut().zip(normal.iter()) {
+                pid.set_integral(*value);
+            }
+        }
+        self.update(size, error)
+    }
+
+    /// Forgets integrals and previous errors.
+    pub fn reset(&mut self) {
+        self.law.reset();
+        self.components.iter_mut().for_each(Pid::reset);
     }
 }

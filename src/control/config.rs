@@ -164,6 +164,38 @@ pub enum Parameter {
     ContourLimit,
     /// A fuzzy factor, `CccConfig::fuzzy`.
     Fuzzy(FuzzyFactor),
+    /// Five-axis: a base gain of the orientation law.
+    OrientationGain(Gain),
+    /// Five-axis: the orientation law's limit.
+    OrientationLimit,
+    /// Five-axis: a fuzzy factor of the orientation law.
+    OrientationFuzzy(FuzzyFactor),
+    /// Five-axis: μ of the damped least squares.
+    Damping,
+    /// Five-axis: the tool length of the mapping.
+    ToolLength,
+    /// Five-axis: the mapping's largest skip per sample.
+    MaxSkip,
+    /// Five-axis: the mapping's weight of the motion angle.
+    AngleWeight,
+    /// Five-axis: segments in the online mapping's band.
+    Band,
+    /// Five-axis: samples the online mapping can read back.
+    Lag,
+    /// Five-axis: coordinate `.1` (x, y, z) of pivot `.0` (0 = A axis, 1 = C axis).
+    Pivot(usize, usize),
+}
+
+impl Parameter {
+    /// The orientation law's counterpart of a contour-law parameter (others unchanged).
+    pub fn orientation(self) -> Parameter {
+        match self {
+            Parameter::ContourGain(g) => Parameter::OrientationGain(g),
+            Parameter::ContourLimit => Parameter::OrientationLimit,
+            Parameter::Fuzzy(k) => Parameter::OrientationFuzzy(k),
+            other => other,
+        }
+    }
 }
 
 impl fmt::Display for Parameter {
@@ -173,21 +205,31 @@ impl fmt::Display for Parameter {
             Gain::Ki => "ki",
             Gain::Kd => "kd",
         };
+        let factor = |k: &FuzzyFactor| match k {
+            FuzzyFactor::Ke => "ke",
+            FuzzyFactor::Kde => "kde",
+            FuzzyFactor::Kpf => "kpf",
+            FuzzyFactor::Kif => "kif",
+            FuzzyFactor::Kdf => "kdf",
+        };
         match self {
             Parameter::Ts => write!(f, "ts"),
             Parameter::AxisGain(i, g) => write!(f, "axis[{i}].{}", gain(g)),
             Parameter::AxisLimit => write!(f, "axis_limit"),
             Parameter::ContourGain(g) => write!(f, "ccc.gains0.{}", gain(g)),
             Parameter::ContourLimit => write!(f, "ccc.limit"),
-            Parameter::Fuzzy(k) => {
-                let name = match k {
-                    FuzzyFactor::Ke => "ke",
-                    FuzzyFactor::Kde => "kde",
-                    FuzzyFactor::Kpf => "kpf",
-                    FuzzyFactor::Kif => "kif",
-                    FuzzyFactor::Kdf => "kdf",
-                };
-                write!(f, "ccc.fuzzy.{name}")
+            Parameter::Fuzzy(k) => write!(f, "ccc.fuzzy.{}", factor(k)),
+            Parameter::OrientationGain(g) => write!(f, "orientation.gains0.{}", gain(g)),
+            Parameter::OrientationLimit => write!(f, "orientation.limit"),
+            Parameter::OrientationFuzzy(k) => write!(f, "orientation.fuzzy.{}", factor(k)),
+            Parameter::Damping => write!(f, "damping"),
+            Parameter::ToolLength => write!(f, "tool_length"),
+            Parameter::MaxSkip => write!(f, "hmm.max_skip"),
+            Parameter::AngleWeight => write!(f, "hmm.angle_weight"),
+            Parameter::Band => write!(f, "band"),
+            Parameter::Lag => write!(f, "lag"),
+            Parameter::Pivot(i, k) => {
+                write!(f, "{}_pivot.{}", ["a", "c"][*i], ["x", "y", "z"][*k])
             }
         }
     }
@@ -205,6 +247,11 @@ pub struct ConfigError {
 }
 
 impl ConfigError {
+    /// The same error, said of `parameter`.
+    pub fn with_parameter(self, parameter: Parameter) -> ConfigError {
+        ConfigError { parameter, ..self }
+    }
+
     /// The message with the parameter called `name` (an FMU's variable name, say).
     pub fn message_for(&self, name: &str) -> String {
         format!(
@@ -222,6 +269,7 @@ impl fmt::Display for ConfigError {
 
 impl std::error::Error for ConfigError {}
 
+/// `Ok` when `value` is finite and `ok`; otherwise the error naming `parameter`.
 pub(crate) fn check(
     parameter: Parameter,
     value: f64,

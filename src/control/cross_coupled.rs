@@ -20,7 +20,7 @@
 use serde::{Deserialize, Serialize};
 use serde_big_array::BigArray;
 
-use super::ccc_law::{CccLaw, CccStep};
+use super::ccc_law::{CccLaw, CccStep, VectorLaw};
 use super::config::{CccMode, ConfigError, ControllerConfig};
 use super::pid::Pid;
 use crate::contour::{ContourEstimate, ContourEstimator};
@@ -58,10 +58,9 @@ pub struct CrossCoupledController<E, const D: usize = 2> {
     config: ControllerConfig<D>,
     #[serde(with = "BigArray")]
     axes: [Pid; D],
-    law: CccLaw,
-    /// The law per axis on the error vector, for D ≥ 3 (see the module docs).
-    #[serde(with = "BigArray")]
-    contour_axes: [Pid; D],
+    /// The scalar law (D ≤ 2) and, for D ≥ 3, its per-axis form on the error vector (see
+    /// the module docs).
+    law: VectorLaw<D>,
     estimator: E,
 }
 
@@ -73,8 +72,7 @@ impl<E: ContourEstimator<D>, const D: usize> CrossCoupledController<E, D> {
             axes: config
                 .axis
                 .map(|gains| Pid::new(gains, config.ts, config.axis_limit)),
-            law: CccLaw::new(config.ccc, config.ts)?,
-            contour_axes: [(); D].map(|_| Pid::new(config.ccc.gains0, config.ts, config.ccc.limit)),
+            law: VectorLaw::new(config.ccc, config.ts)?,
             estimator,
             config,
         })
@@ -97,12 +95,12 @@ impl<E: ContourEstimator<D>, const D: usize> CrossCoupledController<E, D> {
 
     /// The contour law (state inspection).
     pub fn law(&self) -> &CccLaw {
-        &self.law
+        self.law.law()
     }
 
     /// The per-axis contour PIDs, used for D ≥ 3 (state inspection).
     pub fn contour_axes(&self) -> &[Pid; D] {
-        &self.contour_axes
+        self.law.components()
     }
 
     /// The position controllers, in axis order (state inspection).
@@ -123,19 +121,15 @@ impl<E: ContourEstimator<D>, const D: usize> CrossCoupledController<E, D> {
         // `CccLaw::update`): no correction, CCC state untouched.
         let mut step = CccStep::default();
         if geometry::is_finite(&n) {
-            step = self.law.update(contour.error);
-            if self.law.config().mode != CccMode::Off {
-                if D <= 2 {
+            if D <= 2 {
+                step = self.law.update_scalar(contour.error);
+                if self.law.law().config().mode != CccMode::Off {
                     u += n * step.correction;
-                } else if contour.error.is_finite() {
-                    // (A non-finite error gave no gains above; it must not reach the
-                    // per-axis integrals either.)
-                    let error = contour.vector();
-                    for (i, pid) in self.contour_axes.iter_mut().enumerate() {
-                        pid.set_gains(step.gains);
-                        u[i] += pid.update(error[i]);
-                    }
                 }
+            } else {
+                let correction;
+                (correction, step) = self.law.update(contour.error, &contour.vector());
+                u += correction;
             }
         }
         ControlOutput {
@@ -150,7 +144,6 @@ impl<E: ContourEstimator<D>, const D: usize> CrossCoupledController<E, D> {
     /// estimator's history are cleared; the configuration is kept.
     pub fn reset(&mut self) {
         self.axes.iter_mut().for_each(Pid::reset);
-        self.contour_axes.iter_mut().for_each(Pid::reset);
         self.law.reset();
         self.estimator.reset();
     }

@@ -104,6 +104,14 @@ impl Pid {
         self.integral
     }
 
+    /// Replaces the accumulated Σ e·Ts (e.g. to re-express a vector of integrals in a
+    /// turning frame); non-finite values are ignored.
+    pub fn set_integral(&mut self, integral: f64) {
+        if integral.is_finite() {
+            self.integral = integral;
+        }
+    }
+
     /// The error of the previous sample, if there was one.
     pub fn previous_error(&self) -> Option<f64> {
         self.prev_error

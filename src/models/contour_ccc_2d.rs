@@ -290,7 +290,6 @@ fn variable_of(parameter: Parameter) -> Option<&'static Variable> {
     let vr = match parameter {
         Parameter::Ts => TS.vr(),
         Parameter::AxisGain(axis, g) => AXIS_GAINS.at(3 * axis + gain(g)).vr(),
-        Parameter::AxisLimit => return None,
         Parameter::ContourLimit => CCC_LIMIT.vr(),
         Parameter::ContourGain(g) => CCC_GAINS0.at(gain(g)).vr(),
         Parameter::Fuzzy(f) => FUZZY_FACTORS
@@ -302,6 +301,8 @@ fn variable_of(parameter: Parameter) -> Option<&'static Variable> {
                 FuzzyFactor::Kdf => 4,
             })
             .vr(),
+        // The five-axis values are not in this model's configuration.
+        _ => return None,
     };
     Some(&VARIABLES[vr])
 }

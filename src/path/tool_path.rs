@@ -132,7 +132,10 @@ impl ToolPath {
     }
 
     /// A helix of radius 20 mm and pitch 5 mm, two turns, with the tool tilted 20° from
-    /// the helix axis toward its centre line.
+    /// the helix axis toward its centre line; the helix stands at (30, 10) on the table,
+    /// off the C axis. (Centred on the C axis the table would turn the part under a tool
+    /// that only rises: every joint moves uniformly and a lag is a pure delay along the
+    /// path, with no contour error to correct.)
     pub fn tilted_helix() -> ToolPath {
         let n = 2 * SAMPLES_PER_TURN;
         let tilt = 20f64.to_radians();
@@ -141,7 +144,11 @@ impl ToolPath {
                 let t = i as f64 / SAMPLES_PER_TURN as f64 * std::f64::consts::TAU;
                 let (s, c) = t.sin_cos();
                 Pose {
-                    tip: Vector::<3>::new(20.0 * c, 20.0 * s, 5.0 * t / std::f64::consts::TAU),
+                    tip: Vector::<3>::new(
+                        30.0 + 20.0 * c,
+                        10.0 + 20.0 * s,
+                        5.0 * t / std::f64::consts::TAU,
+                    ),
                     axis: Vector::<3>::new(-tilt.sin() * c, -tilt.sin() * s, tilt.cos()),
                 }
             })
@@ -249,13 +256,13 @@ mod tests {
         for u in [0.0, 1234.5, 8000.0] {
             let p = helix.pose_at(u);
             assert!(
-                (p.tip[0].hypot(p.tip[1]) - 20.0).abs() < 1e-5,
+                ((p.tip[0] - 30.0).hypot(p.tip[1] - 10.0) - 20.0).abs() < 1e-5,
                 "radius at {u}"
             );
             assert!((angle_between(&p.axis, &V3::z()) - 20f64.to_radians()).abs() < 1e-6);
         }
         let end = helix.pose_at(8000.0).tip;
-        assert!((end - V3::new(20.0, 0.0, 10.0)).amax() < 1e-9);
+        assert!((end - V3::new(50.0, 10.0, 10.0)).amax() < 1e-9);
 
         // The figure eight passes the origin at t = 0, π (and 2π) with the tool leaning
         // +15°, −15° (and +15°) out of its 25° tilt toward +y.

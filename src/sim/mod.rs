@@ -34,6 +34,7 @@
 //! cover the samples before it, and [`Metrics::divergence`] says where and why.
 
 mod config;
+mod five_axis;
 mod metrics;
 mod reference;
 mod run;
@@ -41,6 +42,10 @@ mod trace;
 
 pub use config::{
     preset_feed, SimConfig, SimError, FREE_CURVE_FEED, MAX_SAMPLES, PAPER_CIRCLE_FEED,
+};
+pub use five_axis::{
+    builtin_tool_path, nearest_on_branch, simulate_five_axis, FiveAxisMetrics, FiveAxisRecord,
+    FiveAxisSimConfig, BUILTIN_TOOL_PATHS,
 };
 pub use metrics::{Divergence, DivergenceKind, Metrics};
 pub use reference::ReferencePath;
