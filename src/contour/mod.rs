@@ -13,6 +13,7 @@ pub mod hmm_online;
 pub mod line;
 mod local_circle;
 pub mod pose_error;
+pub mod run_evaluation;
 pub mod spatial_line;
 pub mod true_error;
 

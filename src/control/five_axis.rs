@@ -26,7 +26,7 @@ use super::config::{check, CccConfig, CccMode, ConfigError, Parameter};
 use super::pid::{Pid, PidGains};
 use crate::contour::hmm::HmmParams;
 use crate::contour::hmm_online::OnlineMapper;
-use crate::contour::pose_error::{foot_point_error, nearest_segment_near, PoseError};
+use crate::contour::pose_error::{foot_point_error_between, nearest_segment_near, PoseError};
 use crate::geometry::{self, Vector};
 use crate::kinematics::{damped_least_squares, Joints, Pose, TableTiltingAc};
 
@@ -255,10 +255,16 @@ impl FiveAxisController {
         let mapper = &self.mapper;
         let foot = segment
             .map(|j| nearest_segment_near(|i| mapper.segment(i), j, &pose.tip))
-            .and_then(|j| mapper.segment(j))
-            .and_then(|(r0, r1)| {
+            .and_then(|j| mapper.segment(j).map(|s| (j, s)))
+            .and_then(|(j, (r0, r1))| {
                 let tangent = geometry::unit(&(r1.tip - r0.tip)).unwrap_or_else(Vector::zeros);
-                foot_point_error(&r0, &r1, &pose).map(|e| (e, tangent))
+                let before = j
+                    .checked_sub(1)
+                    .and_then(|i| mapper.segment(i))
+                    .map(|s| s.0);
+                let after = mapper.segment(j + 1).map(|s| s.1);
+                foot_point_error_between(before.as_ref(), &r0, &r1, after.as_ref(), &pose)
+                    .map(|e| (e, tangent))
             });
         let error = foot.map(|(e, _)| e);
         let mut output = FiveAxisOutput {

@@ -28,9 +28,10 @@ use crate::path::tool_path::ToolPath;
 use crate::path::{Curve, PathError};
 use crate::plant::{ServoAxes, ServoAxesParams};
 
-/// Reference samples the truth search looks back over (0.4 s at 1 ms: ten times the
-/// trailing distance of the default loops).
-const TRUTH_WINDOW: usize = 400;
+/// Reference samples the truth search looks back over: the default loops trail by about
+/// 35 samples, up to 65 through the figure-eight's tightest bends; 150 leaves room and
+/// stays far from the other branch through the crossing (about 1800 samples away).
+const TRUTH_WINDOW: usize = 150;
 
 /// A run stops when the true tip error exceeds this, mm.
 const ABORT_TIP_ERROR: f64 = 10.0;
