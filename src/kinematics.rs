@@ -10,7 +10,8 @@
 //! axis (machine +Z) is o = Rz(−C)·Rx(−A)·e_z = (sC·sA, cC·sA, cA). With zero pivots this
 //! is LinuxCNC's A–C trunnion convention.
 //!
-//! Inverse on the A ≥ 0 branch: A = acos(o_z), C = atan2(o_x, o_y) unwrapped to the turn
+//! Inverse on the A ≥ 0 branch: A = atan2(|o_xy|, o_z) (acos(o_z) would lose digits near
+//! A = 0, its error growing as eps/A), C = atan2(o_x, o_y) unwrapped to the turn
 //! nearest the previous C. At A = 0 (tool along the C axis) C does not move the tool
 //! axis: the previous C is kept, and the Jacobian loses rank (the controller damps it).
 
@@ -34,7 +35,8 @@ pub struct Pose {
     pub axis: Vector<3>,
 }
 
-/// Below this sin A (about 0.06°) the tool counts as parallel to the C axis.
+/// Below this sin A (A < 1e-9 rad) the tool counts as parallel to the C axis: C no longer
+/// turns it measurably, so C is held.
 const VERTICAL: f64 = 1e-9;
 
 /// The machine's geometry.
@@ -108,8 +110,9 @@ impl TableTiltingAc {
             return None;
         }
         let o = pose.axis / length;
-        let a_angle = o[2].clamp(-1.0, 1.0).acos();
-        let c_angle = if o[0].hypot(o[1]) < VERTICAL || !previous_c.is_finite() {
+        let sideways = o[0].hypot(o[1]);
+        let a_angle = sideways.atan2(o[2]);
+        let c_angle = if sideways < VERTICAL || !previous_c.is_finite() {
             if previous_c.is_finite() {
                 previous_c
             } else {

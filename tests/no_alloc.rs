@@ -14,9 +14,11 @@ use contour_fmu::contour::{
     ContourEstimate, ContourEstimator, Estimator, EstimatorKind, TrueErrorIndex,
 };
 use contour_fmu::control::{
-    CccConfig, CccMode, ControllerConfig, CrossCoupledController, FuzzyEngine,
+    CccConfig, CccMode, ControllerConfig, CrossCoupledController, FiveAxisConfig,
+    FiveAxisController, FuzzyEngine,
 };
 use contour_fmu::geometry::Vector2;
+use contour_fmu::kinematics::Joints;
 use contour_fmu::path::{builtin, Curve, Interpolator};
 use contour_fmu::sim::{SimConfig, Simulator};
 
@@ -308,5 +310,38 @@ fn closed_loop_samples_do_not_allocate() {
             long_count, short_count,
             "{name}: allocations grow with run length"
         );
+    }
+}
+
+#[test]
+fn a_five_axis_sample_does_not_allocate() {
+    // Mapping, foot-point errors, both laws and the damped least squares, every sample,
+    // once the controller (and its mapper's rings) exist; longer than the band, so the
+    // rings wrap.
+    for mode in [CccMode::Off, CccMode::Fixed, CccMode::Fuzzy] {
+        let mut controller =
+            FiveAxisController::new(FiveAxisConfig::DEFAULT.with_mode(mode)).unwrap();
+        let reference = |k: usize| {
+            let t = k as f64 * 1e-3;
+            Joints::new(
+                20.0 * t.cos(),
+                20.0 * t.sin(),
+                5.0 * t,
+                0.35 + 0.1 * t.sin(),
+                2.5 * t,
+            )
+        };
+        let mut sum = 0.0;
+        let count = allocations_during(|| {
+            for k in 0..2_000usize {
+                let actual = reference(k.saturating_sub(35)) + Joints::repeat(1e-3);
+                let out = controller
+                    .sample(black_box(&reference(k)), black_box(&actual))
+                    .unwrap();
+                sum += out.u.sum();
+            }
+        });
+        assert_eq!(count, 0, "{mode:?}: five-axis sample() allocated");
+        assert!(sum.is_finite() && controller.mapper().samples() > 1_900);
     }
 }

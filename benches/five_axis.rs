@@ -1,0 +1,96 @@
+//! One sample of the five-axis controller (axis loops + online HMM mapping + foot-point
+//! errors + tip and orientation laws + damped least squares), docs/design.md §5.
+//!
+//! `five_axis/sample_*`: replays the reference and measured joints of the recorded
+//! closed loop on the figure-eight (2 540 samples, through its crossing) in each CCC mode;
+//! criterion's throughput gives the time per sample.
+//!
+//! `five_axis/path_1k` and `five_axis/path_100k`: the last 1 000 samples of a reference of
+//! 1 000 and of 100 000 distinct points (a helix, the tool trailing by 35 samples), the
+//! controller having run through all the points before them — the ratio of the two shows
+//! whether the cost per sample grows with the path.
+
+use std::hint::black_box;
+
+use contour_fmu::control::{CccMode, FiveAxisConfig, FiveAxisController};
+use contour_fmu::kinematics::Joints;
+use contour_fmu::sim::{simulate_five_axis, FiveAxisSimConfig};
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
+
+fn replay(controller: &mut FiveAxisController, samples: &[(Joints, Joints)]) -> f64 {
+    let mut sum = 0.0;
+    for (reference, actual) in samples {
+        let out = controller
+            .sample(black_box(reference), black_box(actual))
+            .expect("finite samples");
+        sum += out.u[0];
+    }
+    sum
+}
+
+fn bench_modes(c: &mut Criterion) {
+    let mut group = c.benchmark_group("five_axis");
+    for (name, mode) in [
+        ("sample_off", CccMode::Off),
+        ("sample_fixed", CccMode::Fixed),
+        ("sample_fuzzy", CccMode::Fuzzy),
+    ] {
+        let config = FiveAxisSimConfig::builtin("figure_eight")
+            .unwrap()
+            .with_mode(mode);
+        let (_, records) = simulate_five_axis(&config, true).unwrap();
+        let samples: Vec<(Joints, Joints)> =
+            records.iter().map(|r| (r.reference, r.actual)).collect();
+        let fresh = FiveAxisController::new(config.controller).unwrap();
+        group.throughput(Throughput::Elements(samples.len() as u64));
+        group.bench_function(name, |b| {
+            b.iter_batched_ref(
+                || fresh.clone(),
+                |controller| replay(controller, &samples),
+                BatchSize::SmallInput,
+            )
+        });
+    }
+    group.finish();
+}
+
+/// A helix in joint space: `n` distinct reference samples, the measured joints trailing
+/// by 35 samples and displaced slightly.
+fn helix(n: usize) -> Vec<(Joints, Joints)> {
+    let q = |k: usize| {
+        let t = k as f64 * 2.5e-3;
+        Joints::new(
+            30.0 + 20.0 * t.cos(),
+            10.0 + 20.0 * t.sin(),
+            0.8 * t,
+            0.35 + 0.1 * (0.3 * t).sin(),
+            t,
+        )
+    };
+    (0..n)
+        .map(|k| (q(k), q(k.saturating_sub(35)) + Joints::repeat(2e-3)))
+        .collect()
+}
+
+fn bench_path_length(c: &mut Criterion) {
+    let mut group = c.benchmark_group("five_axis");
+    let config = FiveAxisConfig::DEFAULT.with_mode(CccMode::Fuzzy);
+    for (name, n) in [("path_1k", 1_000), ("path_100k", 100_000)] {
+        let samples = helix(n);
+        let (before, timed) = samples.split_at(n - 1_000);
+        let mut warmed = FiveAxisController::new(config).unwrap();
+        replay(&mut warmed, before);
+        group.throughput(Throughput::Elements(timed.len() as u64));
+        group.bench_function(name, |b| {
+            b.iter_batched_ref(
+                || warmed.clone(),
+                |controller| replay(controller, timed),
+                BatchSize::SmallInput,
+            )
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_modes, bench_path_length);
+criterion_main!(benches);
