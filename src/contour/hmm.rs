@@ -16,7 +16,9 @@
 
 use crate::geometry::{self, Vector};
 
-/// Distance from `p` to the segment a–b.
+/// Distance from `p` to the segment a–b. (A plain square root of the squared distance:
+/// this runs band × samples times per mapping, and coordinates in mm are far from
+/// where `hypot`'s care about overflow would matter.)
 pub fn segment_distance(p: &Vector<3>, a: &Vector<3>, b: &Vector<3>) -> f64 {
     let d = b - a;
     let len2 = d.dot(&d);
@@ -25,7 +27,8 @@ pub fn segment_distance(p: &Vector<3>, a: &Vector<3>, b: &Vector<3>) -> f64 {
     } else {
         0.0
     };
-    geometry::dist(&(a + d * t), p)
+    let off = a + d * t - p;
+    off.dot(&off).sqrt()
 }
 
 /// Angle between two vectors, rad (0 when either is zero).
@@ -86,7 +89,9 @@ pub fn segment_cost(
     let turn = if *motion == Vector::<3>::zeros() {
         0.0
     } else {
-        angle_between(motion, &(r[1] - r[0]))
+        // angle_between with a plain square root (see segment_distance).
+        let (direction, cross) = (r[1] - r[0], motion.cross(&(r[1] - r[0])));
+        cross.dot(&cross).sqrt().atan2(motion.dot(&direction))
     };
     segment_distance(tip, r[0], r[1])
         + segment_distance(second, s[0], s[1])

@@ -1,7 +1,8 @@
 //! The online form of the HMM segment mapping (docs/design.md §5.2): the reference and
 //! the measured samples arrive one at a time. Only the `band` newest segments are
 //! candidates, and a sample's mapping can be read back `lag` samples later, so the work
-//! per sample is O(band·max_skip + lag) whatever the path's length, and nothing is
+//! per sample is O(band·max_skip + lag) whatever the path's length — less with a beam,
+//! which drops the states that have fallen far behind the best — and nothing is
 //! allocated after construction (every buffer is a ring of fixed size).
 //!
 //! With a band covering the whole reference and a lag covering the whole run it decodes
@@ -18,21 +19,26 @@ pub struct OnlineMapper {
     length: f64,
     band: usize,
     lag: usize,
-    /// The newest `band + 1` reference tips, unit axes and second points (index mod
-    /// `band + 1`).
+    /// Ring capacity − 1: the rings hold a power of two ≥ band + 1 entries, so an index
+    /// wraps with a mask instead of a division (several per segment and sample).
+    mask: usize,
+    /// The newest reference tips, unit axes and second points (index & mask).
     tips: Vec<Vector<3>>,
     axes: Vec<Vector<3>>,
     seconds: Vec<Vector<3>>,
     references: usize,
-    /// C(k, j) of the latest sample for j in `valid` (index j mod band).
+    /// C(k, j) of the latest sample for j in `valid` (index j & mask).
     cost: Vec<f64>,
     next: Vec<f64>,
     valid: (usize, usize),
     /// Predecessors (absolute segments) of the last `lag + 1` samples: row k mod
-    /// (lag + 1), column j mod band.
+    /// (lag + 1), column j & mask.
     back: Vec<usize>,
     samples: usize,
     previous_tip: Option<Vector<3>>,
+    /// States whose cost exceeds the best by more than this are dropped (mm of summed
+    /// cost; infinite: none, the exact decoder).
+    beam: f64,
 }
 
 impl OnlineMapper {
@@ -40,27 +46,39 @@ impl OnlineMapper {
     /// `length` is the tool length of the second points, mm.
     pub fn new(params: HmmParams, length: f64, band: usize, lag: usize) -> Self {
         let band = band.max(1);
+        let capacity = (band + 1).next_power_of_two();
         OnlineMapper {
             params,
             length,
             band,
             lag,
-            tips: vec![Vector::zeros(); band + 1],
-            axes: vec![Vector::zeros(); band + 1],
-            seconds: vec![Vector::zeros(); band + 1],
+            mask: capacity - 1,
+            tips: vec![Vector::zeros(); capacity],
+            axes: vec![Vector::zeros(); capacity],
+            seconds: vec![Vector::zeros(); capacity],
             references: 0,
-            cost: vec![f64::INFINITY; band],
-            next: vec![f64::INFINITY; band],
+            cost: vec![f64::INFINITY; capacity],
+            next: vec![f64::INFINITY; capacity],
             valid: (0, 0),
-            back: vec![0; (lag + 1) * band],
+            back: vec![0; (lag + 1) * capacity],
             samples: 0,
             previous_tip: None,
+            beam: f64::INFINITY,
         }
+    }
+
+    /// The same decoder keeping only the states within `beam` (mm of summed cost) of the
+    /// best: a state that far behind has fallen off the measured tool for good (every
+    /// sample adds its distance), and dropping it shrinks the work from the whole band to
+    /// the few segments around the tool. A non-positive or NaN beam keeps every state.
+    pub fn with_beam(mut self, beam: f64) -> Self {
+        self.beam = if beam > 0.0 { beam } else { f64::INFINITY };
+        self
     }
 
     /// Appends the next reference point (tip and unit tool axis).
     pub fn push_reference(&mut self, tip: Vector<3>, axis: Vector<3>) {
-        let slot = self.references % (self.band + 1);
+        let slot = self.references & self.mask;
         self.tips[slot] = tip;
         self.axes[slot] = axis;
         self.seconds[slot] = tip + axis * self.length;
@@ -78,10 +96,9 @@ impl OnlineMapper {
         if j < held || j + 1 >= self.references {
             return None;
         }
-        let ring = self.band + 1;
         let pose = |i: usize| Pose {
-            tip: self.tips[i % ring],
-            axis: self.axes[i % ring],
+            tip: self.tips[i & self.mask],
+            axis: self.axes[i & self.mask],
         };
         Some((pose(j), pose(j + 1)))
     }
@@ -92,8 +109,7 @@ impl OnlineMapper {
     }
 
     fn cost_of(&self, j: usize, tip: &Vector<3>, second: &Vector<3>, motion: &Vector<3>) -> f64 {
-        let ring = self.band + 1;
-        let (a, b) = (j % ring, (j + 1) % ring);
+        let (a, b) = (j & self.mask, (j + 1) & self.mask);
         segment_cost(
             &self.params,
             [&self.tips[a], &self.tips[b]],
@@ -114,36 +130,61 @@ impl OnlineMapper {
         }
         let second = tip + axis * self.length;
         let motion = self.previous_tip.map_or(Vector::zeros(), |p| tip - p);
-        let row = (self.samples % (self.lag + 1)) * self.band;
+        let row = (self.samples % (self.lag + 1)) * (self.mask + 1);
+        let skip = self.params.max_skip;
+        // Live states of the previous sample are [vlo, vhi); they reach [vlo, vhi − 1 + K].
         let (vlo, vhi) = self.valid;
+        let (mut from, mut to) = if self.samples > 0 && vlo < vhi {
+            (lo.max(vlo), hi.min(vhi + skip))
+        } else {
+            (lo, hi)
+        };
         let mut reachable = false;
-        for j in lo..hi {
+        for j in from..to {
             let c = self.cost_of(j, &tip, &second, &motion);
             let mut best = (f64::INFINITY, j);
             if self.samples > 0 {
-                for i in
-                    j.saturating_sub(self.params.max_skip).max(vlo)..=j.min(vhi.wrapping_sub(1))
-                {
-                    let ci = self.cost[i % self.band];
+                for i in j.saturating_sub(skip).max(vlo)..=j.min(vhi.wrapping_sub(1)) {
+                    let ci = self.cost[i & self.mask];
                     if ci < best.0 {
                         best = (ci, i);
                     }
                 }
             }
             reachable |= best.0.is_finite();
-            self.next[j % self.band] = best.0 + c;
-            self.back[row + j % self.band] = best.1;
+            self.next[j & self.mask] = best.0 + c;
+            self.back[row + (j & self.mask)] = best.1;
         }
         if !reachable {
             // The first sample, or the band ran past every path: start afresh (any
             // segment, no history).
+            (from, to) = (lo, hi);
             for j in lo..hi {
-                self.next[j % self.band] = self.cost_of(j, &tip, &second, &motion);
-                self.back[row + j % self.band] = j;
+                self.next[j & self.mask] = self.cost_of(j, &tip, &second, &motion);
+                self.back[row + (j & self.mask)] = j;
             }
         }
+        // The beam: states costlier than the best by more than `beam` are dropped.
+        let least = (from..to)
+            .map(|j| self.next[j & self.mask])
+            .fold(f64::INFINITY, f64::min);
+        let (mut first, mut last) = (to, from);
+        for j in from..to {
+            let slot = &mut self.next[j & self.mask];
+            if *slot > least + self.beam || slot.is_nan() {
+                *slot = f64::INFINITY;
+            } else {
+                first = first.min(j);
+                last = j + 1;
+            }
+        }
+        if first >= last {
+            // Nothing finite (a NaN observation): keep the range so the next sample
+            // restarts.
+            (first, last) = (from, to);
+        }
         std::mem::swap(&mut self.cost, &mut self.next);
-        self.valid = (lo, hi);
+        self.valid = (first, last);
         self.samples += 1;
         self.previous_tip = Some(tip);
         Some(self.best())
@@ -153,7 +194,7 @@ impl OnlineMapper {
     fn best(&self) -> usize {
         let (lo, hi) = self.valid;
         (lo..hi).fold(lo, |best, j| {
-            if self.cost[j % self.band] < self.cost[best % self.band] {
+            if self.cost[j & self.mask] < self.cost[best & self.mask] {
                 j
             } else {
                 best
@@ -170,7 +211,7 @@ impl OnlineMapper {
         let mut j = self.best();
         for s in 0..steps {
             let k = self.samples - 1 - s;
-            j = self.back[(k % (self.lag + 1)) * self.band + j % self.band];
+            j = self.back[(k % (self.lag + 1)) * (self.mask + 1) + (j & self.mask)];
         }
         Some(j)
     }
@@ -241,14 +282,20 @@ mod tests {
         let offline = viterbi_offline(&reference, &params, &run[..n], &seconds[..n]);
         let (band, lag) = (24, 8);
         let mut online = OnlineMapper::new(params, 80.0, band, lag);
+        // With a beam of 2 mm it commits the same decisions.
+        let mut beamed = OnlineMapper::new(params, 80.0, band, lag).with_beam(2.0);
         for j in 0..lead {
             online.push_reference(tips[j], axes[j]);
+            beamed.push_reference(tips[j], axes[j]);
         }
         let mut committed = 0;
         for k in 0..n {
             online.push_reference(tips[k + lead], axes[k + lead]);
             online.push_sample(run[k], axes[k]);
+            beamed.push_reference(tips[k + lead], axes[k + lead]);
+            beamed.push_sample(run[k], axes[k]);
             if k >= lag {
+                assert_eq!(beamed.mapped(lag), online.mapped(lag), "beam, sample {k}");
                 assert_eq!(
                     online.mapped(lag),
                     Some(offline[k - lag]),

@@ -145,16 +145,12 @@ pub fn nearest_segment_near(
     };
     let (mut best, mut d) = (mapped, distance(mapped));
     for step in [1isize, -1] {
-        loop {
-            let Some(next) = best.checked_add_signed(step) else {
-                break;
-            };
+        while let Some(next) = best.checked_add_signed(step) {
             let dn = distance(next);
-            if dn < d {
-                (best, d) = (next, dn);
-            } else {
+            if dn >= d {
                 break;
             }
+            (best, d) = (next, dn);
         }
     }
     best

@@ -182,6 +182,8 @@ pub enum Parameter {
     Band,
     /// Five-axis: samples the online mapping can read back.
     Lag,
+    /// Five-axis: the online mapping's beam.
+    Beam,
     /// Five-axis: coordinate `.1` (x, y, z) of pivot `.0` (0 = A axis, 1 = C axis).
     Pivot(usize, usize),
 }
@@ -228,6 +230,7 @@ impl fmt::Display for Parameter {
             Parameter::AngleWeight => write!(f, "hmm.angle_weight"),
             Parameter::Band => write!(f, "band"),
             Parameter::Lag => write!(f, "lag"),
+            Parameter::Beam => write!(f, "beam"),
             Parameter::Pivot(i, k) => {
                 write!(f, "{}_pivot.{}", ["a", "c"][*i], ["x", "y", "z"][*k])
             }

@@ -59,6 +59,12 @@ pub struct FiveAxisConfig {
     pub band: usize,
     /// How many samples back a mapping can be read (for the lagging estimates). Default 16.
     pub lag: usize,
+    /// The online mapping keeps the states within this much summed cost (mm) of the best.
+    /// Default 5 mm: a state that far behind gains about its distance from the tool every
+    /// sample and does not come back, while the live ones — a few segments around the
+    /// tool — are kept; the work per sample drops from the band to those (a third of the
+    /// instructions of the full band, the same mapping on both built-ins).
+    pub beam: f64,
     /// The machine.
     pub machine: TableTiltingAc,
 }
@@ -79,6 +85,7 @@ impl FiveAxisConfig {
         },
         band: 128,
         lag: 16,
+        beam: 5.0,
         machine: TableTiltingAc::ORIGIN,
     };
 
@@ -111,6 +118,12 @@ impl FiveAxisConfig {
             Parameter::ToolLength,
             self.tool_length,
             self.tool_length > 0.0,
+            "must be finite and > 0 mm",
+        )?;
+        check(
+            Parameter::Beam,
+            self.beam,
+            self.beam > 0.0,
             "must be finite and > 0 mm",
         )?;
         check(
@@ -208,7 +221,8 @@ impl FiveAxisController {
             tip: VectorLaw::new(config.tip, config.ts)?,
             orientation: VectorLaw::new(config.orientation, config.ts)
                 .map_err(|e| e.with_parameter(Parameter::orientation(e.parameter)))?,
-            mapper: OnlineMapper::new(config.hmm, config.tool_length, config.band, config.lag),
+            mapper: OnlineMapper::new(config.hmm, config.tool_length, config.band, config.lag)
+                .with_beam(config.beam),
             last_reference: None,
             config,
         })
@@ -317,7 +331,7 @@ impl FiveAxisController {
         self.tip.reset();
         self.orientation.reset();
         let c = &self.config;
-        self.mapper = OnlineMapper::new(c.hmm, c.tool_length, c.band, c.lag);
+        self.mapper = OnlineMapper::new(c.hmm, c.tool_length, c.band, c.lag).with_beam(c.beam);
         self.last_reference = None;
     }
 }
