@@ -8,9 +8,9 @@ use contour_fmu::control::{CccMode, FiveAxisConfig, FiveAxisController, SampleEr
 use contour_fmu::geometry::{self, Vector};
 use contour_fmu::kinematics::{damped_least_squares, Joints};
 use contour_fmu::path::joint_reference::JointReference;
+use contour_fmu::path::tool_path::BUILTIN_TOOL_PATHS;
 use contour_fmu::sim::{
     nearest_on_branch, simulate_five_axis, FiveAxisMetrics, FiveAxisRecord, FiveAxisSimConfig,
-    BUILTIN_TOOL_PATHS,
 };
 
 fn run(name: &str, mode: CccMode) -> (FiveAxisMetrics, Vec<FiveAxisRecord>) {

@@ -18,9 +18,7 @@ use contour_fmu::contour::run_evaluation::{
 };
 use contour_fmu::geometry::{self, Vector};
 use contour_fmu::kinematics::{Joints, Pose, TableTiltingAc};
-use contour_fmu::path::cl_data::load_cl;
-use contour_fmu::path::tool_path::ToolPath;
-use contour_fmu::path::Curve;
+use contour_fmu::path::tool_path::load_poses;
 
 mod plot;
 
@@ -157,62 +155,13 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
     Ok(Some(o))
 }
 
-/// The reference poses named by `--path`.
+/// The reference poses named by `--path` (CL warnings to stderr).
 fn load_reference(spec: &str) -> Result<Vec<Pose>, String> {
-    let lower = spec.to_ascii_lowercase();
-    let path = if lower.ends_with(".cl") || lower.ends_with(".apt") {
-        let data = load_cl(spec).map_err(|e| e.to_string())?;
-        for warning in &data.warnings {
-            eprintln!("contour-eval: warning: {warning}");
-        }
-        return Ok(data.poses);
-    } else if lower.ends_with(".json") {
-        let text =
-            std::fs::read_to_string(spec).map_err(|e| format!("{spec}: cannot read: {e}"))?;
-        ToolPath::parse_json(&text, spec).map_err(|e| e.to_string())?
-    } else {
-        match spec {
-            "tilted_helix" => ToolPath::tilted_helix(),
-            "figure_eight" => ToolPath::figure_eight(),
-            other => {
-                return Err(format!(
-                    "unknown path '{other}': expected a .cl/.apt or .json file, or one of \
-                     the built-ins tilted_helix, figure_eight"
-                ))
-            }
-        }
-    };
-    Ok(poses_of(&path))
-}
-
-/// The vertices of a pose path, or the curves of a JSON path sampled uniformly in
-/// their parameter, finely enough that no tip chord exceeds [`JSON_CHORD`].
-fn poses_of(path: &ToolPath) -> Vec<Pose> {
-    match path {
-        ToolPath::Poses { tips, axes } => tips
-            .points()
-            .iter()
-            .zip(axes)
-            .map(|(&tip, &axis)| Pose { tip, axis })
-            .collect(),
-        ToolPath::Curves { tip, .. } => {
-            let (u0, u1) = tip.param_range();
-            let mut n = ((tip.length() / JSON_CHORD).ceil() as usize).max(1);
-            loop {
-                let poses: Vec<Pose> = (0..=n)
-                    .map(|i| path.pose_at(u0 + (u1 - u0) * i as f64 / n as f64))
-                    .collect();
-                let longest = poses
-                    .windows(2)
-                    .map(|w| geometry::dist(&w[0].tip, &w[1].tip))
-                    .fold(0.0, f64::max);
-                if longest <= JSON_CHORD {
-                    return poses;
-                }
-                n *= 2;
-            }
-        }
+    let (poses, warnings) = load_poses(spec, JSON_CHORD).map_err(|e| e.to_string())?;
+    for warning in &warnings {
+        eprintln!("contour-eval: warning: {warning}");
     }
+    Ok(poses)
 }
 
 /// The measured run: times and joints.

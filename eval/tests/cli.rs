@@ -350,7 +350,11 @@ fn bad_inputs_fail_naming_the_cause_and_write_nothing() {
         (s(&no_goto), vec!["empty.cl", "at least two GOTO points"]),
         (
             "spiral",
-            vec!["unknown path 'spiral'", "tilted_helix", "figure_eight"],
+            vec![
+                "unknown five-axis path \"spiral\"",
+                "tilted_helix",
+                "figure_eight",
+            ],
         ),
         (s(&missing_cl), vec!["missing.cl", "cannot read"]),
     ] {

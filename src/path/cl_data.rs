@@ -106,7 +106,13 @@ pub fn parse_cl(text: &str, name: &str) -> Result<ClData, PathError> {
                     "{name}:{first_line}: tool axis of length {length} normalised"
                 ));
             }
-            axis = given / length;
+            // A length within a few ulps of 1 is unit already: dividing would only
+            // round (and a written unit axis would not read back as written).
+            axis = if (length - 1.0).abs() <= 4.0 * f64::EPSILON {
+                given
+            } else {
+                given / length
+            };
         }
         data.poses.push(Pose { tip, axis });
     }
@@ -172,6 +178,36 @@ mod tests {
             data.warnings,
             ["blade.cl:7: tool axis of length 2 normalised"]
         );
+    }
+
+    #[test]
+    fn written_records_read_back_exactly() {
+        // Poses written as a post-processor would (shortest round-trip decimals, a
+        // continuation line, comments and other records around) come back bit for bit.
+        let poses: Vec<Pose> = (0..50)
+            .map(|i| {
+                let t = i as f64 * 0.137;
+                let axis = Vector::<3>::new(0.3 * t.sin(), 0.2 * t.cos(), 1.0);
+                Pose {
+                    tip: Vector::<3>::new(25.0 * t.cos(), -3.0 + t.sin() / 3.0, 1e-3 * t),
+                    axis: geometry::unit(&axis).unwrap(),
+                }
+            })
+            .collect();
+        let mut text = String::from("PARTNO/ROUND TRIP\nMULTAX\nFEDRAT/MMPM,1200\n");
+        for (i, p) in poses.iter().enumerate() {
+            let [x, y, z]: [f64; 3] = p.tip.into();
+            let [a, b, c]: [f64; 3] = p.axis.into();
+            if i % 7 == 3 {
+                text += &format!("GOTO/{x},{y},{z},$\n{a},{b},{c} $$ split\n");
+            } else {
+                text += &format!("GOTO/{x},{y},{z},{a},{b},{c}\n");
+            }
+        }
+        text += "FINI\n";
+        let data = parse_cl(&text, "trip.cl").unwrap();
+        assert_eq!(data.poses, poses);
+        assert!(data.warnings.is_empty(), "{:?}", data.warnings);
     }
 
     #[test]

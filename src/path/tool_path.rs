@@ -45,7 +45,107 @@ struct ToolPathFile {
     length: f64,
 }
 
+/// Names of the built-in five-axis paths.
+pub const BUILTIN_TOOL_PATHS: [&str; 2] = ["tilted_helix", "figure_eight"];
+
+/// How a five-axis reference is named: a CL file (`.cl`, `.apt`), a two-curve JSON file
+/// (`.json`), or a built-in.
+enum Source<'a> {
+    Cl(&'a str),
+    Json(&'a str),
+    Builtin(&'a str),
+}
+
+fn source(spec: &str) -> Source<'_> {
+    let lower = spec.to_ascii_lowercase();
+    if lower.ends_with(".cl") || lower.ends_with(".apt") {
+        Source::Cl(spec)
+    } else if lower.ends_with(".json") {
+        Source::Json(spec)
+    } else {
+        Source::Builtin(spec)
+    }
+}
+
+/// The poses of the reference named `spec` (see [`ToolPath::load`]) and the CL reader's
+/// warnings: a CL file's records as written (a tool turning on the spot is kept), a
+/// curve pair sampled so that no tip chord exceeds `chord` mm.
+pub fn load_poses(spec: &str, chord: f64) -> Result<(Vec<Pose>, Vec<String>), PathError> {
+    match source(spec) {
+        Source::Cl(file) => {
+            let data = super::cl_data::load_cl(file)?;
+            Ok((data.poses, data.warnings))
+        }
+        _ => Ok((ToolPath::load(spec)?.0.poses(chord), Vec::new())),
+    }
+}
+
 impl ToolPath {
+    /// The built-in path called `name` (one of [`BUILTIN_TOOL_PATHS`]).
+    pub fn builtin(name: &str) -> Result<ToolPath, PathError> {
+        match name {
+            "tilted_helix" => Ok(ToolPath::tilted_helix()),
+            "figure_eight" => Ok(ToolPath::figure_eight()),
+            _ => Err(PathError::invalid(format!(
+                "unknown five-axis path {name:?}: expected a .cl/.apt or .json file, or a \
+                 built-in ({})",
+                BUILTIN_TOOL_PATHS.join(", ")
+            ))),
+        }
+    }
+
+    /// The reference named `spec`: a CL file (`.cl`, `.apt`: APT GOTO records), a
+    /// two-curve JSON file (`.json`), or a built-in name; with the CL reader's warnings.
+    pub fn load(spec: &str) -> Result<(ToolPath, Vec<String>), PathError> {
+        match source(spec) {
+            Source::Cl(file) => {
+                let data = super::cl_data::load_cl(file)?;
+                Ok((ToolPath::from_poses(&data.poses)?, data.warnings))
+            }
+            Source::Json(file) => {
+                let text = std::fs::read_to_string(file).map_err(|e| PathError::File {
+                    file: file.to_string(),
+                    line: 0,
+                    column: 0,
+                    message: format!("cannot read: {e}"),
+                })?;
+                Ok((ToolPath::parse_json(&text, file)?, Vec::new()))
+            }
+            Source::Builtin(name) => Ok((ToolPath::builtin(name)?, Vec::new())),
+        }
+    }
+
+    /// The reference as poses: the vertices of a pose path; a curve pair sampled
+    /// uniformly in its parameter, doubling the count until no tip chord exceeds `chord`
+    /// mm (> 0).
+    pub fn poses(&self, chord: f64) -> Vec<Pose> {
+        match self {
+            ToolPath::Poses { tips, axes } => tips
+                .points()
+                .iter()
+                .zip(axes)
+                .map(|(&tip, &axis)| Pose { tip, axis })
+                .collect(),
+            ToolPath::Curves { tip, .. } => {
+                let (u0, u1) = tip.param_range();
+                let mut n = ((tip.length() / chord).ceil() as usize).max(1);
+                loop {
+                    let poses: Vec<Pose> = (0..=n)
+                        .map(|i| self.pose_at(u0 + (u1 - u0) * i as f64 / n as f64))
+                        .collect();
+                    let longest = poses
+                        .windows(2)
+                        .map(|w| geometry::dist(&w[0].tip, &w[1].tip))
+                        .fold(0.0, f64::max);
+                    if longest <= chord || n > 1 << 26 {
+                        return poses;
+                    }
+                    n *= 2;
+                }
+            }
+        }
+    }
+
     /// Parses the JSON form; `name` is used in messages.
     pub fn parse_json(text: &str, name: &str) -> Result<Self, PathError> {
         let fail = |line: usize, column: usize, message: String| PathError::File {
@@ -250,6 +350,49 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("x.json:1:"), "{e}");
+    }
+
+    #[test]
+    fn references_are_named_by_file_kind_or_built_in_name() {
+        let dir = std::env::temp_dir().join(format!("tool-path-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // A CL file with a tool turning on the spot: as poses it is kept, as a path to
+        // follow at a tip feed it is refused (the tip does not move).
+        let cl = dir.join("part.CL");
+        std::fs::write(
+            &cl,
+            "GOTO/0,0,0,0,0,1\nGOTO/1,0,0,0,0,2\nGOTO/1,0,0,0,0.6,0.8\nGOTO/2,0,0,0,0.6,0.8\n",
+        )
+        .unwrap();
+        let spec = cl.to_str().unwrap();
+        let (poses, warnings) = load_poses(spec, 0.01).unwrap();
+        assert_eq!(poses.len(), 4);
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(ToolPath::load(spec).is_err());
+        let json = dir.join("tilt.json");
+        std::fs::write(
+            &json,
+            r#"{"tip": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0, 0], [1, 0, 0]]},
+                "second": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0, 100], [1, 0, 100]]},
+                "length": 100}"#,
+        )
+        .unwrap();
+        // 1 mm sampled at chords ≤ 0.3 mm: 4 pieces.
+        let (poses, _) = load_poses(json.to_str().unwrap(), 0.3).unwrap();
+        assert_eq!(poses.len(), 5);
+        assert!((poses[1].tip - V3::new(0.25, 0.0, 0.0)).amax() < 1e-15);
+        let (helix, _) = ToolPath::load("tilted_helix").unwrap();
+        assert_eq!(helix, ToolPath::tilted_helix());
+        let e = ToolPath::load("spiral").unwrap_err().to_string();
+        assert!(e.contains("spiral") && e.contains("figure_eight"), "{e}");
+        let e = ToolPath::load(dir.join("missing.json").to_str().unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("missing.json") && e.contains("cannot read"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

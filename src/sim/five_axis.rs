@@ -63,28 +63,13 @@ impl FiveAxisSimConfig {
 
     /// A built-in five-axis path (`tilted_helix`, `figure_eight`) at 50 mm/s.
     pub fn builtin(name: &str) -> Result<Self, PathError> {
-        Ok(Self::new(builtin_tool_path(name)?, 50.0))
+        Ok(Self::new(ToolPath::builtin(name)?, 50.0))
     }
 
     /// Both contour laws in `mode`.
     pub fn with_mode(mut self, mode: CccMode) -> Self {
         self.controller = self.controller.with_mode(mode);
         self
-    }
-}
-
-/// Names of the built-in five-axis paths.
-pub const BUILTIN_TOOL_PATHS: [&str; 2] = ["tilted_helix", "figure_eight"];
-
-/// The built-in five-axis path called `name`.
-pub fn builtin_tool_path(name: &str) -> Result<ToolPath, PathError> {
-    match name {
-        "tilted_helix" => Ok(ToolPath::tilted_helix()),
-        "figure_eight" => Ok(ToolPath::figure_eight()),
-        _ => Err(PathError::invalid(format!(
-            "unknown five-axis path {name:?}; built-ins: {}",
-            BUILTIN_TOOL_PATHS.join(", ")
-        ))),
     }
 }
 

@@ -44,8 +44,7 @@ pub use config::{
     preset_feed, SimConfig, SimError, FREE_CURVE_FEED, MAX_SAMPLES, PAPER_CIRCLE_FEED,
 };
 pub use five_axis::{
-    builtin_tool_path, nearest_on_branch, simulate_five_axis, FiveAxisMetrics, FiveAxisRecord,
-    FiveAxisSimConfig, BUILTIN_TOOL_PATHS,
+    nearest_on_branch, simulate_five_axis, FiveAxisMetrics, FiveAxisRecord, FiveAxisSimConfig,
 };
 pub use metrics::{Divergence, DivergenceKind, Metrics};
 pub use reference::ReferencePath;
