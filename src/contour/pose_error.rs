@@ -6,7 +6,7 @@
 use crate::geometry::{self, Vector};
 use crate::kinematics::Pose;
 
-use super::hmm::angle_between;
+use super::hmm::{angle_between, segment_fraction};
 
 /// Spherical interpolation of unit vectors: the unit vector a fraction `t` of the way
 /// from `a` to `b` along the great circle; `None` for opposite vectors (no unique way).
@@ -47,14 +47,17 @@ pub fn foot_point_error(r0: &Pose, r1: &Pose, actual: &Pose) -> Option<PoseError
     if !finite {
         return None;
     }
-    let d = r1.tip - r0.tip;
-    let len2 = d.dot(&d);
-    let fraction = if len2 > 0.0 {
-        ((actual.tip - r0.tip).dot(&d) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let foot = r0.tip + d * fraction;
+    errors_at(
+        r0,
+        r1,
+        segment_fraction(&actual.tip, &r0.tip, &r1.tip),
+        actual,
+    )
+}
+
+/// The errors of `actual` against the point a `fraction` of the way along the segment.
+fn errors_at(r0: &Pose, r1: &Pose, fraction: f64, actual: &Pose) -> Option<PoseError> {
+    let foot = r0.tip + (r1.tip - r0.tip) * fraction;
     let reference_axis = slerp(&r0.axis, &r1.axis, fraction)?;
     let actual_axis = geometry::unit(&actual.axis)?;
     let orientation = angle_between(&actual_axis, &reference_axis);
@@ -111,18 +114,7 @@ pub fn foot_point_error_between(
     if !(0.0..=1.0).contains(&fraction) {
         return Some(chord);
     }
-    let foot = r0.tip + d * fraction;
-    let reference_axis = slerp(&r0.axis, &r1.axis, fraction)?;
-    let actual_axis = geometry::unit(&actual.axis)?;
-    let orientation = angle_between(&actual_axis, &reference_axis);
-    let rotation = geometry::unit(&actual_axis.cross(&reference_axis))
-        .map_or(Vector::zeros(), |axis| axis * orientation);
-    Some(PoseError {
-        tip: foot - actual.tip,
-        orientation,
-        rotation,
-        fraction,
-    })
+    errors_at(r0, r1, fraction, actual)
 }
 
 /// The segment nearest the tip `tip` among the neighbours of the mapped segment

@@ -26,14 +26,7 @@ pub struct ClData {
 
 /// Reads a CL file.
 pub fn load_cl(file: impl AsRef<std::path::Path>) -> Result<ClData, PathError> {
-    let file = file.as_ref();
-    let name = file.display().to_string();
-    let text = std::fs::read_to_string(file).map_err(|e| PathError::File {
-        file: name.clone(),
-        line: 0,
-        column: 0,
-        message: format!("cannot read: {e}"),
-    })?;
+    let (name, text) = super::file::read_path_file(file.as_ref())?;
     parse_cl(&text, &name)
 }
 

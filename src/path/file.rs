@@ -21,15 +21,23 @@ use super::{Nurbs, PathError};
 pub fn load_nurbs<const D: usize>(
     file: impl AsRef<std::path::Path>,
 ) -> Result<Nurbs<D>, PathError> {
-    let file = file.as_ref();
-    let name = file.display().to_string();
-    let text = std::fs::read_to_string(file).map_err(|e| PathError::File {
-        file: name.clone(),
-        line: 0,
-        column: 0,
-        message: format!("cannot read: {e}"),
-    })?;
+    let (name, text) = read_path_file(file.as_ref())?;
     parse_nurbs(&text, &name)
+}
+
+/// The name (for messages) and the text of a path file; an unreadable file is an error
+/// naming it.
+pub(crate) fn read_path_file(file: &std::path::Path) -> Result<(String, String), PathError> {
+    let name = file.display().to_string();
+    match std::fs::read_to_string(file) {
+        Ok(text) => Ok((name, text)),
+        Err(e) => Err(PathError::File {
+            file: name,
+            line: 0,
+            column: 0,
+            message: format!("cannot read: {e}"),
+        }),
+    }
 }
 
 /// Parses the JSON text of a NURBS file; `name` is used in error messages.

@@ -103,13 +103,8 @@ impl ToolPath {
                 Ok((ToolPath::from_poses(&data.poses)?, data.warnings))
             }
             Source::Json(file) => {
-                let text = std::fs::read_to_string(file).map_err(|e| PathError::File {
-                    file: file.to_string(),
-                    line: 0,
-                    column: 0,
-                    message: format!("cannot read: {e}"),
-                })?;
-                Ok((ToolPath::parse_json(&text, file)?, Vec::new()))
+                let (name, text) = super::file::read_path_file(file.as_ref())?;
+                Ok((ToolPath::parse_json(&text, &name)?, Vec::new()))
             }
             Source::Builtin(name) => Ok((ToolPath::builtin(name)?, Vec::new())),
         }

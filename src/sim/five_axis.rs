@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use super::config::SimError;
 use super::metrics::{Divergence, DivergenceKind};
-use crate::contour::hmm::angle_between;
+use crate::contour::hmm::{angle_between, segment_fraction};
 use crate::control::{CccMode, FiveAxisConfig, FiveAxisController};
 use crate::geometry::{self, Vector};
 use crate::kinematics::Joints;
@@ -124,14 +124,7 @@ pub fn nearest_on_branch(path: &ToolPath, point: &Vector<3>, lo: f64, hi: f64) -
             let end = (hi.ceil().max(0.0) as usize).clamp(first, last);
             let mut best = (f64::INFINITY, 0.0);
             for i in first..=end {
-                let (a, b) = (&points[i], &points[i + 1]);
-                let d = b - a;
-                let len2 = d.dot(&d);
-                let t = if len2 > 0.0 {
-                    ((point - a).dot(&d) / len2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
+                let t = segment_fraction(point, &points[i], &points[i + 1]);
                 let u = (i as f64 + t).clamp(lo, hi);
                 let distance = geometry::dist(&tips.point(u), point);
                 if distance < best.0 {
