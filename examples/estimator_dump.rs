@@ -8,20 +8,9 @@
 
 use contour_fmu::contour::{true_error, TrueErrorIndex};
 use contour_fmu::path::{builtin, Curve};
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
 use serde_json::json;
-
-/// SplitMix64: small, seedable, good enough for test points.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -40,15 +29,15 @@ fn main() {
         }
     };
     let idx = TrueErrorIndex::new(&path);
-    let mut rng = Rng(seed);
+    let mut rng = StdRng::seed_from_u64(seed);
     let (a, b) = path.param_range();
     let points: Vec<_> = (0..count)
         .map(|_| {
-            let u = a + (b - a) * rng.next();
+            let u = rng.random_range(a..b);
             let e = path.eval(u);
             let s = e.d1[0].hypot(e.d1[1]);
-            let span = if rng.next() < 0.8 { 2.0 } else { 20.0 };
-            let off = (2.0 * rng.next() - 1.0) * span;
+            let span = if rng.random_bool(0.8) { 2.0 } else { 20.0 };
+            let off = rng.random_range(-span..span);
             let p = [e.p[0] - off * e.d1[1] / s, e.p[1] + off * e.d1[0] / s];
             let g = true_error(&path, p.into());
             let h = idx.error(p.into(), u);

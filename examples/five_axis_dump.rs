@@ -23,6 +23,8 @@
 use contour_fmu::geometry::Vector;
 use contour_fmu::kinematics::{Joints, Pose, TableTiltingAc};
 use contour_fmu::plant::{ServoAxes, ServoAxesParams};
+use rand::rngs::StdRng;
+use rand::{RngExt, SeedableRng};
 use serde_json::{json, Value};
 
 fn fail(msg: impl std::fmt::Display) -> ! {
@@ -30,33 +32,13 @@ fn fail(msg: impl std::fmt::Display) -> ! {
     std::process::exit(2);
 }
 
-/// SplitMix64: small, seedable, good enough for test cases.
-struct Rng(u64);
-
-impl Rng {
-    /// Uniform in [0, 1).
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in [lo, hi).
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-
-    /// 5 to 120 in magnitude, either sign: never zero.
-    fn offset(&mut self) -> f64 {
-        let magnitude = self.uniform(5.0, 120.0);
-        if self.next() < 0.5 {
-            -magnitude
-        } else {
-            magnitude
-        }
+/// 5 to 120 in magnitude, either sign: never zero.
+fn offset(rng: &mut StdRng) -> f64 {
+    let magnitude = rng.random_range(5.0..120.0);
+    if rng.random_bool(0.5) {
+        -magnitude
+    } else {
+        magnitude
     }
 }
 
@@ -64,19 +46,19 @@ fn vec<const D: usize>(v: &Vector<D>) -> Vec<f64> {
     v.iter().copied().collect()
 }
 
-fn case(rng: &mut Rng, a_angle: f64) -> Value {
+fn case(rng: &mut StdRng, a_angle: f64) -> Value {
     let q = Joints::new(
-        rng.uniform(-200.0, 200.0),
-        rng.uniform(-200.0, 200.0),
-        rng.uniform(-200.0, 200.0),
+        rng.random_range(-200.0..200.0),
+        rng.random_range(-200.0..200.0),
+        rng.random_range(-200.0..200.0),
         a_angle,
-        rng.uniform(-7.0, 7.0),
+        rng.random_range(-7.0..7.0),
     );
     let machine = TableTiltingAc {
-        a_pivot: Vector::<3>::new(rng.offset(), rng.offset(), rng.offset()),
-        c_pivot: Vector::<3>::new(rng.offset(), rng.offset(), rng.offset()),
+        a_pivot: Vector::<3>::new(offset(rng), offset(rng), offset(rng)),
+        c_pivot: Vector::<3>::new(offset(rng), offset(rng), offset(rng)),
     };
-    let previous_c = q[4] + rng.uniform(-0.5, 0.5);
+    let previous_c = q[4] + rng.random_range(-0.5..0.5);
     let pose = machine.forward(&q);
     let inverse = machine.inverse(&pose, previous_c);
     let scaled = machine.inverse(
@@ -104,10 +86,10 @@ fn case(rng: &mut Rng, a_angle: f64) -> Value {
 }
 
 fn kinematics(seed: u64, count: usize) -> Value {
-    let mut rng = Rng(seed);
+    let mut rng = StdRng::seed_from_u64(seed);
     let cases: Vec<Value> = (0..count)
         .map(|_| {
-            let a = rng.uniform(0.0, 1.5);
+            let a = rng.random_range(0.0..1.5);
             case(&mut rng, a)
         })
         .collect();

@@ -528,23 +528,10 @@ mod tests {
     use super::*;
     use crate::contour::hmm::{angle_between, viterbi_offline};
 
+    use rand::rngs::StdRng;
+    use rand::{RngExt, SeedableRng};
+
     type V3 = Vector<3>;
-
-    /// xorshift64*: a small deterministic generator for the random cases.
-    struct Rng(u64);
-
-    impl Rng {
-        fn uniform(&mut self) -> f64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-        }
-
-        fn range(&mut self, lo: f64, hi: f64) -> f64 {
-            lo + (hi - lo) * self.uniform()
-        }
-    }
 
     fn tilted(lean: f64, azimuth: f64) -> V3 {
         V3::new(
@@ -555,30 +542,32 @@ mod tests {
     }
 
     /// A random wandering reference and a noisy run along it.
-    fn random_case(rng: &mut Rng, m: usize, n: usize) -> (ReferencePolyline, Vec<V3>, Vec<V3>) {
+    fn random_case(rng: &mut StdRng, m: usize, n: usize) -> (ReferencePolyline, Vec<V3>, Vec<V3>) {
         let mut tips = vec![V3::zeros()];
         let mut heading: f64 = 0.0;
         for _ in 0..m {
-            heading += rng.range(-1.2, 1.2);
-            let step = rng.range(0.3, 2.0);
+            heading += rng.random_range(-1.2..1.2);
+            let step = rng.random_range(0.3..2.0);
             let last = *tips.last().unwrap();
-            tips.push(last + V3::new(heading.cos(), heading.sin(), rng.range(-0.3, 0.3)) * step);
+            tips.push(
+                last + V3::new(heading.cos(), heading.sin(), rng.random_range(-0.3..0.3)) * step,
+            );
         }
         let axes: Vec<V3> = (0..=m)
-            .map(|_| tilted(rng.range(0.1, 0.6), rng.range(-3.0, 3.0)))
+            .map(|_| tilted(rng.random_range(0.1..0.6), rng.random_range(-3.0..3.0)))
             .collect();
-        let length = rng.range(0.0, 50.0);
+        let length = rng.random_range(0.0..50.0);
         let reference = ReferencePolyline::new(&tips, &axes, length);
         let (mut run, mut seconds) = (Vec::new(), Vec::new());
         for k in 0..n {
-            let u = (k as f64 + rng.range(0.0, 0.5)) * m as f64 / n as f64;
+            let u = (k as f64 + rng.random_range(0.0..0.5)) * m as f64 / n as f64;
             let i = (u as usize).min(m - 1);
             let f = u - i as f64;
             let p = tips[i] * (1.0 - f) + tips[i + 1] * f;
             let noise = V3::new(
-                rng.range(-1.0, 1.0),
-                rng.range(-1.0, 1.0),
-                rng.range(-1.0, 1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
             );
             let tip = p + noise * 0.4;
             run.push(tip);
@@ -608,14 +597,14 @@ mod tests {
 
     #[test]
     fn with_the_whole_reference_in_the_window_it_decodes_as_offline() {
-        let mut rng = Rng(0x5EED_1234_ABCD_0001);
+        let mut rng = StdRng::seed_from_u64(0x5EED_1234_ABCD_0001);
         for case in 0..60 {
             let m = 2 + case % 23;
             let n = 1 + (case * 7) % 40;
             let (reference, run, seconds) = random_case(&mut rng, m, n);
             let params = HmmParams {
                 max_skip: 1 + case % 3,
-                angle_weight: rng.range(0.0, 2.0),
+                angle_weight: rng.random_range(0.0..2.0),
             };
             let offline = viterbi_offline(&reference, &params, &run, &seconds);
             // Commit attempts every sample, every third, and never before the end.
@@ -634,7 +623,7 @@ mod tests {
     fn commits_never_change_the_windowed_decoding() {
         // A window much smaller than the reference: whatever the commit schedule, the
         // mapping is the one traced back at the end.
-        let mut rng = Rng(0xC0FF_EE00_0000_0042);
+        let mut rng = StdRng::seed_from_u64(0xC0FF_EE00_0000_0042);
         for case in 0..20 {
             let (reference, run, seconds) = random_case(&mut rng, 120, 300);
             let params = HmmParams {
@@ -671,7 +660,7 @@ mod tests {
         // and only a few hundred samples are ever open at once.
         let (tips, axes) = spiral(801);
         let reference = ReferencePolyline::new(&tips, &axes, 100.0);
-        let mut rng = Rng(0x0123_4567_89AB_CDEF);
+        let mut rng = StdRng::seed_from_u64(0x0123_4567_89AB_CDEF);
         let n = 2000;
         let (mut run, mut seconds) = (Vec::new(), Vec::new());
         for k in 0..n {
@@ -680,7 +669,11 @@ mod tests {
             let tip = tips[i] * (1.0 - f)
                 + tips[i + 1] * f
                 + V3::new(0.05, -0.03, 0.02)
-                + V3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), 0.0) * 0.01;
+                + V3::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    0.0,
+                ) * 0.01;
             let axis = slerp(&axes[i], &axes[i + 1], f).unwrap();
             run.push(tip);
             seconds.push(tip + axis * 100.0);
