@@ -84,26 +84,25 @@ impl AxisParams {
     /// reflected by 1/90² (0.99·10⁻⁴). As for the linear axes the drive puts its PI zero
     /// on the mechanical pole (B/J = 80 rad/s, so B = 0.016 N·m·s/rad at the motor) and
     /// closes the velocity loop at 314 rad/s (50 Hz): Kvp = 314·J/CT, Kvi = 80·Kvp.
-    pub const TRUNNION_A: AxisParams = AxisParams {
-        inertia: 1.99e-4,
-        friction: 80.0 * 1.99e-4,
-        torque_constant: 0.57,
-        transmission: Transmission::Rotary { ratio: 90.0 },
-        kvp: 314.0 * 1.99e-4 / 0.57,
-        kvi: 80.0 * 314.0 * 1.99e-4 / 0.57,
-    };
+    pub const TRUNNION_A: AxisParams = AxisParams::trunnion_drive(1.99e-4);
 
     /// Rotary (C) axis of the same table: a Ø170 mm, 15 kg platter with part
     /// (½·m·r² = 0.054 kg·m², reflected 0.67·10⁻⁵) on the same motor and 90:1 gear; drive
     /// tuned by the same rule.
-    pub const TRUNNION_C: AxisParams = AxisParams {
-        inertia: 1.067e-4,
-        friction: 80.0 * 1.067e-4,
-        torque_constant: 0.57,
-        transmission: Transmission::Rotary { ratio: 90.0 },
-        kvp: 314.0 * 1.067e-4 / 0.57,
-        kvi: 80.0 * 314.0 * 1.067e-4 / 0.57,
-    };
+    pub const TRUNNION_C: AxisParams = AxisParams::trunnion_drive(1.067e-4);
+
+    /// A trunnion-table axis of motor-side inertia `inertia`: the 0.57 N·m/A motor, a
+    /// 90:1 gear, the PI zero on the mechanical pole (80 rad/s) and a 314 rad/s loop.
+    const fn trunnion_drive(inertia: f64) -> AxisParams {
+        AxisParams {
+            inertia,
+            friction: 80.0 * inertia,
+            torque_constant: 0.57,
+            transmission: Transmission::Rotary { ratio: 90.0 },
+            kvp: 314.0 * inertia / 0.57,
+            kvi: 80.0 * 314.0 * inertia / 0.57,
+        }
+    }
 
     /// Checks that the parameters describe a physical, stable drive; the error names
     /// the offending field.
