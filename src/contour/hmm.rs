@@ -72,7 +72,7 @@ impl ReferencePolyline {
 }
 
 /// Parameters of the mapping.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct HmmParams {
     /// Largest forward move per sample, in segments (the paper's K = 1).
     pub max_skip: usize,

@@ -8,12 +8,15 @@
 //! With a band covering the whole reference and a lag covering the whole run it decodes
 //! what [`viterbi_offline`](super::hmm::viterbi_offline) decodes.
 
+use serde::{Deserialize, Serialize};
+
 use super::hmm::{segment_cost, HmmParams};
-use crate::geometry::Vector;
+use crate::geometry::{self, Vector};
 use crate::kinematics::Pose;
 
-/// The online decoder.
-#[derive(Clone, Debug)]
+/// The online decoder. It serialises whole (for FMU state save/restore); bytes from
+/// elsewhere go through [`OnlineMapper::check`] before use.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct OnlineMapper {
     params: HmmParams,
     length: f64,
@@ -85,6 +88,80 @@ impl OnlineMapper {
         self.references += 1;
     }
 
+    /// Checks what construction and use guarantee, for a decoder restored from bytes:
+    /// ring sizes that match the band and lag, a live range inside the band, finite
+    /// points and parameters. The error names the first violation.
+    pub fn check(&self) -> Result<(), String> {
+        let capacity = (self.band.max(1) + 1).next_power_of_two();
+        let rows = self
+            .lag
+            .checked_add(1)
+            .and_then(|r| r.checked_mul(capacity));
+        if self.band == 0 || self.mask != capacity - 1 {
+            return Err(format!(
+                "ring mask {} does not fit the band {}",
+                self.mask, self.band
+            ));
+        }
+        for (name, len) in [
+            ("tips", self.tips.len()),
+            ("axes", self.axes.len()),
+            ("second points", self.seconds.len()),
+            ("costs", self.cost.len()),
+            ("next costs", self.next.len()),
+        ] {
+            if len != capacity {
+                return Err(format!("{name} ring holds {len} entries, not {capacity}"));
+            }
+        }
+        if rows != Some(self.back.len()) {
+            return Err(format!(
+                "back-pointer table holds {} entries, not (lag + 1)·{capacity}",
+                self.back.len()
+            ));
+        }
+        let (lo, hi) = self.valid;
+        if lo > hi || hi > self.references || hi - lo > self.band {
+            return Err(format!(
+                "live segments {lo}..{hi} lie outside the band of the {} reference points",
+                self.references
+            ));
+        }
+        if !(self.params.max_skip >= 1 && self.params.angle_weight >= 0.0)
+            || !self.params.angle_weight.is_finite()
+        {
+            return Err(format!("mapping parameters {:?} are invalid", self.params));
+        }
+        if !(self.length.is_finite() && self.length > 0.0) || self.beam.is_nan() || self.beam <= 0.0
+        {
+            return Err(format!(
+                "tool length {} mm or beam {} mm is invalid",
+                self.length, self.beam
+            ));
+        }
+        let points = self.tips.iter().chain(&self.axes).chain(&self.seconds);
+        if !points.chain(&self.previous_tip).all(geometry::is_finite)
+            || self.cost.iter().chain(&self.next).any(|c| c.is_nan())
+        {
+            return Err("a reference point, cost or the previous tip is not finite".into());
+        }
+        Ok(())
+    }
+
+    /// The mapping's settings: parameters, tool length, band, lag, beam.
+    pub fn settings(&self) -> (HmmParams, f64, usize, usize, f64) {
+        (self.params, self.length, self.band, self.lag, self.beam)
+    }
+
+    /// Reference point `i` while it is held (it ends a held segment, or begins one).
+    pub fn point(&self, i: usize) -> Option<Pose> {
+        let held = self.references.saturating_sub(self.band + 1);
+        (i >= held && i < self.references).then(|| Pose {
+            tip: self.tips[i & self.mask],
+            axis: self.axes[i & self.mask],
+        })
+    }
+
     /// Reference points pushed so far.
     pub fn references(&self) -> usize {
         self.references
@@ -92,15 +169,7 @@ impl OnlineMapper {
 
     /// The end poses of segment `j` while it is still held (one of the `band` newest).
     pub fn segment(&self, j: usize) -> Option<(Pose, Pose)> {
-        let held = self.references.saturating_sub(self.band + 1);
-        if j < held || j + 1 >= self.references {
-            return None;
-        }
-        let pose = |i: usize| Pose {
-            tip: self.tips[i & self.mask],
-            axis: self.axes[i & self.mask],
-        };
-        Some((pose(j), pose(j + 1)))
+        Some((self.point(j)?, self.point(j.checked_add(1)?)?))
     }
 
     /// Samples mapped so far.

@@ -7,6 +7,7 @@ pub mod choice;
 pub mod continuous_sign;
 pub mod estimate;
 pub mod evaluation;
+pub mod evaluation_online;
 pub mod free_curve;
 pub mod hmm;
 pub mod hmm_online;

@@ -21,9 +21,12 @@
 //! Fixed-size state apart from the mapper's rings (sized once at construction), so
 //! `sample` never allocates.
 
+use serde::{Deserialize, Serialize};
+
 use super::ccc_law::{CccStep, VectorLaw};
 use super::config::{check, CccConfig, CccMode, ConfigError, Parameter};
 use super::pid::{Pid, PidGains};
+use crate::contour::evaluation_online::{OnlineEvaluation, PointEvaluation};
 use crate::contour::hmm::HmmParams;
 use crate::contour::hmm_online::OnlineMapper;
 use crate::contour::pose_error::{foot_point_error_between, nearest_segment_near, PoseError};
@@ -31,7 +34,7 @@ use crate::geometry::{self, Vector};
 use crate::kinematics::{damped_least_squares, Joints, Pose, TableTiltingAc};
 
 /// Configuration of the five-axis controller.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FiveAxisConfig {
     /// Sample period, s. Default 1 ms.
     pub ts: f64,
@@ -155,6 +158,12 @@ impl FiveAxisConfig {
     }
 }
 
+/// The online mapping `config` asks for.
+fn mapper(config: &FiveAxisConfig) -> OnlineMapper {
+    OnlineMapper::new(config.hmm, config.tool_length, config.band, config.lag)
+        .with_beam(config.beam)
+}
+
 impl Default for FiveAxisConfig {
     fn default() -> Self {
         Self::DEFAULT
@@ -177,6 +186,10 @@ pub struct FiveAxisOutput {
     /// The tip and orientation laws' steps.
     pub tip_step: CccStep,
     pub orientation_step: CccStep,
+    /// The newest evaluation-function estimate (docs/design.md §5.3), for a reference
+    /// point the settled mapping has passed: it describes the tool `lag` or more samples
+    /// ago ([`PointEvaluation::sample`]).
+    pub evaluation: Option<PointEvaluation>,
 }
 
 /// Why a sample was refused.
@@ -197,14 +210,16 @@ impl std::fmt::Display for SampleError {
     }
 }
 
-/// The five-axis controller.
-#[derive(Clone, Debug)]
+/// The five-axis controller. It serialises whole (FMU state save/restore); bytes from
+/// elsewhere go through [`FiveAxisController::check`] before use.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FiveAxisController {
     config: FiveAxisConfig,
     axes: [Pid; 5],
     tip: VectorLaw<3>,
     orientation: VectorLaw<3>,
     mapper: OnlineMapper,
+    evaluation: OnlineEvaluation,
     /// The last reference pose given to the mapper.
     last_reference: Option<Pose>,
 }
@@ -221,8 +236,8 @@ impl FiveAxisController {
             tip: VectorLaw::new(config.tip, config.ts)?,
             orientation: VectorLaw::new(config.orientation, config.ts)
                 .map_err(|e| e.with_parameter(Parameter::orientation(e.parameter)))?,
-            mapper: OnlineMapper::new(config.hmm, config.tool_length, config.band, config.lag)
-                .with_beam(config.beam),
+            mapper: mapper(&config),
+            evaluation: OnlineEvaluation::new(config.hmm.max_skip, config.lag),
             last_reference: None,
             config,
         })
@@ -281,6 +296,9 @@ impl FiveAxisController {
                     .map(|e| (e, tangent))
             });
         let error = foot.map(|(e, _)| e);
+        let evaluation =
+            self.evaluation
+                .push(machine, &self.mapper, self.config.lag, actual, &pose.tip);
         let mut output = FiveAxisOutput {
             u,
             following_error,
@@ -289,6 +307,7 @@ impl FiveAxisController {
             correction: Joints::zeros(),
             tip_step: CccStep::default(),
             orientation_step: CccStep::default(),
+            evaluation,
         };
         if let Some((e, tangent)) = &foot {
             let (v, tip_step) = self
@@ -324,14 +343,45 @@ impl FiveAxisController {
         damped_least_squares(&jacobian, &target, self.config.damping).unwrap_or_else(Joints::zeros)
     }
 
+    /// The position loops' PIDs (X, Y, Z, A, C).
+    pub fn axes(&self) -> &[Pid; 5] {
+        &self.axes
+    }
+
+    /// The tip and the orientation laws.
+    pub fn laws(&self) -> [&VectorLaw<3>; 2] {
+        [&self.tip, &self.orientation]
+    }
+
+    /// Checks the memories of a controller restored from bytes against its own
+    /// configuration: the mapping and the evaluation built for these settings, finite
+    /// poses. (The configuration and the PIDs are checked by the caller, which knows the
+    /// parameters' names.)
+    pub fn check_memory(&self) -> Result<(), String> {
+        let c = &self.config;
+        if self.mapper.settings() != mapper(c).settings() {
+            return Err("the mapping's settings differ from the configuration".into());
+        }
+        self.mapper.check().map_err(|e| format!("mapping: {e}"))?;
+        self.evaluation
+            .check(c.hmm.max_skip, c.lag)
+            .map_err(|e| format!("evaluation: {e}"))?;
+        if let Some(p) = &self.last_reference {
+            if !(geometry::is_finite(&p.tip) && geometry::is_finite(&p.axis)) {
+                return Err("the last reference pose is not finite".into());
+            }
+        }
+        Ok(())
+    }
+
     /// Back to the initial state (the mapping forgets its reference too); the
     /// configuration is kept.
     pub fn reset(&mut self) {
         self.axes.iter_mut().for_each(Pid::reset);
         self.tip.reset();
         self.orientation.reset();
-        let c = &self.config;
-        self.mapper = OnlineMapper::new(c.hmm, c.tool_length, c.band, c.lag).with_beam(c.beam);
+        self.mapper = mapper(&self.config);
+        self.evaluation = OnlineEvaluation::new(self.config.hmm.max_skip, self.config.lag);
         self.last_reference = None;
     }
 }
