@@ -127,9 +127,8 @@ impl OnlineMapper {
                 self.references
             ));
         }
-        if !(self.params.max_skip >= 1 && self.params.angle_weight >= 0.0)
-            || !self.params.angle_weight.is_finite()
-        {
+        let weight = self.params.angle_weight;
+        if self.params.max_skip == 0 || !(weight.is_finite() && weight >= 0.0) {
             return Err(format!("mapping parameters {:?} are invalid", self.params));
         }
         if !(self.length.is_finite() && self.length > 0.0) || self.beam.is_nan() || self.beam <= 0.0
