@@ -19,10 +19,18 @@
 //!   and saturates, Z is a sine, A steps up and back, C is a ramp plus a sine. Output:
 //!   the axis parameters, the start, the command of every step and the positions and
 //!   velocities after every step (row k is after step k + 1).
+//! - `five_axis_dump closed_loop PATH MODE [FEED]`: the in-process five-axis closed loop
+//!   (`contour_fmu::sim::five_axis`) on a built-in path or a CL/JSON file, CCC `off`,
+//!   `fixed` or `fuzzy`, at FEED mm/s (default 50): the metrics and every sample's record
+//!   (time, reference and actual joints, command, true and estimated errors), for the
+//!   FMU closed loop to reproduce (tests/fmpy/test_five_axis_fmus.py).
 
+use contour_fmu::control::CccMode;
 use contour_fmu::geometry::Vector;
 use contour_fmu::kinematics::{Joints, Pose, TableTiltingAc};
+use contour_fmu::path::tool_path::ToolPath;
 use contour_fmu::plant::{ServoAxes, ServoAxesParams};
+use contour_fmu::sim::{simulate_five_axis, FiveAxisSimConfig};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use serde_json::{json, Value};
@@ -143,6 +151,25 @@ fn plant(steps: usize, dt: f64) -> Value {
     })
 }
 
+fn closed_loop(path: &str, mode: &str, feed: f64) -> Value {
+    let mode = match mode {
+        "off" => CccMode::Off,
+        "fixed" => CccMode::Fixed,
+        "fuzzy" => CccMode::Fuzzy,
+        other => fail(format!("MODE must be off, fixed or fuzzy (got {other})")),
+    };
+    let (tool_path, _) = ToolPath::load(path).unwrap_or_else(|e| fail(e));
+    let mut config = FiveAxisSimConfig::new(tool_path, feed).with_mode(mode);
+    config.settle = 0.1;
+    let (metrics, records) = simulate_five_axis(&config, true).unwrap_or_else(|e| fail(e));
+    json!({
+        "ts": config.controller.ts,
+        "feed": feed,
+        "metrics": metrics,
+        "records": records,
+    })
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let arg = |i: usize| args.get(i).map(String::as_str);
@@ -172,7 +199,18 @@ fn main() {
             }
             plant(steps, dt)
         }
-        _ => fail("usage: five_axis_dump kinematics SEED N | five_axis_dump plant STEPS DT"),
+        Some("closed_loop") => closed_loop(
+            arg(1).unwrap_or("tilted_helix"),
+            arg(2).unwrap_or("fuzzy"),
+            arg(3)
+                .unwrap_or("50")
+                .parse()
+                .unwrap_or_else(|e| fail(format!("FEED: {e}"))),
+        ),
+        _ => fail(
+            "usage: five_axis_dump kinematics SEED N | five_axis_dump plant STEPS DT | \
+             five_axis_dump closed_loop PATH MODE [FEED]",
+        ),
     };
     println!("{out}");
 }

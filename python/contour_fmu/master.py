@@ -19,7 +19,8 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-from .wiring import CLOSED_LOOP_CONNECTIONS, PATH_START
+from .wiring import (CLOSED_LOOP_CONNECTIONS, FIVE_AXIS_CONNECTIONS, FIVE_AXIS_JOINTS,
+                     FIVE_AXIS_PATH_START, PATH_START)
 
 SCHEMES = ("gauss-seidel", "jacobi")
 
@@ -150,3 +151,30 @@ def closed_loop(fmu_dir, path="circle", feed=None, stop=2.0, step=1e-3, controll
     ]
     with Master(units, CLOSED_LOOP_CONNECTIONS, step, stop, scheme, initial=PATH_START) as master:
         return master.run(CLOSED_LOOP_RECORD)
+
+
+FIVE_AXIS_RECORD = (
+    [("interpolator", f"ref.{j}") for j in FIVE_AXIS_JOINTS]
+    + [("plant", f"pos.{j}") for j in FIVE_AXIS_JOINTS]
+    + [("controller", f"u.{j}") for j in FIVE_AXIS_JOINTS]
+    + [("controller", name) for name in ("contourError.tip", "contourError.orientation",
+                                         "evaluation.tip", "evaluation.orientation",
+                                         "evaluation.delay")]
+)
+
+
+def five_axis_closed_loop(fmu_dir, path="tilted_helix", feed=None, stop=1.0, step=1e-3,
+                          controller=None, plant=None, scheme="gauss-seidel", interpolator=None):
+    """Runs PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant; returns (before, after) as
+    `closed_loop` does. `interpolator` holds further PathInterpolator5X start values."""
+    interpolator = {"path": path, **(interpolator or {})}
+    if feed is not None:
+        interpolator["feed"] = feed
+    units = [
+        Unit("controller", str(fmu_dir / "ContourCCC5X.fmu"), dict(controller or {})),
+        Unit("plant", str(fmu_dir / "FiveAxisPlant.fmu"), dict(plant or {})),
+        Unit("interpolator", str(fmu_dir / "PathInterpolator5X.fmu"), interpolator),
+    ]
+    with Master(units, FIVE_AXIS_CONNECTIONS, step, stop, scheme,
+                initial=FIVE_AXIS_PATH_START) as master:
+        return master.run(FIVE_AXIS_RECORD)

@@ -16,3 +16,15 @@ PATH_START = [
     ("interpolator", "ref.x", "plant", "pos0.x"),
     ("interpolator", "ref.y", "plant", "pos0.y"),
 ]
+
+FIVE_AXIS_JOINTS = ("X", "Y", "Z", "A", "C")
+
+# The five-axis loop: PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant.
+FIVE_AXIS_CONNECTIONS = (
+    [("interpolator", f"ref.{j}", "controller", f"ref.{j}") for j in FIVE_AXIS_JOINTS]
+    + [("plant", f"pos.{j}", "controller", f"pos.{j}") for j in FIVE_AXIS_JOINTS]
+    + [("controller", f"u.{j}", "plant", f"u.{j}") for j in FIVE_AXIS_JOINTS]
+)
+
+# The plant starts at the path's start joints.
+FIVE_AXIS_PATH_START = [("interpolator", f"ref.{j}", "plant", f"pos0.{j}") for j in FIVE_AXIS_JOINTS]

@@ -343,6 +343,11 @@ impl FiveAxisController {
         damped_least_squares(&jacobian, &target, self.config.damping).unwrap_or_else(Joints::zeros)
     }
 
+    /// Samples taken so far.
+    pub fn samples(&self) -> u64 {
+        self.evaluation.samples()
+    }
+
     /// The position loops' PIDs (X, Y, Z, A, C).
     pub fn axes(&self) -> &[Pid; 5] {
         &self.axes

@@ -120,6 +120,9 @@ impl Instance {
                 .initialize(&mut self.values, self.time)
                 .map_err(Failure::error)?;
             self.needs_initialize = false;
+            for warning in self.model.take_warnings() {
+                self.log_warning(&warning);
+            }
         }
         Ok(())
     }

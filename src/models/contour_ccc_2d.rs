@@ -13,7 +13,7 @@ use super::{
 use crate::contour::{ArcEstimator, Estimator, EstimatorKind, FreeCurveEstimator, LineEstimator};
 use crate::control::{
     CccConfig, CccMode, ConfigError, ControllerConfig, CrossCoupledController, FuzzyFactor,
-    FuzzyFactors, Gain, Parameter, Pid, PidGains,
+    FuzzyFactors, Gain, Parameter, PidGains,
 };
 use crate::geometry::{Vector, Vector2};
 
@@ -197,51 +197,15 @@ impl SavedState for State {
             ));
         }
         for (axis, pid) in XY.iter().zip(controller.axes()) {
-            check_pid(&format!("{} position loop", axis.label), pid, config.ts)?;
+            state_check::check_pid(&format!("{} position loop", axis.label), pid, config.ts)?;
         }
-        check_pid("contour PID", controller.law().pid(), config.ts)?;
+        state_check::check_pid("contour PID", controller.law().pid(), config.ts)?;
         for (axis, pid) in XY.iter().zip(controller.contour_axes()) {
-            check_pid(&format!("{} contour PID", axis.label), pid, config.ts)?;
+            state_check::check_pid(&format!("{} contour PID", axis.label), pid, config.ts)?;
         }
         state_check::all_positive(self, "radius").map_err(|e| format!("estimator: {e}"))?;
         state_check::all_finite(self)
     }
-}
-
-/// A PID restored from bytes: its period, gains, limit and memory (integral and previous
-/// error) as the configuration would have made them.
-fn check_pid(name: &str, pid: &Pid, ts: f64) -> Result<(), String> {
-    if pid.ts() != ts {
-        return Err(format!(
-            "{name}: PID sample period {} s differs from Ts = {ts} s",
-            pid.ts()
-        ));
-    }
-    if !pid.integral().is_finite() {
-        return Err(format!(
-            "{name}: PID memory (integral) = {} is not finite",
-            pid.integral()
-        ));
-    }
-    if let Some(e) = pid.previous_error().filter(|e| !e.is_finite()) {
-        return Err(format!(
-            "{name}: PID memory (previous error) = {e} is not finite"
-        ));
-    }
-    let g = pid.gains();
-    for (gain, value) in [("Kp", g.kp), ("Ki", g.ki), ("Kd", g.kd)] {
-        if !(value.is_finite() && value >= 0.0) {
-            return Err(format!(
-                "{name}: PID gain {gain} = {value} must be finite and >= 0"
-            ));
-        }
-    }
-    if let Some(limit) = pid.limit().filter(|l| !(l.is_finite() && *l > 0.0)) {
-        return Err(format!(
-            "{name}: PID output limit {limit} must be finite and > 0"
-        ));
-    }
-    Ok(())
 }
 
 pub struct ContourCcc2D {

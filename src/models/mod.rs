@@ -2,9 +2,14 @@
 //! function. Nothing here knows FMI types; `crate::fmi2` adapts these to the C ABI.
 
 pub mod contour_ccc_2d;
+pub mod contour_ccc_5x;
+pub mod five_axis_plant;
+pub mod kinematics_parameters;
 pub mod line_arc_parameters;
 pub mod path_interpolator_2d;
+pub mod path_interpolator_5x;
 pub mod sample_clock;
+pub mod servo_plant;
 pub mod state_check;
 pub mod text;
 pub mod units;
@@ -40,6 +45,12 @@ pub trait Model: Send {
     /// Checks the parameters, rebuilds the internal state from them at `start_time` and
     /// computes the outputs. Called in initialization mode, possibly several times.
     fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult;
+
+    /// Warnings about the last initialization that did not stop it (a path file's
+    /// tolerated irregularities): the FMI layer logs them, and they are gone.
+    fn take_warnings(&mut self) -> Vec<String> {
+        Vec::new()
+    }
 
     /// Tunable parameters changed between steps: check and adopt them. On error the FMI
     /// layer restores the previous values.
@@ -267,6 +278,9 @@ pub fn all() -> Vec<&'static ModelInfo> {
         &path_interpolator_2d::INFO,
         &contour_ccc_2d::INFO,
         &xy_servo_plant::INFO,
+        &path_interpolator_5x::INFO,
+        &contour_ccc_5x::INFO,
+        &five_axis_plant::INFO,
     ]
 }
 
@@ -334,11 +348,20 @@ mod tests {
                 None => vec![Value::Integer(x + 1)],
             },
             Value::Boolean(b) => vec![Value::Boolean(!b)],
-            Value::String(text) => ["circle", "line", "arc", "infinity", "trident", "other"]
-                .iter()
-                .filter(|t| **t != text)
-                .map(|t| Value::String(t.to_string()))
-                .collect(),
+            Value::String(text) => [
+                "circle",
+                "line",
+                "arc",
+                "infinity",
+                "trident",
+                "tilted_helix",
+                "figure_eight",
+                "other",
+            ]
+            .iter()
+            .filter(|t| **t != text)
+            .map(|t| Value::String(t.to_string()))
+            .collect(),
         };
         candidates
             .into_iter()

@@ -6,6 +6,7 @@
 
 use std::fmt;
 
+use crate::control::Pid;
 use serde::ser::{self, Serialize};
 
 /// `fn name(self, _: T) -> Done { Ok(()) }` for each `name: T`.
@@ -267,6 +268,42 @@ impl ser::SerializeMap for Compound<'_> {
     fn end(self) -> Done {
         self.finish()
     }
+}
+
+/// A PID restored from bytes: its period, gains, limit and memory (integral and previous
+/// error) as the configuration would have made them.
+pub fn check_pid(name: &str, pid: &Pid, ts: f64) -> Result<(), String> {
+    if pid.ts() != ts {
+        return Err(format!(
+            "{name}: PID sample period {} s differs from Ts = {ts} s",
+            pid.ts()
+        ));
+    }
+    if !pid.integral().is_finite() {
+        return Err(format!(
+            "{name}: PID memory (integral) = {} is not finite",
+            pid.integral()
+        ));
+    }
+    if let Some(e) = pid.previous_error().filter(|e| !e.is_finite()) {
+        return Err(format!(
+            "{name}: PID memory (previous error) = {e} is not finite"
+        ));
+    }
+    let g = pid.gains();
+    for (gain, value) in [("Kp", g.kp), ("Ki", g.ki), ("Kd", g.kd)] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(format!(
+                "{name}: PID gain {gain} = {value} must be finite and >= 0"
+            ));
+        }
+    }
+    if let Some(limit) = pid.limit().filter(|l| !(l.is_finite() && *l > 0.0)) {
+        return Err(format!(
+            "{name}: PID output limit {limit} must be finite and > 0"
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -48,6 +48,7 @@ pub const UNITS: &[UnitDefinition] = &[
     unit("A/rad", 0, 0, 0, 1, -1, 1.0),
     unit("rad", 0, 0, 0, 0, 1, 1.0),
     unit("rad/s", 0, 0, -1, 0, 1, 1.0),
+    unit("mm/rad", 0, 1, 0, 0, -1, 1e-3),
 ];
 
 pub fn find(name: &str) -> Option<&'static UnitDefinition> {

@@ -155,6 +155,15 @@ impl Axis {
 /// The two-axis models' axes.
 pub const XY: [Axis; 2] = [Axis::linear("x", "X"), Axis::linear("y", "Y")];
 
+/// The five-axis models' joints: X, Y, Z linear, A (tilt) and C (rotary table).
+pub const XYZAC: [Axis; 5] = [
+    Axis::linear("X", "X"),
+    Axis::linear("Y", "Y"),
+    Axis::linear("Z", "Z"),
+    Axis::rotary("A", "A"),
+    Axis::rotary("C", "C"),
+];
+
 /// A unit that may depend on the axis kind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AxisUnit {

@@ -5,10 +5,10 @@
 use super::variable_table::{axis_block, variable_table, AxisTemplate, AxisUnit, AxisWord, XY};
 use super::variables::Values;
 use super::{
-    decode_state, encode_state, state_check, DefaultExperiment, Environment, Model, ModelInfo,
+    decode_state, encode_state, servo_plant, DefaultExperiment, Environment, Model, ModelInfo,
     ModelResult, StateLayout,
 };
-use crate::plant::{AxisParams, ServoAxis, Transmission, XyTable, XyTableParams};
+use crate::plant::{AxisParams, Transmission, XyTable, XyTableParams};
 
 const P: AxisParams = AxisParams::PAPER;
 const LEAD: f64 = match P.transmission {
@@ -125,62 +125,9 @@ const LAYOUT: StateLayout = StateLayout {
     version: 2,
 };
 
-/// Checks a restored table like the parameters it was built from; the error names the
-/// offending value.
-fn validate(table: &XyTable) -> Result<(), String> {
-    for (name, axis) in XY.iter().map(|a| a.name).zip(&table.axes) {
-        axis.params()
-            .validate()
-            .map_err(|e| format!("axis {name}: {e}"))?;
-        // The FMU's parameters make ball screws only.
-        if !matches!(axis.params().transmission, Transmission::Linear { .. }) {
-            return Err(format!("axis {name}: a rotary transmission in an XY table"));
-        }
-        state_check::all_finite(axis).map_err(|e| format!("axis {name}: {e}"))?;
-        check_cached_transition(name, axis)?;
-    }
-    Ok(())
-}
-
-/// An axis keeps the transition matrices of its last step length; they must be the ones
-/// its parameters give for that length (recomputed the same way, so bit for bit), or the
-/// restored axis would follow other dynamics than its parameters say.
-fn check_cached_transition(name: &str, axis: &ServoAxis) -> Result<(), String> {
-    let cached = |a: &ServoAxis| -> Vec<(String, f64)> {
-        state_check::floats(a)
-            .into_iter()
-            .filter(|(path, _)| path.starts_with("cached"))
-            .collect()
-    };
-    let saved = cached(axis);
-    let Some(&(_, step)) = saved.iter().find(|(path, _)| path == "cached.step") else {
-        return Ok(()); // nothing cached yet
-    };
-    if !(step.is_finite() && step > 0.0) {
-        return Err(format!(
-            "axis {name}: cached step length {step} s must be finite and > 0"
-        ));
-    }
-    let mut reference = ServoAxis::new(*axis.params(), 0.0);
-    reference.step(0.0, step);
-    let expected = cached(&reference);
-    if saved.len() != expected.len()
-        || saved
-            .iter()
-            .zip(&expected)
-            .any(|(a, b)| a.0 != b.0 || a.1.to_bits() != b.1.to_bits())
-    {
-        return Err(format!(
-            "axis {name}: the cached transition for steps of {step} s does not match the \
-             axis parameters"
-        ));
-    }
-    Ok(())
-}
-
 fn decode(bytes: &[u8]) -> Result<XyTable, String> {
     let table: XyTable = decode_state(LAYOUT, bytes)?;
-    validate(&table)?;
+    servo_plant::validate(&table, &XY)?;
     Ok(table)
 }
 
@@ -199,26 +146,13 @@ impl Default for XyServoPlant {
 
 /// The parameters of axis `index` (0 = x, 1 = y).
 fn axis_params(values: &Values, index: usize) -> Result<AxisParams, String> {
-    let first = index * AXIS_FIELDS.len();
-    let p = |i: usize| AXIS_PARAMS.at(first + i).get(values);
-    let params = AxisParams {
-        inertia: p(0),
-        friction: p(1),
-        torque_constant: p(2),
-        transmission: Transmission::Linear { lead: p(3) },
-        kvp: p(4),
-        kvi: p(5),
-    };
-    // J, CT and lead divide or scale the dynamics: zero is as unphysical as negative.
-    for i in [0, 2, 3] {
-        if p(i) <= 0.0 {
-            let name = VARIABLES[AXIS_PARAMS.at(first + i).vr()].name;
-            return Err(format!("parameter '{name}' must be > 0 (got {})", p(i)));
-        }
-    }
-    let axis = XY[index].name;
-    params.validate().map_err(|e| format!("axis {axis}: {e}"))?;
-    Ok(params)
+    servo_plant::axis_params(
+        values,
+        &VARIABLES,
+        AXIS_PARAMS,
+        index * AXIS_FIELDS.len(),
+        &XY[index],
+    )
 }
 
 impl XyServoPlant {

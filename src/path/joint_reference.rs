@@ -3,14 +3,16 @@
 //! axis is the path's at that point, and the joints come from the machine's inverse
 //! kinematics with C unwrapped from sample to sample.
 
+use serde::{Deserialize, Serialize};
+
 use super::interpolator::Interpolator;
 use super::polyline::Polyline;
 use super::tool_path::ToolPath;
-use super::{Nurbs, PathError};
+use super::{Curve, Nurbs, PathError};
 use crate::kinematics::{Joints, Pose, TableTiltingAc};
 
 /// The tip curve the interpolator runs on.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 enum TipInterpolator {
     Curve(Interpolator<3, Nurbs<3>>),
     Polyline(Interpolator<3, Polyline<3>>),
@@ -26,8 +28,10 @@ pub struct JointSample {
     pub done: bool,
 }
 
-/// Samples a [`ToolPath`] at a constant tip feed and converts each sample to joints.
-#[derive(Clone, Debug)]
+/// Samples a [`ToolPath`] at a constant tip feed and converts each sample to joints. The
+/// whole struct is the state the FMU saves; bytes from elsewhere go through
+/// [`JointReference::check`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct JointReference {
     path: ToolPath,
     machine: TableTiltingAc,
@@ -89,6 +93,54 @@ impl JointReference {
             u,
             done,
         }
+    }
+
+    /// Checks a reference restored from bytes as construction would have made it, with
+    /// sample period `ts`: the interpolator runs on the path's own tip curve at a finite
+    /// feed, inside its parameter range, and the joints and machine are finite. (The path
+    /// checked itself when decoded.) The error names the first violation.
+    pub fn check(&self, ts: f64) -> Result<(), String> {
+        let (same_curve, feed, period, u, range) = match (&self.tip, &self.path) {
+            (TipInterpolator::Curve(i), ToolPath::Curves { tip, .. }) => (
+                i.path() == tip,
+                i.feed(),
+                i.ts(),
+                i.parameter(),
+                tip.param_range(),
+            ),
+            (TipInterpolator::Polyline(i), ToolPath::Poses { tips, .. }) => (
+                i.path() == tips,
+                i.feed(),
+                i.ts(),
+                i.parameter(),
+                tips.param_range(),
+            ),
+            _ => return Err("the interpolator runs on another kind of path".into()),
+        };
+        if !same_curve {
+            return Err("the interpolator runs on another tip curve than the path's".into());
+        }
+        if !(feed.is_finite() && feed >= 0.0) {
+            return Err(format!("feed {feed} mm/s must be finite and >= 0"));
+        }
+        if period != ts {
+            return Err(format!(
+                "interpolation period {period} s differs from the sample clock's {ts} s"
+            ));
+        }
+        if !(range.0..=range.1).contains(&u) {
+            return Err(format!(
+                "path parameter {u} lies outside the path's [{}, {}]",
+                range.0, range.1
+            ));
+        }
+        let machine = [self.machine.a_pivot, self.machine.c_pivot];
+        if !(crate::geometry::is_finite(&self.joints)
+            && machine.iter().all(crate::geometry::is_finite))
+        {
+            return Err("the joints or the machine's pivots are not finite".into());
+        }
+        Ok(())
     }
 
     /// Advances one period.

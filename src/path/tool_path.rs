@@ -3,7 +3,7 @@
 //! point `length` mm up the tool axis) or a sequence of poses joined by straight tip
 //! moves with the axis slerped in between (CL data, sampled built-ins).
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use super::nurbs::NurbsData;
 use super::polyline::Polyline;
@@ -17,8 +17,10 @@ use crate::kinematics::Pose;
 /// the curve at 0.3 mm off the tightest bend (the truth for the five-axis tests).
 const SAMPLES_PER_TURN: usize = 40_000;
 
-/// A five-axis reference.
-#[derive(Clone, Debug, PartialEq)]
+/// A five-axis reference. Serialised (FMU state) through [`ToolPathData`], so bytes from
+/// elsewhere are validated like a file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "ToolPathData", into = "ToolPathData")]
 pub enum ToolPath {
     /// The tip curve and the curve of the point `length` mm up the tool axis, on the same
     /// parameter.
@@ -32,6 +34,101 @@ pub enum ToolPath {
         tips: Polyline<3>,
         axes: Vec<Vector<3>>,
     },
+}
+
+/// The serialised form of a [`ToolPath`]; converting it back checks it as the
+/// constructors do (unit axes kept as they are, to the last bit).
+#[derive(Serialize, Deserialize)]
+pub enum ToolPathData {
+    Curves {
+        tip: Nurbs<3>,
+        second: Nurbs<3>,
+        length: f64,
+    },
+    Poses {
+        tips: Vec<Vector<3>>,
+        axes: Vec<Vector<3>>,
+    },
+}
+
+impl From<ToolPath> for ToolPathData {
+    fn from(path: ToolPath) -> Self {
+        match path {
+            ToolPath::Curves {
+                tip,
+                second,
+                length,
+            } => ToolPathData::Curves {
+                tip,
+                second,
+                length,
+            },
+            ToolPath::Poses { tips, axes } => ToolPathData::Poses {
+                tips: tips.points().to_vec(),
+                axes,
+            },
+        }
+    }
+}
+
+impl TryFrom<ToolPathData> for ToolPath {
+    type Error = PathError;
+    fn try_from(data: ToolPathData) -> Result<Self, PathError> {
+        match data {
+            ToolPathData::Curves {
+                tip,
+                second,
+                length,
+            } => {
+                if tip.param_range() != second.param_range() {
+                    return Err(PathError::invalid(
+                        "tip and second curves have different parameter ranges",
+                    ));
+                }
+                if !(length.is_finite() && length > 0.0) {
+                    return Err(PathError::invalid(format!(
+                        "length must be > 0 mm, got {length}"
+                    )));
+                }
+                Ok(ToolPath::Curves {
+                    tip,
+                    second,
+                    length,
+                })
+            }
+            ToolPathData::Poses { tips, axes } => {
+                if tips.len() != axes.len() {
+                    return Err(PathError::invalid(format!(
+                        "{} tips but {} tool axes",
+                        tips.len(),
+                        axes.len()
+                    )));
+                }
+                if let Some(i) = axes.iter().position(|a| {
+                    let off = (geometry::norm(a) - 1.0).abs();
+                    off.is_nan() || off >= 1e-12
+                }) {
+                    return Err(PathError::invalid(format!(
+                        "tool axis {i} is not a unit vector"
+                    )));
+                }
+                let poses: Vec<Pose> = tips
+                    .into_iter()
+                    .zip(axes)
+                    .map(|(tip, axis)| Pose { tip, axis })
+                    .collect();
+                let checked = ToolPath::from_poses(&poses)?;
+                // Keep the axes as saved (normalising again could move the last bit).
+                match checked {
+                    ToolPath::Poses { tips, .. } => Ok(ToolPath::Poses {
+                        tips,
+                        axes: poses.iter().map(|p| p.axis).collect(),
+                    }),
+                    curves => Ok(curves),
+                }
+            }
+        }
+    }
 }
 
 /// The JSON form: `{"tip": NURBS, "second": NURBS, "length": L}`, each NURBS as in a

@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use super::config::SimError;
 use super::metrics::{Divergence, DivergenceKind};
+use crate::contour::evaluation_online::PointEvaluation;
 use crate::contour::hmm::{angle_between, segment_fraction};
 use crate::control::{CccMode, FiveAxisConfig, FiveAxisController};
 use crate::geometry::{self, Vector};
@@ -94,6 +95,8 @@ pub struct FiveAxisRecord {
     pub segment: Option<usize>,
     /// The reference's parameter at this sample.
     pub reference_u: f64,
+    /// The controller's newest evaluation-function estimate.
+    pub evaluation: Option<PointEvaluation>,
 }
 
 /// Summary of a five-axis run (true errors).
@@ -245,6 +248,7 @@ pub fn simulate_five_axis(
                 foot,
                 segment: out.segment,
                 reference_u: sample.u,
+                evaluation: out.evaluation,
             });
         }
         if sample.done {

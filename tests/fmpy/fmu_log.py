@@ -22,3 +22,10 @@ class CapturedLog:
 
     def errors(self):
         return [m for s, _c, m in self.records if s == 3]
+
+    def warnings(self):
+        return [m for s, _c, m in self.records if s == 1]
+
+    @property
+    def messages(self):
+        return [m for _s, _c, m in self.records]

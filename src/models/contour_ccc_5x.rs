@@ -1,0 +1,483 @@
+//! `ContourCCC5X`: the five-axis controller (docs/design.md §5.4). Per joint a position
+//! loop on the following error; the reference joints it receives, through the forward
+//! kinematics, are its expected path (no path file), which the online HMM maps the
+//! measured pose onto; tip and orientation contour errors there drive two fuzzy-PID laws
+//! whose correction reaches the joints through the damped least-squares inverse of the
+//! Jacobian. The control law runs every `Ts` inside `fmi2DoStep` on the inputs held over
+//! the step, whatever the communication step.
+
+use super::kinematics_parameters;
+use super::sample_clock::{check_period, SampleClock};
+use super::state_check;
+use super::variable_table::{
+    axis_block, variable_table, AxisTemplate, AxisUnit, AxisWord, Int, XYZAC,
+};
+use super::variables::{Start, Values, Variable};
+use super::{
+    decode_checked, encode_state, DefaultExperiment, Environment, Model, ModelInfo, ModelResult,
+    SavedState, StateLayout,
+};
+use crate::contour::hmm::HmmParams;
+use crate::control::five_axis::{FiveAxisConfig, FiveAxisController};
+use crate::control::{
+    CccConfig, CccMode, ConfigError, FuzzyFactor, FuzzyFactors, Gain, Parameter, PidGains,
+};
+use crate::geometry::Vector;
+
+/// Start values: the controller library's documented defaults.
+const DEFAULT: FiveAxisConfig = FiveAxisConfig::DEFAULT;
+const A: PidGains = DEFAULT.axis[0];
+const TIP: CccConfig = DEFAULT.tip;
+const TURN: CccConfig = DEFAULT.orientation;
+
+const fn real(name: &'static str, start: f64, description: &'static str) -> Variable {
+    Variable::parameter(name, Start::Real(start), description).min(0.0)
+}
+
+const fn count(
+    name: &'static str,
+    start: usize,
+    range: (f64, f64),
+    what: &'static str,
+) -> Variable {
+    Variable::parameter(name, Start::Integer(start as i32), what)
+        .min(range.0)
+        .max(range.1)
+}
+
+/// A position-loop gain of every joint.
+const fn axis_gain(
+    suffix: &'static str,
+    start: f64,
+    what: &'static str,
+    unit: AxisUnit,
+) -> AxisTemplate {
+    AxisTemplate::parameter(
+        ("axis.", suffix),
+        (start, start),
+        ("", AxisWord::Label, what),
+    )
+    .unit(unit)
+    .min(0.0)
+}
+
+variable_table! {
+    static VARIABLES;
+    REF: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::input(
+        ("ref.", ""),
+        ("Reference (command) joint position, ", AxisWord::Label, ""),
+    )
+    .unit(AxisUnit::POSITION)]);
+    POS: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::input(
+        ("pos.", ""),
+        ("Measured joint position, ", AxisWord::Label, ""),
+    )
+    .unit(AxisUnit::POSITION)]);
+    U: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::output(
+        ("u.", ""),
+        ("Velocity command to the ", AxisWord::Label, " drive"),
+    )
+    .unit(AxisUnit::VELOCITY)]);
+    TIP_ERROR: Real = Variable::output(
+        "contourError.tip",
+        "Tool-tip contour error: distance from the measured tip to the foot point on the \
+         reference segment the HMM maps it to (this sample)",
+    )
+    .unit("mm");
+    ORIENTATION_ERROR: Real = Variable::output(
+        "contourError.orientation",
+        "Tool-orientation contour error: angle between the measured tool axis and the \
+         reference axis at the foot point (this sample)",
+    )
+    .unit("rad");
+    EVAL_TIP: Real = Variable::output(
+        "evaluation.tip",
+        "Evaluation-function estimate of the tip contour error at the newest reference \
+         point it can be computed for; it describes the tool evaluation.delay seconds ago \
+         (the decision lag hmm.lag plus up to hmm.maxSkip samples)",
+    )
+    .unit("mm");
+    EVAL_ORIENTATION: Real = Variable::output(
+        "evaluation.orientation",
+        "Evaluation-function estimate of the orientation contour error, for the same \
+         reference point and delay as evaluation.tip",
+    )
+    .unit("rad");
+    EVAL_DELAY: Real = Variable::output(
+        "evaluation.delay",
+        "Age of the measured sample the evaluation estimates were fitted around (0 until \
+         the first estimate)",
+    )
+    .unit("s");
+    ERR: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::output(
+        ("err.", ""),
+        ("Following error (ref - pos), ", AxisWord::Label, ""),
+    )
+    .unit(AxisUnit::POSITION)]);
+    TS: Real = Variable::parameter(
+        "Ts",
+        Start::Real(DEFAULT.ts),
+        "Control period (at least 1 us)",
+    )
+    .unit("s");
+    /// Kp, Ki, Kd of the X position loop, then of Y, Z, A, C.
+    AXIS_GAINS: Reals<15> = axis_block(&XYZAC, &[
+        axis_gain(".Kp", A.kp, " position loop, proportional gain", AxisUnit::Fixed("1/s")),
+        axis_gain(".Ki", A.ki, " position loop, integral gain", AxisUnit::Fixed("1/s2")),
+        axis_gain(".Kd", A.kd, " position loop, derivative gain", AxisUnit::None),
+    ]);
+    CCC_ENABLE: Bool = Variable::parameter(
+        "ccc.enable",
+        Start::Boolean(true),
+        "Apply the cross-coupled tip and orientation corrections",
+    );
+    FUZZY_ENABLE: Bool = Variable::parameter(
+        "fuzzy.enable",
+        Start::Boolean(true),
+        "Adapt the contour PID gains with the fuzzy system (else the fixed base gains)",
+    );
+    /// Kp0, Ki0, Kd0, limit, then ke, kde, kp, ki, kd of the tip law.
+    TIP_LAW: Reals<9> = [
+        real("tip.Kp0", TIP.gains0.kp, "Tip law: PID base gain Kp0").unit("1/s"),
+        real("tip.Ki0", TIP.gains0.ki, "Tip law: PID base gain Ki0").unit("1/s2"),
+        real("tip.Kd0", TIP.gains0.kd, "Tip law: PID base gain Kd0"),
+        Variable::parameter(
+            "tip.limit",
+            Start::Real(100.0),
+            "Tip law: bound on each component of the correction (> 0), with anti-windup",
+        )
+        .unit("mm/s"),
+        real("tip.fuzzy.ke", TIP.fuzzy.ke, "Tip law: error quantisation factor (per um)"),
+        real("tip.fuzzy.kde", TIP.fuzzy.kde, "Tip law: error change factor (per um/sample)"),
+        real("tip.fuzzy.kp", TIP.fuzzy.kpf, "Tip law: scale of the fuzzy Kp adjustment")
+            .unit("1/s"),
+        real("tip.fuzzy.ki", TIP.fuzzy.kif, "Tip law: scale of the fuzzy Ki adjustment")
+            .unit("1/s2"),
+        real("tip.fuzzy.kd", TIP.fuzzy.kdf, "Tip law: scale of the fuzzy Kd adjustment"),
+    ];
+    /// The same for the orientation law (errors in rad, read by the fuzzy inputs in mrad).
+    ORIENTATION_LAW: Reals<9> = [
+        real("orientation.Kp0", TURN.gains0.kp, "Orientation law: PID base gain Kp0")
+            .unit("1/s"),
+        real("orientation.Ki0", TURN.gains0.ki, "Orientation law: PID base gain Ki0")
+            .unit("1/s2"),
+        real("orientation.Kd0", TURN.gains0.kd, "Orientation law: PID base gain Kd0"),
+        Variable::parameter(
+            "orientation.limit",
+            Start::Real(100.0),
+            "Orientation law: bound on each component of the angular correction (> 0), \
+             with anti-windup",
+        )
+        .unit("rad/s"),
+        real("orientation.fuzzy.ke", TURN.fuzzy.ke,
+            "Orientation law: error quantisation factor (per mrad)"),
+        real("orientation.fuzzy.kde", TURN.fuzzy.kde,
+            "Orientation law: error change factor (per mrad/sample)"),
+        real("orientation.fuzzy.kp", TURN.fuzzy.kpf,
+            "Orientation law: scale of the fuzzy Kp adjustment").unit("1/s"),
+        real("orientation.fuzzy.ki", TURN.fuzzy.kif,
+            "Orientation law: scale of the fuzzy Ki adjustment").unit("1/s2"),
+        real("orientation.fuzzy.kd", TURN.fuzzy.kdf,
+            "Orientation law: scale of the fuzzy Kd adjustment"),
+    ];
+    DAMPING: Real = Variable::parameter(
+        "damping",
+        Start::Real(DEFAULT.damping),
+        "Damping of the least-squares inverse of the Jacobian (> 0): bounds the joint \
+         correction near the A = 0 singularity",
+    );
+    TOOL_LENGTH: Real = Variable::parameter(
+        "toolLength",
+        Start::Real(DEFAULT.tool_length),
+        "Tool length L of the mapping's second point up the tool axis (> 0)",
+    )
+    .unit("mm");
+    MAX_SKIP: Int = count(
+        "hmm.maxSkip",
+        DEFAULT.hmm.max_skip,
+        (1.0, 64.0),
+        "Largest number of reference segments the mapping moves forward per sample",
+    );
+    ANGLE_WEIGHT: Real = Variable::parameter(
+        "hmm.angleWeight",
+        Start::Real(DEFAULT.hmm.angle_weight),
+        "Weight of the angle between measured motion and segment direction in the mapping \
+         cost (>= 0)",
+    )
+    .unit("mm/rad")
+    .min(0.0);
+    BAND: Int = count(
+        "hmm.band",
+        DEFAULT.band,
+        (2.0, 4096.0),
+        "Newest reference segments the online mapping considers (must exceed the tool's \
+         lag behind the reference, in samples)",
+    );
+    LAG: Int = count(
+        "hmm.lag",
+        DEFAULT.lag,
+        (0.0, 4096.0),
+        "Decision lag of the mapping read back for the evaluation estimate, samples",
+    );
+    BEAM: Real = Variable::parameter(
+        "hmm.beam",
+        Start::Real(DEFAULT.beam),
+        "The mapping keeps the states within this summed cost of the best (> 0)",
+    )
+    .unit("mm");
+    MACHINE: Reals<{ kinematics_parameters::COUNT }> = kinematics_parameters::VARIABLES;
+}
+
+pub static INFO: ModelInfo = ModelInfo {
+    identifier: "ContourCCC5X",
+    description: "Five-axis cross-coupled contour controller: position loops plus tool-tip \
+                  and tool-orientation corrections (fuzzy-adapted PID gains) from an online \
+                  HMM mapping of the measured pose onto the reference, through the damped \
+                  least-squares inverse of the kinematic Jacobian",
+    variables: &VARIABLES,
+    default_experiment: DefaultExperiment {
+        start_time: 0.0,
+        stop_time: 5.5,
+        step_size: 1e-3,
+    },
+    // Every output starts at 0: the control law first runs in fmi2DoStep.
+    initial_dependencies: &[],
+    create: |_: &Environment| Box::new(ContourCcc5X { state: None }),
+};
+
+/// Version 1: `Option<State>` as below.
+const LAYOUT: StateLayout = StateLayout {
+    model: "ContourCCC5X",
+    version: 1,
+};
+
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
+struct State {
+    controller: FiveAxisController,
+    clock: SampleClock,
+}
+
+impl SavedState for State {
+    fn validate(&self, time: f64) -> Result<(), String> {
+        self.clock.validate_at(time)?;
+        let controller = &self.controller;
+        let config = controller.config();
+        config
+            .validate()
+            .map_err(|e| format!("controller configuration: {}", config_message(e)))?;
+        if self.clock.period() != config.ts {
+            return Err(format!(
+                "sample clock period {} s differs from the controller's Ts = {} s",
+                self.clock.period(),
+                config.ts
+            ));
+        }
+        for (axis, pid) in XYZAC.iter().zip(controller.axes()) {
+            state_check::check_pid(&format!("{} position loop", axis.label), pid, config.ts)?;
+        }
+        for (name, law) in ["tip", "orientation"].iter().zip(controller.laws()) {
+            state_check::check_pid(&format!("{name} law"), law.law().pid(), config.ts)?;
+            for (axis, pid) in ["x", "y", "z"].iter().zip(law.components()) {
+                state_check::check_pid(&format!("{name} law, {axis} component"), pid, config.ts)?;
+            }
+        }
+        controller.check_memory()
+    }
+}
+
+pub struct ContourCcc5X {
+    state: Option<State>,
+}
+
+fn law(mode: CccMode, values: [f64; 9]) -> CccConfig {
+    let [kp, ki, kd, limit, ke, kde, kpf, kif, kdf] = values;
+    CccConfig {
+        mode,
+        gains0: PidGains::new(kp, ki, kd),
+        fuzzy: FuzzyFactors {
+            ke,
+            kde,
+            kpf,
+            kif,
+            kdf,
+        },
+        limit: Some(limit),
+    }
+}
+
+fn config(values: &Values) -> FiveAxisConfig {
+    let mode = match (CCC_ENABLE.get(values), FUZZY_ENABLE.get(values)) {
+        (false, _) => CccMode::Off,
+        (true, false) => CccMode::Fixed,
+        (true, true) => CccMode::Fuzzy,
+    };
+    let g = AXIS_GAINS.get(values);
+    // Integer parameters are within their bounds (checked on every set), so ≥ 0.
+    let whole = |v: Int| v.get(values).max(0) as usize;
+    FiveAxisConfig {
+        ts: TS.get(values),
+        axis: std::array::from_fn(|i| PidGains::new(g[3 * i], g[3 * i + 1], g[3 * i + 2])),
+        axis_limit: None,
+        tip: law(mode, TIP_LAW.get(values)),
+        orientation: law(mode, ORIENTATION_LAW.get(values)),
+        damping: DAMPING.get(values),
+        tool_length: TOOL_LENGTH.get(values),
+        hmm: HmmParams {
+            max_skip: whole(MAX_SKIP),
+            angle_weight: ANGLE_WEIGHT.get(values),
+        },
+        band: whole(BAND),
+        lag: whole(LAG),
+        beam: BEAM.get(values),
+        machine: kinematics_parameters::machine(values, MACHINE),
+    }
+}
+
+/// The variable that sets a configuration value, if one does.
+fn variable_of(parameter: Parameter) -> Option<&'static Variable> {
+    let gain = |g: Gain| match g {
+        Gain::Kp => 0,
+        Gain::Ki => 1,
+        Gain::Kd => 2,
+    };
+    let factor = |f: FuzzyFactor| match f {
+        FuzzyFactor::Ke => 4,
+        FuzzyFactor::Kde => 5,
+        FuzzyFactor::Kpf => 6,
+        FuzzyFactor::Kif => 7,
+        FuzzyFactor::Kdf => 8,
+    };
+    let vr = match parameter {
+        Parameter::Ts => TS.vr(),
+        Parameter::AxisGain(axis, g) => AXIS_GAINS.at(3 * axis + gain(g)).vr(),
+        Parameter::ContourGain(g) => TIP_LAW.at(gain(g)).vr(),
+        Parameter::ContourLimit => TIP_LAW.at(3).vr(),
+        Parameter::Fuzzy(f) => TIP_LAW.at(factor(f)).vr(),
+        Parameter::OrientationGain(g) => ORIENTATION_LAW.at(gain(g)).vr(),
+        Parameter::OrientationLimit => ORIENTATION_LAW.at(3).vr(),
+        Parameter::OrientationFuzzy(f) => ORIENTATION_LAW.at(factor(f)).vr(),
+        Parameter::Damping => DAMPING.vr(),
+        Parameter::ToolLength => TOOL_LENGTH.vr(),
+        Parameter::MaxSkip => MAX_SKIP.vr(),
+        Parameter::AngleWeight => ANGLE_WEIGHT.vr(),
+        Parameter::Band => BAND.vr(),
+        Parameter::Lag => LAG.vr(),
+        Parameter::Beam => BEAM.vr(),
+        Parameter::Pivot(0, 1) => MACHINE.at(0).vr(),
+        Parameter::Pivot(0, 2) => MACHINE.at(1).vr(),
+        Parameter::Pivot(1, 0) => MACHINE.at(2).vr(),
+        Parameter::Pivot(1, 1) => MACHINE.at(3).vr(),
+        // The axis limit and the pivots' coordinates along their own axes: no variable.
+        _ => return None,
+    };
+    Some(&VARIABLES[vr])
+}
+
+/// A configuration error in the FMU's own parameter names.
+fn config_message(e: ConfigError) -> String {
+    match variable_of(e.parameter) {
+        Some(v) => e.message_for(&v.name.to_string()),
+        None => e.to_string(),
+    }
+}
+
+impl ContourCcc5X {
+    fn write_zero_outputs(values: &mut Values) {
+        U.set(values, &Vector::<5>::zeros());
+        ERR.set(values, &Vector::<5>::zeros());
+        for output in [
+            TIP_ERROR,
+            ORIENTATION_ERROR,
+            EVAL_TIP,
+            EVAL_ORIENTATION,
+            EVAL_DELAY,
+        ] {
+            output.set(values, 0.0);
+        }
+    }
+}
+
+impl Model for ContourCcc5X {
+    fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult {
+        check_period("Ts", TS.get(values))?;
+        let config = config(values);
+        let controller = FiveAxisController::new(config).map_err(config_message)?;
+        self.state = Some(State {
+            controller,
+            clock: SampleClock::new(start_time, config.ts),
+        });
+        Self::write_zero_outputs(values);
+        Ok(())
+    }
+
+    fn do_step(&mut self, values: &mut Values, time: f64, step: f64) -> ModelResult {
+        let state = self.state.as_mut().ok_or("not initialized")?;
+        let reference = REF.vector(values);
+        let actual = POS.vector(values);
+        let ts = state.controller.config().ts;
+        while state.clock.take_before(time + step) {
+            // Inputs are finite (fmi2SetReal refuses others), so a sample cannot fail.
+            let out = state
+                .controller
+                .sample(&reference, &actual)
+                .map_err(|e| format!("sample at t = {time}: {e}"))?;
+            U.set(values, &out.u);
+            ERR.set(values, &out.following_error);
+            let (tip, orientation) = out.error.map_or((0.0, 0.0), |e| {
+                (crate::geometry::norm(&e.tip), e.orientation)
+            });
+            TIP_ERROR.set(values, tip);
+            ORIENTATION_ERROR.set(values, orientation);
+            if let Some(e) = out.evaluation {
+                EVAL_TIP.set(values, e.tip);
+                EVAL_ORIENTATION.set(values, e.orientation);
+                let newest = state.controller.samples().saturating_sub(1);
+                EVAL_DELAY.set(values, newest.saturating_sub(e.sample) as f64 * ts);
+            }
+        }
+        Ok(())
+    }
+
+    fn save_state(&self) -> Result<Vec<u8>, String> {
+        encode_state(LAYOUT, &self.state)
+    }
+
+    fn check_state(&self, bytes: &[u8], time: f64) -> ModelResult {
+        decode_checked::<State>(LAYOUT, bytes, time).map(drop)
+    }
+
+    fn restore_state(&mut self, bytes: &[u8], time: f64) -> ModelResult {
+        self.state = decode_checked(LAYOUT, bytes, time)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn start_values_are_the_controller_library_defaults() {
+        let values = Values::from_table(&VARIABLES);
+        assert_eq!(config(&values), FiveAxisConfig::DEFAULT);
+    }
+
+    #[test]
+    fn configuration_errors_use_the_fmu_parameter_names() {
+        let mut values = Values::from_table(&VARIABLES);
+        values.set_real(AXIS_GAINS.at(13).vr(), -1.0);
+        let e = FiveAxisController::new(config(&values)).unwrap_err();
+        assert_eq!(
+            config_message(e),
+            "parameter axis.C.Ki = -1 is invalid: must be finite and >= 0"
+        );
+        let mut values = Values::from_table(&VARIABLES);
+        values.set_real(ORIENTATION_LAW.at(7).vr(), -2.0);
+        let e = config(&values).validate().unwrap_err();
+        assert!(config_message(e).starts_with("parameter orientation.fuzzy.ki = -2"));
+        let mut values = Values::from_table(&VARIABLES);
+        values.set_real(DAMPING.vr(), 0.0);
+        let e = config(&values).validate().unwrap_err();
+        assert!(config_message(e).starts_with("parameter damping = 0"));
+    }
+}

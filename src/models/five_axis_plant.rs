@@ -1,0 +1,237 @@
+//! `FiveAxisPlant`: the five-axis test plant of docs/design.md §5.5 as an FMU model —
+//! X, Y, Z ball-screw axes as the two-axis plant's, A and C on a small trunnion table
+//! (worm gears). Velocity commands in (mm/s, rad/s), positions and velocities out;
+//! integrated exactly, so the trajectory does not depend on the communication step.
+
+use super::servo_plant::{self, FIELDS};
+use super::variable_table::{
+    axis_block, variable_table, Axis, AxisTemplate, AxisUnit, AxisWord, XYZAC,
+};
+use super::variables::Values;
+use super::{
+    decode_state, encode_state, DefaultExperiment, Environment, Model, ModelInfo, ModelResult,
+    StateLayout,
+};
+use crate::plant::{AxisParams, ServoAxes, ServoAxesParams, Transmission};
+
+const PLANT: ServoAxesParams<5> = ServoAxesParams::<5>::TRUNNION;
+
+/// A drive parameter of one axis (`X.J`, `A.ratio`, …), ≥ 0 (J, CT and the transmission
+/// are further checked > 0 on initialization).
+const fn drive(
+    suffix: &'static str,
+    start: f64,
+    description: (&'static str, &'static str),
+    unit: &'static str,
+) -> AxisTemplate {
+    AxisTemplate::parameter(
+        ("", suffix),
+        (start, start),
+        (description.0, AxisWord::Label, description.1),
+    )
+    .unit(AxisUnit::Fixed(unit))
+    .min(0.0)
+}
+
+/// The drive parameters of an axis whose defaults are `p`, in [`AxisParams`] field order.
+const fn drive_fields(p: AxisParams) -> [AxisTemplate; FIELDS] {
+    let transmission = match p.transmission {
+        Transmission::Linear { lead } => drive(
+            ".lead",
+            lead,
+            ("Ball-screw lead of the ", " axis (mm per revolution)"),
+            "mm",
+        ),
+        Transmission::Rotary { ratio } => drive(
+            ".ratio",
+            ratio,
+            ("Gear ratio of the ", " axis (motor turns per axis turn)"),
+            "",
+        )
+        .unit(AxisUnit::None),
+    };
+    [
+        drive(
+            ".J",
+            p.inertia,
+            ("Inertia of the ", " motor plus reflected load"),
+            "kg.m2",
+        ),
+        drive(
+            ".B",
+            p.friction,
+            ("Viscous friction of the ", " axis, at the motor"),
+            "N.m.s/rad",
+        ),
+        drive(
+            ".CT",
+            p.torque_constant,
+            ("Torque constant of the ", " motor"),
+            "N.m/A",
+        ),
+        transmission,
+        drive(
+            ".Kvp",
+            p.kvp,
+            ("Proportional gain of the ", " drive's velocity loop"),
+            "A.s/rad",
+        ),
+        drive(
+            ".Kvi",
+            p.kvi,
+            ("Integral gain of the ", " drive's velocity loop"),
+            "A/rad",
+        ),
+    ]
+}
+
+const LINEAR: [Axis; 3] = [XYZAC[0], XYZAC[1], XYZAC[2]];
+
+variable_table! {
+    static VARIABLES;
+    U: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::input(
+        ("u.", ""),
+        ("Velocity command to the ", AxisWord::Label, " drive"),
+    )
+    .unit(AxisUnit::VELOCITY)]);
+    POS: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::output(
+        ("pos.", ""),
+        ("Position of the ", AxisWord::Label, " axis"),
+    )
+    .unit(AxisUnit::POSITION)]);
+    VEL: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::output(
+        ("vel.", ""),
+        ("Velocity of the ", AxisWord::Label, " axis"),
+    )
+    .unit(AxisUnit::VELOCITY)]);
+    /// J, B, CT, lead, Kvp, Kvi of X, Y, Z (the same ball-screw drive on each).
+    LINEAR_PARAMS: Reals<18> = axis_block(&LINEAR, &drive_fields(PLANT.axes[0]));
+    /// J, B, CT, ratio, Kvp, Kvi of A (tilting cradle).
+    A_PARAMS: Reals<6> = axis_block(&[XYZAC[3]], &drive_fields(PLANT.axes[3]));
+    /// J, B, CT, ratio, Kvp, Kvi of C (rotary table).
+    C_PARAMS: Reals<6> = axis_block(&[XYZAC[4]], &drive_fields(PLANT.axes[4]));
+    POS0: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::parameter(
+        ("pos0.", ""),
+        (0.0, 0.0),
+        ("Initial position of the ", AxisWord::Label, " axis"),
+    )
+    .unit(AxisUnit::POSITION)]);
+}
+
+pub static INFO: ModelInfo = ModelInfo {
+    identifier: "FiveAxisPlant",
+    description: "Five-axis servo test plant (X Y Z ball screws, A C trunnion table on worm \
+                  gears): per axis a PI velocity-loop drive and a motor; velocity commands \
+                  in, positions out, integrated exactly",
+    variables: &VARIABLES,
+    default_experiment: DefaultExperiment {
+        start_time: 0.0,
+        stop_time: 2.0,
+        step_size: 1e-3,
+    },
+    // Every axis starts at rest at pos0.
+    initial_dependencies: &[
+        (POS.at(0).vr(), &[POS0.at(0).vr()]),
+        (POS.at(1).vr(), &[POS0.at(1).vr()]),
+        (POS.at(2).vr(), &[POS0.at(2).vr()]),
+        (POS.at(3).vr(), &[POS0.at(3).vr()]),
+        (POS.at(4).vr(), &[POS0.at(4).vr()]),
+    ],
+    create: |_: &Environment| Box::new(FiveAxisPlant::default()),
+};
+
+/// The [`ServoAxes`] as they serialise.
+const LAYOUT: StateLayout = StateLayout {
+    model: "FiveAxisPlant",
+    version: 1,
+};
+
+fn decode(bytes: &[u8]) -> Result<ServoAxes<5>, String> {
+    let table: ServoAxes<5> = decode_state(LAYOUT, bytes)?;
+    servo_plant::validate(&table, &XYZAC)?;
+    Ok(table)
+}
+
+/// The plant model; its state is the axes'.
+pub struct FiveAxisPlant {
+    table: ServoAxes<5>,
+}
+
+impl Default for FiveAxisPlant {
+    fn default() -> Self {
+        FiveAxisPlant {
+            table: ServoAxes::new(PLANT, Vector5::zeros()),
+        }
+    }
+}
+
+type Vector5 = crate::geometry::Vector<5>;
+
+/// The parameters of joint `index` (X, Y, Z, A, C).
+fn axis_params(values: &Values, index: usize) -> Result<AxisParams, String> {
+    let axis = &XYZAC[index];
+    match index {
+        0..=2 => servo_plant::axis_params(values, &VARIABLES, LINEAR_PARAMS, index * FIELDS, axis),
+        3 => servo_plant::axis_params(values, &VARIABLES, A_PARAMS, 0, axis),
+        _ => servo_plant::axis_params(values, &VARIABLES, C_PARAMS, 0, axis),
+    }
+}
+
+impl FiveAxisPlant {
+    fn write_outputs(&self, values: &mut Values) {
+        POS.set(values, &self.table.position());
+        VEL.set(values, &self.table.velocity());
+    }
+}
+
+impl Model for FiveAxisPlant {
+    fn initialize(&mut self, values: &mut Values, _start_time: f64) -> ModelResult {
+        let mut axes = [PLANT.axes[0]; 5];
+        for (index, axis) in axes.iter_mut().enumerate() {
+            *axis = axis_params(values, index)?;
+        }
+        self.table = ServoAxes::new(ServoAxesParams { axes }, POS0.vector(values));
+        self.write_outputs(values);
+        Ok(())
+    }
+
+    fn do_step(&mut self, values: &mut Values, _time: f64, step: f64) -> ModelResult {
+        // Inputs are finite: fmi2SetReal refuses NaN and infinities.
+        let command = U.vector(values);
+        self.table.step(command, step);
+        self.write_outputs(values);
+        Ok(())
+    }
+
+    fn save_state(&self) -> Result<Vec<u8>, String> {
+        encode_state(LAYOUT, &self.table)
+    }
+
+    fn check_state(&self, bytes: &[u8], _time: f64) -> ModelResult {
+        decode(bytes).map(drop)
+    }
+
+    fn restore_state(&mut self, bytes: &[u8], _time: f64) -> ModelResult {
+        self.table = decode(bytes)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn start_values_are_the_trunnion_plant() {
+        let values = Values::from_table(&VARIABLES);
+        for (index, expected) in PLANT.axes.iter().enumerate() {
+            assert_eq!(axis_params(&values, index).as_ref(), Ok(expected));
+        }
+        let names: Vec<String> = VARIABLES.iter().map(|v| v.name.to_string()).collect();
+        for name in [
+            "u.X", "pos.C", "vel.A", "X.lead", "A.ratio", "C.Kvi", "pos0.Z",
+        ] {
+            assert!(names.iter().any(|n| n == name), "{name}");
+        }
+    }
+}

@@ -1,0 +1,109 @@
+//! What the servo-plant models share (`XYServoPlant`, `FiveAxisPlant`): reading one
+//! axis's drive parameters from a block of six (J, B, CT, lead or ratio, Kvp, Kvi), and
+//! checking a restored table of axes.
+
+use super::state_check;
+use super::variable_table::{Axis, AxisKind, Reals};
+use super::variables::{Values, Variable};
+use crate::plant::{AxisParams, ServoAxes, ServoAxis, Transmission};
+
+/// Drive parameters per axis, in [`AxisParams`] field order.
+pub const FIELDS: usize = 6;
+
+/// The parameters of `axis` from its block `block` of [`FIELDS`] variables starting at
+/// offset `first` in `table`; J, CT and the transmission must be > 0.
+pub fn axis_params<const N: usize>(
+    values: &Values,
+    table: &[Variable],
+    block: Reals<N>,
+    first: usize,
+    axis: &Axis,
+) -> Result<AxisParams, String> {
+    let p = |i: usize| block.at(first + i).get(values);
+    let transmission = match axis.kind {
+        AxisKind::Linear => Transmission::Linear { lead: p(3) },
+        AxisKind::Rotary => Transmission::Rotary { ratio: p(3) },
+    };
+    let params = AxisParams {
+        inertia: p(0),
+        friction: p(1),
+        torque_constant: p(2),
+        transmission,
+        kvp: p(4),
+        kvi: p(5),
+    };
+    // J, CT and the transmission divide or scale the dynamics: zero is as unphysical as
+    // negative.
+    for i in [0, 2, 3] {
+        if p(i) <= 0.0 {
+            let name = table[block.at(first + i).vr()].name;
+            return Err(format!("parameter '{name}' must be > 0 (got {})", p(i)));
+        }
+    }
+    params
+        .validate()
+        .map_err(|e| format!("axis {}: {e}", axis.name))?;
+    Ok(params)
+}
+
+/// Checks a restored table like the parameters it was built from: each axis's drive
+/// valid, of its axis's kind (ball screw or gear), finite, with the cached transition
+/// of its parameters. The error names the axis.
+pub fn validate<const D: usize>(table: &ServoAxes<D>, axes: &[Axis; D]) -> Result<(), String> {
+    for (axis, servo) in axes.iter().zip(&table.axes) {
+        let name = axis.name;
+        servo
+            .params()
+            .validate()
+            .map_err(|e| format!("axis {name}: {e}"))?;
+        let kind_fits = matches!(
+            (axis.kind, servo.params().transmission),
+            (AxisKind::Linear, Transmission::Linear { .. })
+                | (AxisKind::Rotary, Transmission::Rotary { .. })
+        );
+        if !kind_fits {
+            return Err(format!(
+                "axis {name}: a transmission of the wrong kind for this axis"
+            ));
+        }
+        state_check::all_finite(servo).map_err(|e| format!("axis {name}: {e}"))?;
+        check_cached_transition(name, servo)?;
+    }
+    Ok(())
+}
+
+/// An axis keeps the transition matrices of its last step length; they must be the ones
+/// its parameters give for that length (recomputed the same way, so bit for bit), or the
+/// restored axis would follow other dynamics than its parameters say.
+fn check_cached_transition(name: &str, axis: &ServoAxis) -> Result<(), String> {
+    let cached = |a: &ServoAxis| -> Vec<(String, f64)> {
+        state_check::floats(a)
+            .into_iter()
+            .filter(|(path, _)| path.starts_with("cached"))
+            .collect()
+    };
+    let saved = cached(axis);
+    let Some(&(_, step)) = saved.iter().find(|(path, _)| path == "cached.step") else {
+        return Ok(()); // nothing cached yet
+    };
+    if !(step.is_finite() && step > 0.0) {
+        return Err(format!(
+            "axis {name}: cached step length {step} s must be finite and > 0"
+        ));
+    }
+    let mut reference = ServoAxis::new(*axis.params(), 0.0);
+    reference.step(0.0, step);
+    let expected = cached(&reference);
+    if saved.len() != expected.len()
+        || saved
+            .iter()
+            .zip(&expected)
+            .any(|(a, b)| a.0 != b.0 || a.1.to_bits() != b.1.to_bits())
+    {
+        return Err(format!(
+            "axis {name}: the cached transition for steps of {step} s does not match the \
+             axis parameters"
+        ));
+    }
+    Ok(())
+}
