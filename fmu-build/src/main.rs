@@ -2,6 +2,8 @@
 //! builds the library in release mode and writes one `.fmu` per model to `target/fmu/`
 //! (or DIR). `--bless` rewrites the committed `modelDescription/<Model>.xml` files from
 //! the code; each `--resource` puts FILE into MODEL's `resources/` folder.
+//! PathInterpolator5X always carries the example CL part `examples/cl/blade.cl` as
+//! `resources/blade.cl`.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -17,6 +19,9 @@ const USAGE: &str = "usage: fmu-build [--bless] [--out DIR] [--resource MODEL=FI
   --resource MODEL=FILE  put FILE into MODEL's resources/ folder under its own name\n\
                          (repeatable; e.g. PathInterpolator2D=part.json, then set the\n\
                          FMU's parameter path = \"part.json\")";
+
+/// The APT CL part every PathInterpolator5X carries in its resources.
+const EXAMPLE_CL_PART: &str = "examples/cl/blade.cl";
 
 fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -70,9 +75,21 @@ fn run(args: &[String]) -> Result<(), String> {
             },
         }
     }
+    let root = workspace_root();
+    // The example CL part ships with PathInterpolator5X (path = "blade.cl"), unless a
+    // resource of that name replaces it.
+    let example = Resource::parse(&format!(
+        "PathInterpolator5X={}",
+        root.join(EXAMPLE_CL_PART).display()
+    ))?;
+    if !resources
+        .iter()
+        .any(|r| r.model == example.model && r.name == example.name)
+    {
+        resources.push(example);
+    }
     // Refused before the (slow) build, so a typo costs nothing.
     package::check_unique(&resources)?;
-    let root = workspace_root();
     let out = out.unwrap_or_else(|| target_dir(&root).join("fmu"));
 
     let committed_dir = root.join("modelDescription");

@@ -25,7 +25,6 @@ editable mode): <repo>/target/fmu, <repo>/out, <repo>/target/release/ccc-tune.
 """
 
 import argparse
-import csv
 import json
 import math
 import subprocess
@@ -33,8 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import repo
+from . import five_axis_demo, repo
 from .master import closed_loop
+from .output_files import write_csv
+from .output_files import write_cross_check as write_cross_check_files
 from .reference_paths import INFINITY, TRIDENT, ContourReference, clamped_uniform
 from .tuned import start_values
 
@@ -110,29 +111,12 @@ def run_path(fmu_dir, path, feed, controller, mirrored=None):
     return before, after, error
 
 
-def write_csv(filename, columns):
-    with open(filename, "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow(list(columns))
-        writer.writerows(zip(*columns.values()))
-
-
 def write_cross_check(out, before, after):
-    """Inputs at t_k and the outputs the FMU reports after its step to t_k+1."""
-    directory = out / "cross-check" / "ContourCCC2D"
-    directory.mkdir(parents=True, exist_ok=True)
-    inputs = {"time": before["time"]}
-    for ours, theirs in (("ref.x", "interpolator.ref.x"), ("ref.y", "interpolator.ref.y"),
-                         ("pos.x", "plant.pos.x"), ("pos.y", "plant.pos.y")):
-        inputs[ours] = before[theirs]
-    write_csv(directory / "ContourCCC2D_in.csv", inputs)
-    outputs = {"time": np.concatenate([[0.0], after["time"]])}
-    for name in ("u.x", "u.y", "contourError", "ccc.Kp", "ccc.Ki", "ccc.Kd"):
-        outputs[name] = np.concatenate([[0.0], after[f"controller.{name}"]])
-    write_csv(directory / "ContourCCC2D_ref.csv", outputs)
-    stop = float(after["time"][-1])
-    (directory / "ContourCCC2D_ref.opt").write_text(
-        f"StartTime,0.0\nStopTime,{stop!r}\nStepSize,{STEP!r}\nRelTol,1e-6\n")
+    """ContourCCC2D's cross-check files: inputs at t_k, outputs after the step to t_k+1."""
+    inputs = [(ours, f"{unit}.{ours}") for unit, ours in (
+        ("interpolator", "ref.x"), ("interpolator", "ref.y"), ("plant", "pos.x"), ("plant", "pos.y"))]
+    outputs = ["u.x", "u.y", "contourError", "ccc.Kp", "ccc.Ki", "ccc.Kd"]
+    write_cross_check_files(out, "ContourCCC2D", before, after, inputs, outputs, STEP)
 
 
 def plot(out, path, runs):
@@ -156,7 +140,8 @@ def plot(out, path, runs):
     plt.close(fig)
 
 
-FMUS = ("PathInterpolator2D.fmu", "ContourCCC2D.fmu", "XYServoPlant.fmu")
+FMUS = ("PathInterpolator2D.fmu", "ContourCCC2D.fmu", "XYServoPlant.fmu",
+        "PathInterpolator5X.fmu", "ContourCCC5X.fmu", "FiveAxisPlant.fmu")
 
 
 def build_ccc_tune():
@@ -242,6 +227,9 @@ def main(argv=None):
     for path, feed, label, emax, emean, mmax, mmean, rmax, rmean in rows:
         print(f"{path:9} {feed:9.2f}  {label:15} {emax * 1e3:8.3f} {emean * 1e3:8.3f} {mmax * 1e3:9.3f} "
               f"{mmean * 1e3:9.3f} {rmax:10.1f} {rmean:11.1f}")
+    print()
+    five_axis_rows = five_axis_demo.main(args.fmu_dir, args.out)
+    five_axis_demo.print_table(five_axis_rows)
     print(f"wrote CSV, PNG and cross-check files to {args.out}")
     return rows
 

@@ -34,7 +34,7 @@ variable_table! {
         Start::String("tilted_helix"),
         "tilted_helix or figure_eight (built-in), or a file: APT CL data (.cl, .apt: \
          GOTO/x,y,z,i,j,k records) or a two-curve JSON file (.json); absolute, or relative \
-         to the FMU's resources folder",
+         to the FMU's resources folder, which holds the example CL part blade.cl",
     );
     FEED: Real = Variable::parameter(
         "feed",

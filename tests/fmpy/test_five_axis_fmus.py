@@ -1,17 +1,20 @@
 """PathInterpolator5X, ContourCCC5X and FiveAxisPlant through fmpy: validation, the closed
 loop against the in-process simulator, multi-rate sampling, state save/restore into a
-fresh instance, bad input."""
+fresh instance, bad input, the FMI cross-check files."""
 
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
+from fmpy import read_csv, simulate_fmu
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
+from contour_fmu import five_axis_demo
 from contour_fmu.master import five_axis_closed_loop
+from contour_fmu.output_files import write_cross_check
 from contour_fmu.wiring import FIVE_AXIS_JOINTS
 from fmu_slave import Slave
 
@@ -345,3 +348,28 @@ def test_a_cl_file_in_the_fmus_resources_folder_is_found_by_its_relative_name(in
     assert np.allclose(interpolator.reals(REF), [1, 2, 3, 0, 0])
     interpolator.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1.0)
     assert np.allclose(interpolator.reals(REF), [3, 2, 3, 0, 0], atol=1e-9)
+
+
+def test_cross_check_files_reproduce_through_simulate_fmu(fmu_dir, tmp_path):
+    before, after = five_axis_closed_loop(fmu_dir, path="tilted_helix", stop=0.3)
+    write_cross_check(tmp_path, "ContourCCC5X", before, after, five_axis_demo.CROSS_CHECK_INPUTS,
+                      five_axis_demo.CROSS_CHECK_OUTPUTS, 1e-3)
+    folder = tmp_path / "cross-check" / "ContourCCC5X"
+    inputs = read_csv(folder / "ContourCCC5X_in.csv")
+    reference = read_csv(folder / "ContourCCC5X_ref.csv")
+    options = dict(line.split(",") for line in (folder / "ContourCCC5X_ref.opt").read_text().split())
+    result = simulate_fmu(str(fmu_dir / "ContourCCC5X.fmu"), stop_time=float(options["StopTime"]),
+                          step_size=float(options["StepSize"]), output_interval=float(options["StepSize"]),
+                          input=inputs, output=list(reference.dtype.names[1:]))
+    assert len(result) == len(reference)
+    for name in reference.dtype.names[1:]:
+        assert np.max(np.abs(result[name] - reference[name])) < 1e-9, name
+    assert np.max(np.abs(reference["u.C"])) > 0.1 and np.max(reference["contourError.tip"]) > 1e-3
+
+
+def test_the_example_cl_part_ships_in_the_interpolators_resources(interpolator):
+    interpolator.set(path="blade.cl")
+    interpolator.fmu.exitInitializationMode()
+    interpolator.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.1)
+    assert np.all(np.isfinite(interpolator.reals(REF)))
+    assert (Path(interpolator.dir) / "resources" / "blade.cl").read_text() == BLADE.read_text()
