@@ -19,7 +19,8 @@ import zipfile
 
 import pytest
 
-FMUS = ("PathInterpolator2D", "ContourCCC2D", "XYServoPlant")
+FMUS = ("PathInterpolator2D", "ContourCCC2D", "XYServoPlant", "PathInterpolator5X", "ContourCCC5X",
+        "FiveAxisPlant")
 CLI = "from fmu_manipulation_toolbox.cli.fmutool import fmutool; fmutool()"
 VERDICTS = (
     "This FMU seems to be compliant with FMI-2.0.",
