@@ -9,9 +9,10 @@ without fmpy):
 - tuned: a ccc-tune result as ContourCCC2D start values;
 - reference_paths: the built-in paths rebuilt in Python and the true contour error;
 - demo: the paper's comparison through the FMUs (python -m contour_fmu.demo);
-- container_build: the loop packed into one FMU with fmpy's container;
-- cosim_closed_loop, ecos_closed_loop: the loop in libcosim and in ecos (run as
-  python -m contour_fmu.cosim_closed_loop / .ecos_closed_loop);
+- loops: the two-axis and five-axis loops by name, for the outside engines below;
+- container_build: a loop packed into one FMU with fmpy's container;
+- cosim_closed_loop, ecos_closed_loop: a loop in libcosim and in ecos (run as
+  python -m contour_fmu.cosim_closed_loop / .ecos_closed_loop [--loop five_axis]);
 - repo: where the checkout, its FMUs and ccc-tune are.
 """
 

@@ -1,5 +1,11 @@
-"""Packs the closed loop PathInterpolator2D -> ContourCCC2D <- XYServoPlant into one FMI 2.0
+"""Packs a closed loop (by default PathInterpolator2D -> ContourCCC2D <- XYServoPlant, or
+PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant; see contour_fmu.loops) into one FMI 2.0
 co-simulation container FMU with fmpy.container_fmu.
+
+The container exposes the loop's outputs and some parameters as "<component>.<variable>",
+among them the targets of the loop's path_start (the plant's pos0.*): the container's
+connections are copied at every step, so they cannot carry the path's start onto a fixed
+parameter once, and a caller that wants the plant to start on the path sets them.
 
 Conventions of fmpy's container runtime (container_fmu.so) that the description must follow:
 - value reference 0 is the container's own time, so modelVariables[0] is "time"
@@ -29,28 +35,9 @@ from fmpy.container_fmu.config import Component, Connection
 from fmpy.model_description import (CoSimulation, DefaultExperiment, ModelDescription,
                                     ModelVariable, Unknown)
 
-from .wiring import CLOSED_LOOP_CONNECTIONS
+from .loops import LOOPS
 
 _FMI3_TYPES = {"Real": "Float64", "Integer": "Int32", "Enumeration": "Int32"}
-
-COMPONENTS = {  # name -> FMU file; the default component order
-    "interpolator": "PathInterpolator2D.fmu",
-    "controller": "ContourCCC2D.fmu",
-    "plant": "XYServoPlant.fmu",
-}
-
-# Component variables exposed by the container as "<component>.<variable>".
-EXPOSED_OUTPUTS = [
-    ("interpolator", "ref.x"), ("interpolator", "ref.y"), ("interpolator", "done"),
-    ("controller", "u.x"), ("controller", "u.y"), ("controller", "contourError"),
-    ("controller", "err.x"), ("controller", "err.y"),
-    ("controller", "ccc.Kp"), ("controller", "ccc.Ki"), ("controller", "ccc.Kd"),
-    ("plant", "pos.x"), ("plant", "pos.y"), ("plant", "vel.x"), ("plant", "vel.y"),
-]
-EXPOSED_PARAMETERS = [
-    ("interpolator", "path"), ("interpolator", "feed"),
-    ("controller", "ccc.enable"), ("controller", "fuzzy.enable"),
-]
 
 
 def _exposed(name, source, causality):
@@ -77,19 +64,22 @@ def _as_fmi3_type(variable):
     return evolve(variable, type=_FMI3_TYPES.get(variable.type, variable.type))
 
 
-def build_container(fmu_dir, workdir, step=1e-3, stop=2.0, order=tuple(COMPONENTS),
-                    parallel_do_step=False):
-    """Writes ContourLoop.fmu into `workdir` and returns its path.
+def build_container(fmu_dir, workdir, step=1e-3, stop=2.0, order=None, parallel_do_step=False,
+                    loop="two_axis"):
+    """Writes the container FMU of `loop` (a name in contour_fmu.loops.LOOPS) into
+    `workdir` and returns its path (ContourLoop.fmu for the two-axis loop).
 
-    order: the components' order in container.json, in which the runtime steps them.
+    order: the components' order in container.json, in which the runtime steps them
+    (default: the loop's, interpolator, controller, plant).
     parallel_do_step: container.json's "parallelDoStep" (step the components on a thread
     pool). fmpy 0.3.32's runtime does not implement it: fmi2DoStep panics with "not yet
     implemented" and, the panic being unable to unwind through the C ABI, aborts the
     process; only ever try it in a subprocess."""
+    loop = LOOPS[loop]
     fmu_dir, workdir = Path(fmu_dir), Path(workdir)
     components, variables, units = {}, {}, {}
-    for name in order:
-        file = COMPONENTS[name]
+    for name in order or loop.units:
+        file = loop.units[name]
         md = read_model_description(fmu_dir / file)
         components[name] = Component(name=name, filename=fmu_dir / file, modelDescription=md)
         variables[name] = {v.name: v for v in md.modelVariables}
@@ -98,8 +88,9 @@ def build_container(fmu_dir, workdir, step=1e-3, stop=2.0, order=tuple(COMPONENT
     time = ModelVariable(name="time", type="Real", causality="independent",
                          variability="continuous", description="Simulation time")
     mappings = {}
-    for (unit, name), causality in ([(x, "output") for x in EXPOSED_OUTPUTS]
-                                    + [(x, "parameter") for x in EXPOSED_PARAMETERS]):
+    path_start_targets = [(dst, inp) for _, _, dst, inp in loop.path_start]
+    for (unit, name), causality in ([(x, "output") for x in loop.recorded + loop.more_outputs]
+                                    + [(x, "parameter") for x in loop.parameters + path_start_targets]):
         source = variables[unit][name]
         mappings[_exposed(f"{unit}.{name}", source, causality)] = [(components[unit], source)]
     model_variables = [time, *mappings]
@@ -107,9 +98,9 @@ def build_container(fmu_dir, workdir, step=1e-3, stop=2.0, order=tuple(COMPONENT
 
     model_description = ModelDescription(
         fmiVersion="2.0",
-        modelName="ContourLoop",
+        modelName=loop.container_name,
         instantiationToken="{" + str(uuid.uuid4()) + "}",
-        description="PathInterpolator2D -> ContourCCC2D <- XYServoPlant in an fmpy container",
+        description=f"{loop.title} in an fmpy container",
         generationTool="contour_fmu.container_build (fmpy.container_fmu)",
         variableNamingConvention="structured",
         coSimulation=CoSimulation(modelIdentifier="container_fmu", fixedInternalStepSize=step,
@@ -124,7 +115,7 @@ def build_container(fmu_dir, workdir, step=1e-3, stop=2.0, order=tuple(COMPONENT
     connections = [
         Connection(startElement=components[src], startConnectors=[_as_fmi3_type(variables[src][out])],
                    endElement=components[dst], endConnectors=[_as_fmi3_type(variables[dst][inp])])
-        for src, out, dst, inp in CLOSED_LOOP_CONNECTIONS
+        for src, out, dst, inp in loop.connections
     ]
 
     configuration = Configuration(parallelDoStep=parallel_do_step,
@@ -132,9 +123,9 @@ def build_container(fmu_dir, workdir, step=1e-3, stop=2.0, order=tuple(COMPONENT
                                   components=list(components.values()),
                                   connections=connections, variableMappings=mappings)
 
-    unzipdir = workdir / "ContourLoop.unzipped"
+    unzipdir = workdir / f"{loop.container_name}.unzipped"
     unzipdir.mkdir(parents=True, exist_ok=True)  # create_container_fmu rmtree()s it first
-    filename = workdir / "ContourLoop.fmu"
+    filename = workdir / f"{loop.container_name}.fmu"
     filename.unlink(missing_ok=True)
     create_container_fmu(configuration, unzipdir, filename)
     shutil.rmtree(unzipdir, ignore_errors=True)

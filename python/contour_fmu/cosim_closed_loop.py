@@ -1,21 +1,26 @@
-"""Runs the closed loop PathInterpolator2D -> ContourCCC2D <- XYServoPlant in libcosim
-(libcosimpy) and prints the trajectories as one line of JSON.
+"""Runs a closed loop (by default PathInterpolator2D -> ContourCCC2D <- XYServoPlant, with
+--loop five_axis PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant; see
+contour_fmu.loops) in libcosim (libcosimpy) and prints the trajectories as one line of JSON.
 
 Kept in its own process: libcosim can take the interpreter down on a broken FMU.
-usage: python -m contour_fmu.cosim_closed_loop FMU_DIR STEP_NS STEPS [UNIT.VARIABLE=VALUE ...]
+usage: python -m contour_fmu.cosim_closed_loop [--loop two_axis|five_axis] FMU_DIR STEP_NS STEPS
+                                               [UNIT.VARIABLE=VALUE ...]
+
+libcosim connections are transferred at every step, so they cannot carry an output onto a
+fixed parameter once: the plant's pos0.* (the path's start) come as UNIT.VARIABLE=VALUE.
 
 The printed object holds
 - "time_ns": the execution's final time (integer ns);
 - "steps", "time_ns_points": step numbers 1..STEPS and their time points (ns) from the
   time-series observer, which samples every observed variable after each step: step n is
   the state at t = n * STEP_NS;
-- "series": {"unit.variable": [values at steps 1..STEPS]};
-- "last": {"unit.variable": value} from a last-value observer after the run.
+- "series": {"unit.variable": [values at steps 1..STEPS]} for the loop's recorded outputs;
+- "last": {"unit.variable": value} of the same outputs and interpolator.done, from a
+  last-value observer after the run.
 """
 
 import json
 import sys
-from pathlib import Path
 
 from libcosimpy.CosimEnums import CosimVariableType
 from libcosimpy.CosimExecution import CosimExecution
@@ -23,21 +28,9 @@ from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 from libcosimpy.CosimObserver import CosimObserver
 from libcosimpy.CosimSlave import CosimLocalSlave
 
-from .wiring import CLOSED_LOOP_CONNECTIONS
+from .loops import engine_arguments
 
-UNITS = {  # instance name -> FMU file, as in contour_fmu.master.closed_loop
-    "interpolator": "PathInterpolator2D.fmu",
-    "controller": "ContourCCC2D.fmu",
-    "plant": "XYServoPlant.fmu",
-}
-CONNECTIONS = CLOSED_LOOP_CONNECTIONS
-SERIES = [
-    ("interpolator", "ref.x"), ("interpolator", "ref.y"),
-    ("controller", "u.x"), ("controller", "u.y"), ("controller", "contourError"),
-    ("plant", "pos.x"), ("plant", "pos.y"),
-]
-LAST_REAL = [("interpolator", "ref.x"), ("interpolator", "ref.y"), ("plant", "pos.x"), ("plant", "pos.y")]
-LAST_BOOLEAN = [("interpolator", "done")]
+DONE = ("interpolator", "done")
 
 
 def check(ok, what):
@@ -59,14 +52,14 @@ def set_initial(execution, index, variable, text):
 
 
 def main(argv):
-    fmu_dir, step_ns, steps = Path(argv[0]), int(argv[1]), int(argv[2])
-    assignments = [a.split("=", 1) for a in argv[3:]]
+    args = engine_arguments(argv, "A closed loop in libcosim", (int, "communication step (ns)"))
+    loop, steps = args.loop, args.steps
     log_output_level(CosimLogLevel.WARNING)
 
-    execution = CosimExecution.from_step_size(step_size=step_ns)
+    execution = CosimExecution.from_step_size(step_size=args.step)
     slaves, index, variables = {}, {}, {}
-    for name, file in UNITS.items():
-        slaves[name] = CosimLocalSlave(fmu_path=str(fmu_dir / file), instance_name=name)
+    for name, file in loop.units.items():
+        slaves[name] = CosimLocalSlave(fmu_path=str(args.fmu_dir / file), instance_name=name)
         index[name] = execution.add_local_slave(local_slave=slaves[name])
         check(index[name] >= 0, f"adding {file}")
         variables[name] = {v.name.decode(): v for v in execution.slave_variables(index[name])}
@@ -74,16 +67,15 @@ def main(argv):
     def ref(unit, name):
         return variables[unit][name].reference
 
-    for src, out, dst, inp in CONNECTIONS:
+    for src, out, dst, inp in loop.connections:
         check(execution.connect_real_variables(index[src], ref(src, out), index[dst], ref(dst, inp)),
               f"connecting {src}.{out} -> {dst}.{inp}")
-    for target, text in assignments:
-        unit, name = target.split(".", 1)
+    for unit, name, text in args.assignments:
         set_initial(execution, index[unit], variables[unit][name], text)
 
     series = CosimObserver.create_time_series(buffer_size=steps + 16)
     check(execution.add_observer(observer=series), "adding the time-series observer")
-    for unit, name in SERIES:
+    for unit, name in loop.recorded:
         check(series.start_time_series(index[unit], ref(unit, name), CosimVariableType.REAL),
               f"observing {unit}.{name}")
     last = CosimObserver.create_last_value()
@@ -93,17 +85,16 @@ def main(argv):
     status = execution.status()
 
     result = {"time_ns": status.current_time, "series": {}, "last": {}}
-    for unit, name in SERIES:
+    for unit, name in loop.recorded:
         # From step 1: libcosimpy trims its sample arrays by the number of zero step numbers,
         # so asking from step 0 would drop the last sample.
         points, numbers, values = series.time_series_real_samples(
             index[unit], ref(unit, name), from_step=1, sample_count=steps)
         result["series"][f"{unit}.{name}"] = list(values)
         result["steps"], result["time_ns_points"] = list(numbers), list(points)
-    for unit, name in LAST_REAL:
         result["last"][f"{unit}.{name}"] = last.last_real_values(index[unit], [ref(unit, name)])[0]
-    for unit, name in LAST_BOOLEAN:
-        result["last"][f"{unit}.{name}"] = bool(last.last_boolean_values(index[unit], [ref(unit, name)])[0])
+    unit, name = DONE
+    result["last"][f"{unit}.{name}"] = bool(last.last_boolean_values(index[unit], [ref(unit, name)])[0])
     print(json.dumps(result))
 
 

@@ -19,8 +19,9 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-from .wiring import (CLOSED_LOOP_CONNECTIONS, FIVE_AXIS_CONNECTIONS, FIVE_AXIS_JOINTS,
-                     FIVE_AXIS_PATH_START, PATH_START)
+from .loops import LOOPS
+from .wiring import (CLOSED_LOOP_CONNECTIONS, FIVE_AXIS_CONNECTIONS, FIVE_AXIS_PATH_START,
+                     PATH_START)
 
 SCHEMES = ("gauss-seidel", "jacobi")
 
@@ -153,14 +154,8 @@ def closed_loop(fmu_dir, path="circle", feed=None, stop=2.0, step=1e-3, controll
         return master.run(CLOSED_LOOP_RECORD)
 
 
-FIVE_AXIS_RECORD = (
-    [("interpolator", f"ref.{j}") for j in FIVE_AXIS_JOINTS]
-    + [("plant", f"pos.{j}") for j in FIVE_AXIS_JOINTS]
-    + [("controller", f"u.{j}") for j in FIVE_AXIS_JOINTS]
-    + [("controller", name) for name in ("contourError.tip", "contourError.orientation",
-                                         "evaluation.tip", "evaluation.orientation",
-                                         "evaluation.delay")]
-)
+# Every output the engines record for the five-axis loop (contour_fmu.loops).
+FIVE_AXIS_RECORD = LOOPS["five_axis"].recorded
 
 
 def five_axis_closed_loop(fmu_dir, path="tilted_helix", feed=None, stop=1.0, step=1e-3,

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import pytest
 
+from contour_fmu.loops import LOOPS
+
 REPO = Path(__file__).resolve().parents[2]
 
 
@@ -35,9 +37,11 @@ def xy_plant_fmu(fmu_dir):
 
 @pytest.fixture(scope="module")
 def fmus(fmu_dir, tmp_path_factory):
-    """A private copy of the three FMUs, so that an outside engine (libcosim, ecos) and the
-    fmpy master run the same build even if fmu-build rewrites target/fmu meanwhile."""
+    """A private copy of the FMUs of both closed loops, so that an outside engine (libcosim,
+    ecos, the container) and the fmpy master run the same build even if fmu-build rewrites
+    target/fmu meanwhile."""
     directory = tmp_path_factory.mktemp("fmus")
-    for file in ("PathInterpolator2D.fmu", "ContourCCC2D.fmu", "XYServoPlant.fmu"):
-        shutil.copy2(fmu_dir / file, directory / file)
+    for loop in LOOPS.values():
+        for file in loop.units.values():
+            shutil.copy2(fmu_dir / file, directory / file)
     return directory

@@ -26,7 +26,6 @@ Agreement is exact (0.0 mm) in both cases; the asserted bound is the 1e-9 mm of 
 """
 
 import json
-import shutil
 import subprocess
 import sys
 
@@ -35,7 +34,7 @@ import pytest
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
-from contour_fmu.container_build import COMPONENTS, build_container
+from contour_fmu.container_build import build_container
 from contour_fmu.master import closed_loop
 
 STEP, STOP = 1e-3, 2.0
@@ -49,16 +48,6 @@ COMPARED = POSITIONS + ("controller.u.x", "controller.u.y", "controller.contourE
 def circle_error(x, y):
     """Distance (mm) of the points from the paper's circle x = 10 cos(pi t) - 10, y = 10 sin(pi t)."""
     return np.abs(np.hypot(np.asarray(x) + 10.0, y) - 10.0)
-
-
-@pytest.fixture(scope="module")
-def fmus(fmu_dir, tmp_path_factory):
-    """A private copy of the three FMUs, so that container and master run the same build
-    even if fmu-build rewrites target/fmu while the tests run."""
-    directory = tmp_path_factory.mktemp("fmus")
-    for file in COMPONENTS.values():
-        shutil.copy2(fmu_dir / file, directory / file)
-    return directory
 
 
 @pytest.fixture(scope="module")
