@@ -75,7 +75,7 @@ bindings: libclang
 # --- measurements -------------------------------------------------------------------------
 
 bench: fmus ccc-tune $(VENV)/.test-installed
-	$(CARGO) bench --bench fuzzy --bench controller --bench five_axis
+	$(CARGO) bench --bench fuzzy --bench controller --bench five_axis --bench fmu_abi
 	$(CARGO) build --release -p contour-fmu --example fuzzy_timing
 	$(PYTHON) benches/fuzzy_vs_skfuzzy.py
 	$(PYTHON) benches/tuning_vs_pyswarms_fmu.py

@@ -59,46 +59,14 @@ static GLOBAL: Counting = Counting;
 
 mod common;
 
-use common::{callbacks, cstr, fmi2Component, fmi2Status, fmi2ValueReference, Log};
+// Linked statically from the rlib (not dlopened), so the counting allocator sees what
+// they allocate.
+use common::linked::{
+    fmi2DoStep, fmi2EnterInitializationMode, fmi2ExitInitializationMode, fmi2FreeInstance,
+    fmi2GetReal, fmi2Instantiate, fmi2SetReal, fmi2SetupExperiment,
+};
+use common::{callbacks, cstr, fmi2ValueReference, Log};
 use contour_fmu::models;
-
-// The library's exported functions, linked statically from the rlib (not dlopened), so
-// the counting allocator sees their allocations.
-extern "C" {
-    fn fmi2Instantiate(
-        name: *const std::ffi::c_char,
-        fmu_type: u32,
-        guid: *const std::ffi::c_char,
-        resources: *const std::ffi::c_char,
-        functions: *const common::fmi2CallbackFunctions,
-        visible: i32,
-        logging_on: i32,
-    ) -> fmi2Component;
-    fn fmi2SetupExperiment(
-        c: fmi2Component,
-        tol_def: i32,
-        tol: f64,
-        start: f64,
-        stop_def: i32,
-        stop: f64,
-    ) -> fmi2Status;
-    fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status;
-    fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status;
-    fn fmi2DoStep(c: fmi2Component, t: f64, h: f64, no_prior: i32) -> fmi2Status;
-    fn fmi2GetReal(
-        c: fmi2Component,
-        vr: *const fmi2ValueReference,
-        n: usize,
-        v: *mut f64,
-    ) -> fmi2Status;
-    fn fmi2SetReal(
-        c: fmi2Component,
-        vr: *const fmi2ValueReference,
-        n: usize,
-        v: *const f64,
-    ) -> fmi2Status;
-    fn fmi2FreeInstance(c: fmi2Component);
-}
 
 #[test]
 fn an_fmi_step_round_allocates_nothing_with_logging_off() {
@@ -166,6 +134,81 @@ fn an_fmi_step_round_allocates_nothing_with_logging_off() {
         }
         assert!(log.records.lock().unwrap().is_empty());
     }
+}
+
+#[test]
+fn a_contour_ccc_5x_round_on_a_moving_path_allocates_nothing() {
+    // The round above holds every input constant, so ContourCCC5X's mapping never moves
+    // past its first segment and never produces an evaluation estimate. Here the reference
+    // joints run along a helix and the measured ones trail 35 samples behind: the online
+    // mapping, the foot-point errors, both laws and the evaluation estimate all run, the
+    // mapping's rings wrap, through the ABI, every sample.
+    let model = common::linked::model("ContourCCC5X");
+    let inputs = common::linked::vrs(
+        model,
+        &[
+            "ref.X", "ref.Y", "ref.Z", "ref.A", "ref.C", "pos.X", "pos.Y", "pos.Z", "pos.A",
+            "pos.C",
+        ],
+    );
+    let outputs = common::linked::vrs(
+        model,
+        &[
+            "u.X",
+            "u.Y",
+            "u.Z",
+            "u.A",
+            "u.C",
+            "contourError.tip",
+            "contourError.orientation",
+            "evaluation.tip",
+            "evaluation.delay",
+        ],
+    );
+    let q = |k: usize| {
+        let t = k as f64 * 2.5e-3;
+        [
+            30.0 + 20.0 * t.cos(),
+            10.0 + 20.0 * t.sin(),
+            0.8 * t,
+            0.35 + 0.1 * (0.3 * t).sin(),
+            t,
+        ]
+    };
+    let write: Vec<[f64; 10]> = (0..2_300)
+        .map(|k| {
+            let (r, a) = (q(k), q(k.saturating_sub(35)));
+            std::array::from_fn(|i| if i < 5 { r[i] } else { a[i - 5] + 2e-3 })
+        })
+        .collect();
+    let log = Log::default();
+    let functions = callbacks(&log);
+    let name = cstr("no-alloc-5x");
+    // SAFETY: the callbacks (and the log they point to) outlive the instance.
+    let c = unsafe { common::linked::instantiate_started(model, &name, &*functions) };
+    let mut read = [0.0; 9];
+    let (mut max_tip, mut max_u) = (0.0f64, 0.0f64);
+    let mut round = |k: usize| {
+        // SAFETY: a live instance and arrays of the stated lengths.
+        unsafe {
+            assert_eq!(fmi2SetReal(c, inputs.as_ptr(), 10, write[k].as_ptr()), 0);
+            assert_eq!(fmi2DoStep(c, k as f64 * 1e-3, 1e-3, 1), 0);
+            assert_eq!(fmi2GetReal(c, outputs.as_ptr(), 9, read.as_mut_ptr()), 0);
+        }
+        max_tip = max_tip.max(read[5]);
+        max_u = max_u.max(read[0].abs());
+    };
+    (0..300).for_each(&mut round);
+    let n = allocations_during(|| (300..write.len()).for_each(&mut round));
+    assert_eq!(n, 0, "{n} allocations in 2000 ContourCCC5X step rounds");
+    // The paths the constant inputs miss did run: a contour error, an evaluation estimate
+    // describing a tool some samples back, velocity commands.
+    assert!(read.iter().all(|v| v.is_finite()), "{read:?}");
+    assert!(max_tip > 1e-4 && max_u > 1.0, "tip {max_tip}, u.X {max_u}");
+    assert!(read[8] > 0.0, "no evaluation estimate: {read:?}");
+    // SAFETY: a live instance, freed once.
+    unsafe { fmi2FreeInstance(c) };
+    assert!(log.records.lock().unwrap().is_empty());
 }
 
 fn allocations_during(f: impl FnOnce()) -> u64 {

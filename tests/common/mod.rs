@@ -14,6 +14,8 @@ pub use contour_fmu::fmi2::bindings::*;
 #[rustfmt::skip]
 mod fmi2_library;
 pub use fmi2_library::*;
+// The same functions linked statically instead (tests/no_alloc.rs, benches/fmu_abi.rs).
+pub mod linked;
 use serde::{Deserialize, Serialize};
 
 pub const OK: fmi2Status = fmi2Status_fmi2OK;

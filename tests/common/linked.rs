@@ -1,0 +1,165 @@
+//! The library's exported `fmi2*` functions linked statically from the rlib instead of
+//! dlopened (as `super::lib()` does): the calls stay inside the test or bench binary, so
+//! its global allocator sees every allocation they make and a timing sees no PLT stub of
+//! a second copy of the library. Plus what an instance with logging off needs around
+//! them: the smallest callbacks, the model by identifier, value references by name, and a
+//! started instance.
+//!
+//! Shared by the tests (as `common::linked`) and by benches/fmu_abi.rs (through
+//! `#[path]`), so it uses nothing else of `common`.
+#![allow(dead_code)]
+
+use std::ffi::{c_char, CStr};
+
+use contour_fmu::fmi2::bindings::{
+    fmi2Boolean, fmi2CallbackFunctions, fmi2CallbackLogger, fmi2Component,
+    fmi2ComponentEnvironment, fmi2FMUstate, fmi2Real, fmi2Status, fmi2String, fmi2Type,
+    fmi2Type_fmi2CoSimulation, fmi2ValueReference,
+};
+use contour_fmu::models::{self, ModelInfo};
+
+extern "C" {
+    pub fn fmi2Instantiate(
+        instance_name: fmi2String,
+        fmu_type: fmi2Type,
+        guid: fmi2String,
+        resource_location: fmi2String,
+        functions: *const fmi2CallbackFunctions,
+        visible: fmi2Boolean,
+        logging_on: fmi2Boolean,
+    ) -> fmi2Component;
+    pub fn fmi2SetupExperiment(
+        c: fmi2Component,
+        tolerance_defined: fmi2Boolean,
+        tolerance: fmi2Real,
+        start_time: fmi2Real,
+        stop_time_defined: fmi2Boolean,
+        stop_time: fmi2Real,
+    ) -> fmi2Status;
+    pub fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status;
+    pub fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status;
+    pub fn fmi2DoStep(
+        c: fmi2Component,
+        current_communication_point: fmi2Real,
+        communication_step_size: fmi2Real,
+        no_set_fmu_state_prior: fmi2Boolean,
+    ) -> fmi2Status;
+    pub fn fmi2GetReal(
+        c: fmi2Component,
+        vr: *const fmi2ValueReference,
+        nvr: usize,
+        value: *mut fmi2Real,
+    ) -> fmi2Status;
+    pub fn fmi2SetReal(
+        c: fmi2Component,
+        vr: *const fmi2ValueReference,
+        nvr: usize,
+        value: *const fmi2Real,
+    ) -> fmi2Status;
+    pub fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status;
+    pub fn fmi2SetFMUstate(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status;
+    pub fn fmi2FreeFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status;
+    pub fn fmi2FreeInstance(c: fmi2Component);
+}
+
+/// A logger that drops every message. Declared with the five fixed parameters of the C
+/// prototype only: on the C ABIs of the supported targets the caller passes (and cleans
+/// up) the variadic arguments, which the callee may ignore.
+unsafe extern "C" fn drop_message(
+    _environment: fmi2ComponentEnvironment,
+    _instance: fmi2String,
+    _status: fmi2Status,
+    _category: fmi2String,
+    _format: fmi2String,
+) {
+}
+
+/// Callbacks for an instance with logging off and no interest in its messages: the
+/// library never calls `allocateMemory`/`freeMemory`, but a conforming importer passes
+/// them, so they are C's `calloc` and `free`.
+pub fn quiet_callbacks() -> fmi2CallbackFunctions {
+    type Fixed = unsafe extern "C" fn(
+        fmi2ComponentEnvironment,
+        fmi2String,
+        fmi2Status,
+        fmi2String,
+        fmi2String,
+    );
+    type Variadic = unsafe extern "C" fn(
+        fmi2ComponentEnvironment,
+        fmi2String,
+        fmi2Status,
+        fmi2String,
+        fmi2String,
+        ...
+    );
+    // SAFETY: the same function pointer under its C prototype's variadic type; calling a
+    // function that ignores the variadic arguments through it is sound (see
+    // `drop_message`).
+    let logger: fmi2CallbackLogger =
+        Some(unsafe { std::mem::transmute::<Fixed, Variadic>(drop_message) });
+    fmi2CallbackFunctions {
+        logger,
+        allocateMemory: Some(libc::calloc),
+        freeMemory: Some(libc::free),
+        stepFinished: None,
+        componentEnvironment: std::ptr::null_mut(),
+    }
+}
+
+/// The model served under `identifier`.
+pub fn model(identifier: &str) -> &'static ModelInfo {
+    models::all()
+        .into_iter()
+        .find(|m| m.identifier == identifier)
+        .unwrap_or_else(|| panic!("no model {identifier}"))
+}
+
+/// The value references of `names` in `model`, in that order.
+pub fn vrs(model: &ModelInfo, names: &[&str]) -> Vec<fmi2ValueReference> {
+    names
+        .iter()
+        .map(|name| {
+            let v = model
+                .variables
+                .iter()
+                .find(|v| v.name == *name)
+                .unwrap_or_else(|| panic!("{} has no variable {name}", model.identifier));
+            v.vr as fmi2ValueReference
+        })
+        .collect()
+}
+
+/// A Co-Simulation instance of `model`, logging off, set up at t = 0 without a stop time
+/// and initialized: ready for `fmi2DoStep(c, 0.0, …)`.
+///
+/// # Safety
+/// `functions` stays valid until the instance is freed with `fmi2FreeInstance`.
+pub unsafe fn instantiate_started(
+    model: &ModelInfo,
+    name: &CStr,
+    functions: *const fmi2CallbackFunctions,
+) -> fmi2Component {
+    let guid = std::ffi::CString::new(model.guid()).expect("GUID without NUL");
+    // SAFETY: NUL-terminated strings that live across the call, callbacks as the caller
+    // promises; no resource location (none of the models used this way needs one).
+    let c = unsafe {
+        fmi2Instantiate(
+            name.as_ptr(),
+            fmi2Type_fmi2CoSimulation,
+            guid.as_ptr(),
+            std::ptr::null::<c_char>(),
+            functions,
+            0,
+            0,
+        )
+    };
+    assert!(!c.is_null(), "{}: fmi2Instantiate failed", model.identifier);
+    // SAFETY: a live instance.
+    unsafe {
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
+        assert_eq!(fmi2EnterInitializationMode(c), 0);
+        assert_eq!(fmi2ExitInitializationMode(c), 0);
+    }
+    c
+}
