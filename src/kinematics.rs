@@ -97,7 +97,9 @@ impl TableTiltingAc {
         let (a, c) = (self.a_pivot, self.c_pivot);
         Pose {
             tip: rc * (ra * (machine - a) + a - c) + c,
-            axis: rc * ra * Vector::<3>::z(),
+            // rc·ra·e_z, as the column of ra it picks (the same sums, without the products
+            // by zero: bit for bit the full product).
+            axis: rc * ra.column(2),
         }
     }
 

@@ -53,9 +53,21 @@ pub struct Evaluation {
     pub t: f64,
 }
 
+/// How closely t* is found. At the minimum F is flat: a step δt changes F by ½F''·δt²,
+/// and F's rounding (≈ 10⁻¹⁸ mm) hides steps below ~10⁻⁹, where a finer tolerance only
+/// makes the search thrash. The errors at t* move by ~10⁻¹² (mm, rad) over 10⁻⁸.
+/// Half-width of the first three points around the guess, in t (1 = one sample): wide
+/// enough that F²'s rounding does not disturb the first parabola, narrow enough that it
+/// fits the minimum.
+const GUESS_SPAN: f64 = 0.05;
+
+const T_TOLERANCE: f64 = 1e-7;
+
 /// Minimises F over the parabolic fit of `q` (three consecutive actual joint samples,
-/// the middle one nearest the reference point): a scan of 64 points, then golden-section
-/// search in the best scan interval to |Δt| ≤ 1e-9.
+/// the middle one nearest the reference point): F at the three samples and at the
+/// reference tip's foot on the fit's tangent, then Brent's method on t ∈ [−1, 1] from
+/// those to |Δt| ≤ [`T_TOLERANCE`] (about 10 evaluations in all; each is a forward
+/// kinematics, the cost of the estimate).
 pub fn evaluate(
     machine: &TableTiltingAc,
     reference: &Pose,
@@ -70,37 +82,132 @@ pub fn evaluate(
             angle_between(&pose.axis, &reference.axis),
         )
     };
-    let f = |t: f64| {
-        let (tip, angle) = errors(t);
-        lambda.0 * tip + lambda.1 * mm_per_rad * angle
+    // F² with plain square roots (hypot's overflow care is moot at machine scales); the
+    // estimate itself is computed with `errors`. Squared because F is nearly V-shaped
+    // (a distance to a point passing by), which parabolic steps fit badly, while F² is
+    // nearly a parabola; both have the same minimiser.
+    let pose_at = |t: f64| machine.forward(&parabola(q, t));
+    let squared = |pose: &Pose| {
+        let cross = pose.axis.cross(&reference.axis);
+        let angle = cross.norm().atan2(pose.axis.dot(&reference.axis));
+        let value = lambda.0 * (pose.tip - reference.tip).norm() + lambda.1 * mm_per_rad * angle;
+        value * value
     };
-    const SCAN: usize = 64;
-    let at = |k: usize| -1.0 + 2.0 * k as f64 / SCAN as f64;
-    let best = (0..=SCAN).fold(0, |b, k| if f(at(k)) < f(at(b)) { k } else { b });
-    let (mut lo, mut hi) = (at(best.saturating_sub(1)), at((best + 1).min(SCAN)));
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    while hi - lo > 1e-9 {
-        if f1 <= f2 {
-            hi = x2;
-            (x2, f2) = (x1, f1);
-            x1 = hi - g * (hi - lo);
-            f1 = f(x1);
-        } else {
-            lo = x1;
-            (x1, f1) = (x2, f2);
-            x2 = lo + g * (hi - lo);
-            f2 = f(x2);
-        }
-    }
-    let t = 0.5 * (lo + hi);
+    let f = |t: f64| squared(&pose_at(t));
+    let (before, middle, after) = (pose_at(-1.0), pose_at(0.0), pose_at(1.0));
+    // A first guess: the reference tip's foot on the tangent of the fit at t = 0.
+    let velocity = (after.tip - before.tip) * 0.5;
+    let speed2 = velocity.norm_squared();
+    let guess = if speed2 > 0.0 {
+        ((reference.tip - middle.tip).dot(&velocity) / speed2).clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
+    // F² near the guess is close to a parabola: two more points either side seed it.
+    let side = |t: f64| {
+        let t = t.clamp(-1.0, 1.0);
+        (t, f(t))
+    };
+    let mut points = [
+        side(guess),
+        side(guess - GUESS_SPAN),
+        side(guess + GUESS_SPAN),
+    ];
+    points.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let t = brent_minimum(f, (-1.0, 1.0), points, T_TOLERANCE);
     let (tip, orientation) = errors(t);
     Evaluation {
         tip,
         orientation,
         t,
     }
+}
+
+/// Brent's method: the minimum of `f` on `bracket`, to an absolute tolerance `tol` in t,
+/// from three points (t, f(t)) already evaluated, the best first (x, then w and v of the
+/// method). Parabolic steps through the three best points while they behave, golden-section
+/// steps otherwise, so it converges superlinearly on a smooth minimum and never worse than
+/// golden section; with three distinct points the first step is already parabolic.
+fn brent_minimum(
+    f: impl Fn(f64) -> f64,
+    bracket: (f64, f64),
+    points: [(f64, f64); 3],
+    tol: f64,
+) -> f64 {
+    const GOLDEN: f64 = 0.381_966_011_250_105_2; // (3 − √5)/2
+    let (mut a, mut b) = bracket;
+    // x: the best point; w: the second best; v: the previous w.
+    let [(mut x, mut fx), (mut w, mut fw), (mut v, mut fv)] = points;
+    // d: the last step; e: the step before it (a parabolic step must halve it): the
+    // bracket's width lets the first one be parabolic.
+    let (mut d, mut e) = (b - a, b - a);
+    for _ in 0..100 {
+        let middle = 0.5 * (a + b);
+        if (x - middle).abs() <= 2.0 * tol - 0.5 * (b - a) {
+            break;
+        }
+        let mut parabolic = false;
+        if e.abs() > tol {
+            let r = (x - w) * (fx - fv);
+            let mut q = (x - v) * (fx - fw);
+            let mut p = (x - v) * q - (x - w) * r;
+            q = 2.0 * (q - r);
+            if q > 0.0 {
+                p = -p;
+            } else {
+                q = -q;
+            }
+            let before = e;
+            e = d;
+            if p.abs() < (0.5 * q * before).abs() && p > q * (a - x) && p < q * (b - x) {
+                d = p / q;
+                let u = x + d;
+                if u - a < 2.0 * tol || b - u < 2.0 * tol {
+                    d = tol.copysign(middle - x);
+                }
+                parabolic = true;
+            }
+        }
+        if !parabolic {
+            e = if x >= middle { a - x } else { b - x };
+            d = GOLDEN * e;
+        }
+        let u = if d.abs() >= tol {
+            x + d
+        } else {
+            x + tol.copysign(d)
+        };
+        let fu = f(u);
+        // A parabolic step this short means x has converged (on a smooth minimum the
+        // bracket would shrink to it only a tolerance-sized step at a time).
+        let converged = parabolic && d.abs() <= tol;
+        if fu <= fx {
+            if u >= x {
+                a = x;
+            } else {
+                b = x;
+            }
+            (v, fv) = (w, fw);
+            (w, fw) = (x, fx);
+            (x, fx) = (u, fu);
+        } else {
+            if u < x {
+                a = u;
+            } else {
+                b = u;
+            }
+            if fu <= fw || w == x {
+                (v, fv) = (w, fw);
+                (w, fw) = (u, fu);
+            } else if fu <= fv || v == x || v == w {
+                (v, fv) = (u, fu);
+            }
+        }
+        if converged {
+            break;
+        }
+    }
+    x
 }
 
 #[cfg(test)]
@@ -110,6 +217,33 @@ mod tests {
     use crate::geometry::Vector;
 
     type V3 = Vector<3>;
+
+    #[test]
+    fn brent_finds_smooth_and_kinked_minima_in_few_evaluations() {
+        let cases: [(fn(f64) -> f64, f64); 4] = [
+            (|t| (t - 0.3).powi(2) + 1.0, 0.3),
+            (|t| (t - 0.123).cosh(), 0.123),
+            (|t| (t + 0.07).abs() + 0.2 * t * t, -0.07),
+            (|t| ((t - 0.01).powi(2) + 1e-6).sqrt(), 0.01),
+        ];
+        for (f, expected) in cases {
+            let calls = std::cell::Cell::new(0);
+            let counted = |t: f64| {
+                calls.set(calls.get() + 1);
+                f(t)
+            };
+            let (lo, hi) = (-0.125, 0.375);
+            let (x, y) = if f(0.0) < f(0.25) {
+                (0.0, 0.25)
+            } else {
+                (0.25, 0.0)
+            };
+            let points = [(x, f(x)), (y, f(y)), (lo, f(lo))];
+            let t = brent_minimum(counted, (lo, hi), points, 1e-9);
+            assert!((t - expected).abs() < 1e-8, "{t} vs {expected}");
+            assert!(calls.get() <= 60, "{} evaluations", calls.get());
+        }
+    }
 
     #[test]
     fn the_parabola_passes_through_its_three_points() {

@@ -68,6 +68,9 @@ pub struct FiveAxisConfig {
     /// tool — are kept; the work per sample drops from the band to those (a third of the
     /// instructions of the full band, the same mapping on both built-ins).
     pub beam: f64,
+    /// Compute the evaluation-function estimate online (docs/design.md §5.6). Default on;
+    /// it is a diagnostic the control law does not use, and about 40 % of a sample's cost.
+    pub evaluate: bool,
     /// The machine.
     pub machine: TableTiltingAc,
 }
@@ -89,6 +92,7 @@ impl FiveAxisConfig {
         band: 128,
         lag: 16,
         beam: 5.0,
+        evaluate: true,
         machine: TableTiltingAc::ORIGIN,
     };
 
@@ -296,9 +300,12 @@ impl FiveAxisController {
                     .map(|e| (e, tangent))
             });
         let error = foot.map(|(e, _)| e);
-        let evaluation =
+        let evaluation = if self.config.evaluate {
             self.evaluation
-                .push(machine, &self.mapper, self.config.lag, actual, &pose.tip);
+                .push(machine, &self.mapper, self.config.lag, actual, &pose.tip)
+        } else {
+            None
+        };
         let mut output = FiveAxisOutput {
             u,
             following_error,

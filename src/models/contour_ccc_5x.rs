@@ -225,6 +225,12 @@ variable_table! {
         "The mapping keeps the states within this summed cost of the best (> 0)",
     )
     .unit("mm");
+    EVALUATION_ENABLE: Bool = Variable::parameter(
+        "evaluation.enable",
+        Start::Boolean(true),
+        "Compute the evaluation-function estimate (evaluation.*): a diagnostic the control \
+         law does not use, about 40 % of a sample's cost",
+    );
     MACHINE: Reals<{ kinematics_parameters::COUNT }> = kinematics_parameters::VARIABLES;
 }
 
@@ -329,6 +335,7 @@ fn config(values: &Values) -> FiveAxisConfig {
         band: whole(BAND),
         lag: whole(LAG),
         beam: BEAM.get(values),
+        evaluate: EVALUATION_ENABLE.get(values),
         machine: kinematics_parameters::machine(values, MACHINE),
     }
 }

@@ -373,3 +373,14 @@ def test_the_example_cl_part_ships_in_the_interpolators_resources(interpolator):
     interpolator.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.1)
     assert np.all(np.isfinite(interpolator.reals(REF)))
     assert (Path(interpolator.dir) / "resources" / "blade.cl").read_text() == BLADE.read_text()
+
+
+def test_switching_the_evaluation_estimate_off_changes_no_command(fmu_dir):
+    """The evaluation-function estimate is a diagnostic: without it the loop is the same."""
+    on = five_axis_closed_loop(fmu_dir, path="figure_eight", stop=0.3)[1]
+    off = five_axis_closed_loop(fmu_dir, path="figure_eight", stop=0.3,
+                                controller={"evaluation.enable": False})[1]
+    for j in FIVE_AXIS_JOINTS:
+        assert np.array_equal(on[f"controller.u.{j}"], off[f"controller.u.{j}"]), j
+    assert np.all(off["controller.evaluation.tip"] == 0.0)
+    assert np.max(on["controller.evaluation.tip"]) > 0.0
