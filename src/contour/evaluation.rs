@@ -82,15 +82,15 @@ pub fn evaluate(
             angle_between(&pose.axis, &reference.axis),
         )
     };
-    // F² with plain square roots (hypot's overflow care is moot at machine scales); the
-    // estimate itself is computed with `errors`. Squared because F is nearly V-shaped
+    // F², squared because F is nearly V-shaped
     // (a distance to a point passing by), which parabolic steps fit badly, while F² is
     // nearly a parabola; both have the same minimiser.
     let pose_at = |t: f64| machine.forward(&parabola(q, t));
     let squared = |pose: &Pose| {
         let cross = pose.axis.cross(&reference.axis);
-        let angle = cross.norm().atan2(pose.axis.dot(&reference.axis));
-        let value = lambda.0 * (pose.tip - reference.tip).norm() + lambda.1 * mm_per_rad * angle;
+        let angle = geometry::norm(&cross).atan2(pose.axis.dot(&reference.axis));
+        let tip = geometry::dist(&pose.tip, &reference.tip);
+        let value = lambda.0 * tip + lambda.1 * mm_per_rad * angle;
         value * value
     };
     let f = |t: f64| squared(&pose_at(t));
@@ -220,7 +220,8 @@ mod tests {
 
     #[test]
     fn brent_finds_smooth_and_kinked_minima_in_few_evaluations() {
-        let cases: [(fn(f64) -> f64, f64); 4] = [
+        type Case = (fn(f64) -> f64, f64);
+        let cases: [Case; 4] = [
             (|t| (t - 0.3).powi(2) + 1.0, 0.3),
             (|t| (t - 0.123).cosh(), 0.123),
             (|t| (t + 0.07).abs() + 0.2 * t * t, -0.07),

@@ -3,17 +3,18 @@
 //! fuzzy-adapted PID gains (docs/design.md §4.2, 4.3). The control law runs every `Ts` inside
 //! `fmi2DoStep` on the inputs held over the step, whatever the communication step.
 
+use super::controller_parameters::{self, axis_gain, nonnegative};
 use super::sample_clock::{check_period, SampleClock};
 use super::variable_table::{axis_block, variable_table, AxisTemplate, AxisUnit, AxisWord, XY};
 use super::variables::{EnumItem, EnumType, Start, Values, Variable};
 use super::{
-    decode_checked, encode_state, line_arc_parameters, state_check, DefaultExperiment, Environment,
-    Model, ModelInfo, ModelResult, SavedState, StateLayout,
+    line_arc_parameters, state_check, DefaultExperiment, Environment, Model, ModelInfo,
+    ModelResult, SavedState, StateLayout,
 };
 use crate::contour::{ArcEstimator, Estimator, EstimatorKind, FreeCurveEstimator, LineEstimator};
 use crate::control::{
-    CccConfig, CccMode, ConfigError, ControllerConfig, CrossCoupledController, FuzzyFactor,
-    FuzzyFactors, Gain, Parameter, PidGains,
+    CccConfig, ConfigError, ControllerConfig, CrossCoupledController, FuzzyFactor, FuzzyFactors,
+    Parameter, PidGains,
 };
 use crate::geometry::{Vector, Vector2};
 
@@ -45,26 +46,6 @@ pub static ESTIMATOR_TYPE: EnumType = EnumType {
 const DEFAULT: ControllerConfig = ControllerConfig::DEFAULT;
 const A: PidGains = DEFAULT.axis[0];
 const C: CccConfig = DEFAULT.ccc;
-
-const fn real(name: &'static str, start: f64, description: &'static str) -> Variable {
-    Variable::parameter(name, Start::Real(start), description).min(0.0)
-}
-
-/// A position-loop gain of every axis.
-const fn axis_gain(
-    suffix: &'static str,
-    start: f64,
-    what: &'static str,
-    unit: AxisUnit,
-) -> AxisTemplate {
-    AxisTemplate::parameter(
-        ("axis.", suffix),
-        (start, start),
-        ("", AxisWord::Label, what),
-    )
-    .unit(unit)
-    .min(0.0)
-}
 
 variable_table! {
     static VARIABLES;
@@ -122,9 +103,9 @@ variable_table! {
     );
     /// Kp0, Ki0, Kd0.
     CCC_GAINS0: Reals<3> = [
-        real("ccc.Kp0", C.gains0.kp, "Contour PID base gain Kp0").unit("1/s"),
-        real("ccc.Ki0", C.gains0.ki, "Contour PID base gain Ki0").unit("1/s2"),
-        real("ccc.Kd0", C.gains0.kd, "Contour PID base gain Kd0"),
+        nonnegative("ccc.Kp0", C.gains0.kp, "Contour PID base gain Kp0").unit("1/s"),
+        nonnegative("ccc.Ki0", C.gains0.ki, "Contour PID base gain Ki0").unit("1/s2"),
+        nonnegative("ccc.Kd0", C.gains0.kd, "Contour PID base gain Kd0"),
     ];
     CCC_LIMIT: Real = Variable::parameter(
         "ccc.limit",
@@ -134,11 +115,11 @@ variable_table! {
     .unit("mm/s");
     /// ke, kde, kp, ki, kd.
     FUZZY_FACTORS: Reals<5> = [
-        real("fuzzy.ke", C.fuzzy.ke, "Contour error quantisation factor (per um)"),
-        real("fuzzy.kde", C.fuzzy.kde, "Error change quantisation factor (per um/sample)"),
-        real("fuzzy.kp", C.fuzzy.kpf, "Scale of the fuzzy Kp adjustment").unit("1/s"),
-        real("fuzzy.ki", C.fuzzy.kif, "Scale of the fuzzy Ki adjustment").unit("1/s2"),
-        real("fuzzy.kd", C.fuzzy.kdf, "Scale of the fuzzy Kd adjustment"),
+        nonnegative("fuzzy.ke", C.fuzzy.ke, "Contour error quantisation factor (per um)"),
+        nonnegative("fuzzy.kde", C.fuzzy.kde, "Error change quantisation factor (per um/sample)"),
+        nonnegative("fuzzy.kp", C.fuzzy.kpf, "Scale of the fuzzy Kp adjustment").unit("1/s"),
+        nonnegative("fuzzy.ki", C.fuzzy.kif, "Scale of the fuzzy Ki adjustment").unit("1/s2"),
+        nonnegative("fuzzy.kd", C.fuzzy.kdf, "Scale of the fuzzy Kd adjustment"),
     ];
     ESTIMATOR: Int = Variable::parameter(
         "estimator",
@@ -218,11 +199,7 @@ fn gains([kp, ki, kd]: [f64; 3]) -> PidGains {
 
 fn config(values: &Values) -> ControllerConfig {
     let [ke, kde, kpf, kif, kdf] = FUZZY_FACTORS.get(values);
-    let mode = match (CCC_ENABLE.get(values), FUZZY_ENABLE.get(values)) {
-        (false, _) => CccMode::Off,
-        (true, false) => CccMode::Fixed,
-        (true, true) => CccMode::Fuzzy,
-    };
+    let mode = controller_parameters::mode(CCC_ENABLE.get(values), FUZZY_ENABLE.get(values));
     let [xp, xi, xd, yp, yi, yd] = AXIS_GAINS.get(values);
     ControllerConfig {
         ts: TS.get(values),
@@ -246,11 +223,7 @@ fn config(values: &Values) -> ControllerConfig {
 /// The variable that sets a configuration value, if one does (the FMU never sets an
 /// axis limit).
 fn variable_of(parameter: Parameter) -> Option<&'static Variable> {
-    let gain = |g: Gain| match g {
-        Gain::Kp => 0,
-        Gain::Ki => 1,
-        Gain::Kd => 2,
-    };
+    let gain = controller_parameters::gain_index;
     let vr = match parameter {
         Parameter::Ts => TS.vr(),
         Parameter::AxisGain(axis, g) => AXIS_GAINS.at(3 * axis + gain(g)).vr(),
@@ -340,18 +313,7 @@ impl Model for ContourCcc2D {
         Ok(())
     }
 
-    fn save_state(&self) -> Result<Vec<u8>, String> {
-        encode_state(LAYOUT, &self.state)
-    }
-
-    fn check_state(&self, bytes: &[u8], time: f64) -> ModelResult {
-        decode_checked::<State>(LAYOUT, bytes, time).map(drop)
-    }
-
-    fn restore_state(&mut self, bytes: &[u8], time: f64) -> ModelResult {
-        self.state = decode_checked(LAYOUT, bytes, time)?;
-        Ok(())
-    }
+    super::sampled_state_methods!(State, LAYOUT);
 }
 
 #[cfg(test)]

@@ -6,6 +6,7 @@
 //! Jacobian. The control law runs every `Ts` inside `fmi2DoStep` on the inputs held over
 //! the step, whatever the communication step.
 
+use super::controller_parameters::{self, axis_gain, nonnegative};
 use super::kinematics_parameters;
 use super::sample_clock::{check_period, SampleClock};
 use super::state_check;
@@ -14,13 +15,12 @@ use super::variable_table::{
 };
 use super::variables::{Start, Values, Variable};
 use super::{
-    decode_checked, encode_state, DefaultExperiment, Environment, Model, ModelInfo, ModelResult,
-    SavedState, StateLayout,
+    DefaultExperiment, Environment, Model, ModelInfo, ModelResult, SavedState, StateLayout,
 };
 use crate::contour::hmm::HmmParams;
 use crate::control::five_axis::{FiveAxisConfig, FiveAxisController};
 use crate::control::{
-    CccConfig, CccMode, ConfigError, FuzzyFactor, FuzzyFactors, Gain, Parameter, PidGains,
+    CccConfig, CccMode, ConfigError, FuzzyFactor, FuzzyFactors, Parameter, PidGains,
 };
 use crate::geometry::Vector;
 
@@ -29,10 +29,6 @@ const DEFAULT: FiveAxisConfig = FiveAxisConfig::DEFAULT;
 const A: PidGains = DEFAULT.axis[0];
 const TIP: CccConfig = DEFAULT.tip;
 const TURN: CccConfig = DEFAULT.orientation;
-
-const fn real(name: &'static str, start: f64, description: &'static str) -> Variable {
-    Variable::parameter(name, Start::Real(start), description).min(0.0)
-}
 
 const fn count(
     name: &'static str,
@@ -43,22 +39,6 @@ const fn count(
     Variable::parameter(name, Start::Integer(start as i32), what)
         .min(range.0)
         .max(range.1)
-}
-
-/// A position-loop gain of every joint.
-const fn axis_gain(
-    suffix: &'static str,
-    start: f64,
-    what: &'static str,
-    unit: AxisUnit,
-) -> AxisTemplate {
-    AxisTemplate::parameter(
-        ("axis.", suffix),
-        (start, start),
-        ("", AxisWord::Label, what),
-    )
-    .unit(unit)
-    .min(0.0)
 }
 
 variable_table! {
@@ -138,30 +118,30 @@ variable_table! {
     );
     /// Kp0, Ki0, Kd0, limit, then ke, kde, kp, ki, kd of the tip law.
     TIP_LAW: Reals<9> = [
-        real("tip.Kp0", TIP.gains0.kp, "Tip law: PID base gain Kp0").unit("1/s"),
-        real("tip.Ki0", TIP.gains0.ki, "Tip law: PID base gain Ki0").unit("1/s2"),
-        real("tip.Kd0", TIP.gains0.kd, "Tip law: PID base gain Kd0"),
+        nonnegative("tip.Kp0", TIP.gains0.kp, "Tip law: PID base gain Kp0").unit("1/s"),
+        nonnegative("tip.Ki0", TIP.gains0.ki, "Tip law: PID base gain Ki0").unit("1/s2"),
+        nonnegative("tip.Kd0", TIP.gains0.kd, "Tip law: PID base gain Kd0"),
         Variable::parameter(
             "tip.limit",
             Start::Real(100.0),
             "Tip law: bound on each component of the correction (> 0), with anti-windup",
         )
         .unit("mm/s"),
-        real("tip.fuzzy.ke", TIP.fuzzy.ke, "Tip law: error quantisation factor (per um)"),
-        real("tip.fuzzy.kde", TIP.fuzzy.kde, "Tip law: error change factor (per um/sample)"),
-        real("tip.fuzzy.kp", TIP.fuzzy.kpf, "Tip law: scale of the fuzzy Kp adjustment")
+        nonnegative("tip.fuzzy.ke", TIP.fuzzy.ke, "Tip law: error quantisation factor (per um)"),
+        nonnegative("tip.fuzzy.kde", TIP.fuzzy.kde, "Tip law: error change factor (per um/sample)"),
+        nonnegative("tip.fuzzy.kp", TIP.fuzzy.kpf, "Tip law: scale of the fuzzy Kp adjustment")
             .unit("1/s"),
-        real("tip.fuzzy.ki", TIP.fuzzy.kif, "Tip law: scale of the fuzzy Ki adjustment")
+        nonnegative("tip.fuzzy.ki", TIP.fuzzy.kif, "Tip law: scale of the fuzzy Ki adjustment")
             .unit("1/s2"),
-        real("tip.fuzzy.kd", TIP.fuzzy.kdf, "Tip law: scale of the fuzzy Kd adjustment"),
+        nonnegative("tip.fuzzy.kd", TIP.fuzzy.kdf, "Tip law: scale of the fuzzy Kd adjustment"),
     ];
     /// The same for the orientation law (errors in rad, read by the fuzzy inputs in mrad).
     ORIENTATION_LAW: Reals<9> = [
-        real("orientation.Kp0", TURN.gains0.kp, "Orientation law: PID base gain Kp0")
+        nonnegative("orientation.Kp0", TURN.gains0.kp, "Orientation law: PID base gain Kp0")
             .unit("1/s"),
-        real("orientation.Ki0", TURN.gains0.ki, "Orientation law: PID base gain Ki0")
+        nonnegative("orientation.Ki0", TURN.gains0.ki, "Orientation law: PID base gain Ki0")
             .unit("1/s2"),
-        real("orientation.Kd0", TURN.gains0.kd, "Orientation law: PID base gain Kd0"),
+        nonnegative("orientation.Kd0", TURN.gains0.kd, "Orientation law: PID base gain Kd0"),
         Variable::parameter(
             "orientation.limit",
             Start::Real(100.0),
@@ -169,15 +149,15 @@ variable_table! {
              with anti-windup",
         )
         .unit("rad/s"),
-        real("orientation.fuzzy.ke", TURN.fuzzy.ke,
+        nonnegative("orientation.fuzzy.ke", TURN.fuzzy.ke,
             "Orientation law: error quantisation factor (per mrad)"),
-        real("orientation.fuzzy.kde", TURN.fuzzy.kde,
+        nonnegative("orientation.fuzzy.kde", TURN.fuzzy.kde,
             "Orientation law: error change factor (per mrad/sample)"),
-        real("orientation.fuzzy.kp", TURN.fuzzy.kpf,
+        nonnegative("orientation.fuzzy.kp", TURN.fuzzy.kpf,
             "Orientation law: scale of the fuzzy Kp adjustment").unit("1/s"),
-        real("orientation.fuzzy.ki", TURN.fuzzy.kif,
+        nonnegative("orientation.fuzzy.ki", TURN.fuzzy.kif,
             "Orientation law: scale of the fuzzy Ki adjustment").unit("1/s2"),
-        real("orientation.fuzzy.kd", TURN.fuzzy.kdf,
+        nonnegative("orientation.fuzzy.kd", TURN.fuzzy.kdf,
             "Orientation law: scale of the fuzzy Kd adjustment"),
     ];
     DAMPING: Real = Variable::parameter(
@@ -312,11 +292,7 @@ fn law(mode: CccMode, values: [f64; 9]) -> CccConfig {
 }
 
 fn config(values: &Values) -> FiveAxisConfig {
-    let mode = match (CCC_ENABLE.get(values), FUZZY_ENABLE.get(values)) {
-        (false, _) => CccMode::Off,
-        (true, false) => CccMode::Fixed,
-        (true, true) => CccMode::Fuzzy,
-    };
+    let mode = controller_parameters::mode(CCC_ENABLE.get(values), FUZZY_ENABLE.get(values));
     let g = AXIS_GAINS.get(values);
     // Integer parameters are within their bounds (checked on every set), so ≥ 0.
     let whole = |v: Int| v.get(values).max(0) as usize;
@@ -342,11 +318,7 @@ fn config(values: &Values) -> FiveAxisConfig {
 
 /// The variable that sets a configuration value, if one does.
 fn variable_of(parameter: Parameter) -> Option<&'static Variable> {
-    let gain = |g: Gain| match g {
-        Gain::Kp => 0,
-        Gain::Ki => 1,
-        Gain::Kd => 2,
-    };
+    let gain = controller_parameters::gain_index;
     let factor = |f: FuzzyFactor| match f {
         FuzzyFactor::Ke => 4,
         FuzzyFactor::Kde => 5,
@@ -445,18 +417,7 @@ impl Model for ContourCcc5X {
         Ok(())
     }
 
-    fn save_state(&self) -> Result<Vec<u8>, String> {
-        encode_state(LAYOUT, &self.state)
-    }
-
-    fn check_state(&self, bytes: &[u8], time: f64) -> ModelResult {
-        decode_checked::<State>(LAYOUT, bytes, time).map(drop)
-    }
-
-    fn restore_state(&mut self, bytes: &[u8], time: f64) -> ModelResult {
-        self.state = decode_checked(LAYOUT, bytes, time)?;
-        Ok(())
-    }
+    super::sampled_state_methods!(State, LAYOUT);
 }
 
 #[cfg(test)]

@@ -12,78 +12,9 @@ use super::{
     decode_state, encode_state, DefaultExperiment, Environment, Model, ModelInfo, ModelResult,
     StateLayout,
 };
-use crate::plant::{AxisParams, ServoAxes, ServoAxesParams, Transmission};
+use crate::plant::{AxisParams, ServoAxes, ServoAxesParams};
 
 const PLANT: ServoAxesParams<5> = ServoAxesParams::<5>::TRUNNION;
-
-/// A drive parameter of one axis (`X.J`, `A.ratio`, …), ≥ 0 (J, CT and the transmission
-/// are further checked > 0 on initialization).
-const fn drive(
-    suffix: &'static str,
-    start: f64,
-    description: (&'static str, &'static str),
-    unit: &'static str,
-) -> AxisTemplate {
-    AxisTemplate::parameter(
-        ("", suffix),
-        (start, start),
-        (description.0, AxisWord::Label, description.1),
-    )
-    .unit(AxisUnit::Fixed(unit))
-    .min(0.0)
-}
-
-/// The drive parameters of an axis whose defaults are `p`, in [`AxisParams`] field order.
-const fn drive_fields(p: AxisParams) -> [AxisTemplate; FIELDS] {
-    let transmission = match p.transmission {
-        Transmission::Linear { lead } => drive(
-            ".lead",
-            lead,
-            ("Ball-screw lead of the ", " axis (mm per revolution)"),
-            "mm",
-        ),
-        Transmission::Rotary { ratio } => drive(
-            ".ratio",
-            ratio,
-            ("Gear ratio of the ", " axis (motor turns per axis turn)"),
-            "",
-        )
-        .unit(AxisUnit::None),
-    };
-    [
-        drive(
-            ".J",
-            p.inertia,
-            ("Inertia of the ", " motor plus reflected load"),
-            "kg.m2",
-        ),
-        drive(
-            ".B",
-            p.friction,
-            ("Viscous friction of the ", " axis, at the motor"),
-            "N.m.s/rad",
-        ),
-        drive(
-            ".CT",
-            p.torque_constant,
-            ("Torque constant of the ", " motor"),
-            "N.m/A",
-        ),
-        transmission,
-        drive(
-            ".Kvp",
-            p.kvp,
-            ("Proportional gain of the ", " drive's velocity loop"),
-            "A.s/rad",
-        ),
-        drive(
-            ".Kvi",
-            p.kvi,
-            ("Integral gain of the ", " drive's velocity loop"),
-            "A/rad",
-        ),
-    ]
-}
 
 const LINEAR: [Axis; 3] = [XYZAC[0], XYZAC[1], XYZAC[2]];
 
@@ -105,11 +36,11 @@ variable_table! {
     )
     .unit(AxisUnit::VELOCITY)]);
     /// J, B, CT, lead, Kvp, Kvi of X, Y, Z (the same ball-screw drive on each).
-    LINEAR_PARAMS: Reals<18> = axis_block(&LINEAR, &drive_fields(PLANT.axes[0]));
+    LINEAR_PARAMS: Reals<18> = axis_block(&LINEAR, &servo_plant::drive_fields(PLANT.axes[0]));
     /// J, B, CT, ratio, Kvp, Kvi of A (tilting cradle).
-    A_PARAMS: Reals<6> = axis_block(&[XYZAC[3]], &drive_fields(PLANT.axes[3]));
+    A_PARAMS: Reals<6> = axis_block(&[XYZAC[3]], &servo_plant::drive_fields(PLANT.axes[3]));
     /// J, B, CT, ratio, Kvp, Kvi of C (rotary table).
-    C_PARAMS: Reals<6> = axis_block(&[XYZAC[4]], &drive_fields(PLANT.axes[4]));
+    C_PARAMS: Reals<6> = axis_block(&[XYZAC[4]], &servo_plant::drive_fields(PLANT.axes[4]));
     POS0: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::parameter(
         ("pos0.", ""),
         (0.0, 0.0),

@@ -3,6 +3,7 @@
 
 pub mod contour_ccc_2d;
 pub mod contour_ccc_5x;
+pub mod controller_parameters;
 pub mod five_axis_plant;
 pub mod kinematics_parameters;
 pub mod line_arc_parameters;
@@ -76,6 +77,27 @@ pub trait Model: Send {
     /// changes when it is refused.
     fn restore_state(&mut self, bytes: &[u8], time: f64) -> ModelResult;
 }
+
+/// The three state methods of a sampled model whose internal state is
+/// `self.state: Option<State>` (`None` before initialization), saved with layout `$layout`:
+/// the same in every such model, written once.
+macro_rules! sampled_state_methods {
+    ($state:ty, $layout:expr) => {
+        fn save_state(&self) -> Result<Vec<u8>, String> {
+            $crate::models::encode_state($layout, &self.state)
+        }
+
+        fn check_state(&self, bytes: &[u8], time: f64) -> $crate::models::ModelResult {
+            $crate::models::decode_checked::<$state>($layout, bytes, time).map(drop)
+        }
+
+        fn restore_state(&mut self, bytes: &[u8], time: f64) -> $crate::models::ModelResult {
+            self.state = $crate::models::decode_checked($layout, bytes, time)?;
+            Ok(())
+        }
+    };
+}
+pub(crate) use sampled_state_methods;
 
 /// The version of one model's internal state layout. Bump `version` whenever the saved
 /// state of that model changes shape or meaning (a field added, a type changed, a unit

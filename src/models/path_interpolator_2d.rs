@@ -10,8 +10,8 @@ use super::variable_table::{
 };
 use super::variables::{Start, Values, Variable};
 use super::{
-    decode_checked, encode_state, line_arc_parameters, state_check, DefaultExperiment, Environment,
-    Model, ModelInfo, ModelResult, SavedState, StateLayout,
+    line_arc_parameters, state_check, DefaultExperiment, Environment, Model, ModelInfo,
+    ModelResult, SavedState, StateLayout,
 };
 use crate::path::{Arc, Curve, Interpolator, Line, Path};
 
@@ -204,18 +204,7 @@ impl Model for PathInterpolator2D {
         Ok(())
     }
 
-    fn save_state(&self) -> Result<Vec<u8>, String> {
-        encode_state(LAYOUT, &self.state)
-    }
-
-    fn check_state(&self, bytes: &[u8], time: f64) -> ModelResult {
-        decode_checked::<State>(LAYOUT, bytes, time).map(drop)
-    }
-
-    fn restore_state(&mut self, bytes: &[u8], time: f64) -> ModelResult {
-        self.state = decode_checked(LAYOUT, bytes, time)?;
-        Ok(())
-    }
+    super::sampled_state_methods!(State, LAYOUT);
 }
 
 #[cfg(test)]

@@ -11,8 +11,8 @@ use super::sample_clock::{check_period, SampleClock};
 use super::variable_table::{axis_block, variable_table, AxisTemplate, AxisUnit, AxisWord, XYZAC};
 use super::variables::{Start, Values, Variable};
 use super::{
-    decode_checked, encode_state, state_check, DefaultExperiment, Environment, Model, ModelInfo,
-    ModelResult, SavedState, StateLayout,
+    state_check, DefaultExperiment, Environment, Model, ModelInfo, ModelResult, SavedState,
+    StateLayout,
 };
 use crate::path::joint_reference::JointReference;
 use crate::path::tool_path::{ToolPath, BUILTIN_TOOL_PATHS};
@@ -183,18 +183,7 @@ impl Model for PathInterpolator5X {
         Ok(())
     }
 
-    fn save_state(&self) -> Result<Vec<u8>, String> {
-        encode_state(LAYOUT, &self.state)
-    }
-
-    fn check_state(&self, bytes: &[u8], time: f64) -> ModelResult {
-        decode_checked::<State>(LAYOUT, bytes, time).map(drop)
-    }
-
-    fn restore_state(&mut self, bytes: &[u8], time: f64) -> ModelResult {
-        self.state = decode_checked(LAYOUT, bytes, time)?;
-        Ok(())
-    }
+    super::sampled_state_methods!(State, LAYOUT);
 }
 
 impl PathInterpolator5X {

@@ -3,12 +3,81 @@
 //! checking a restored table of axes.
 
 use super::state_check;
-use super::variable_table::{Axis, AxisKind, Reals};
+use super::variable_table::{Axis, AxisKind, AxisTemplate, AxisUnit, AxisWord, Reals};
 use super::variables::{Values, Variable};
 use crate::plant::{AxisParams, ServoAxes, ServoAxis, Transmission};
 
 /// Drive parameters per axis, in [`AxisParams`] field order.
 pub const FIELDS: usize = 6;
+
+/// A drive parameter of every axis of a block (`x.J`, `A.ratio`, …), ≥ 0 (J, CT and the
+/// transmission are further checked > 0 by [`axis_params`]).
+const fn drive(
+    suffix: &'static str,
+    start: f64,
+    description: (&'static str, &'static str),
+    unit: AxisUnit,
+) -> AxisTemplate {
+    AxisTemplate::parameter(
+        ("", suffix),
+        (start, start),
+        (description.0, AxisWord::Name, description.1),
+    )
+    .unit(unit)
+    .min(0.0)
+}
+
+/// The drive parameters of axes whose defaults are `p`, in [`AxisParams`] field order:
+/// `.J`, `.B`, `.CT`, `.lead` (ball screw) or `.ratio` (gear), `.Kvp`, `.Kvi`.
+pub const fn drive_fields(p: AxisParams) -> [AxisTemplate; FIELDS] {
+    let transmission = match p.transmission {
+        Transmission::Linear { lead } => drive(
+            ".lead",
+            lead,
+            ("Ball-screw lead of the ", " axis (mm per revolution)"),
+            AxisUnit::Fixed("mm"),
+        ),
+        Transmission::Rotary { ratio } => drive(
+            ".ratio",
+            ratio,
+            ("Gear ratio of the ", " axis (motor turns per axis turn)"),
+            AxisUnit::None,
+        ),
+    };
+    [
+        drive(
+            ".J",
+            p.inertia,
+            ("Inertia of the ", " motor plus reflected load"),
+            AxisUnit::Fixed("kg.m2"),
+        ),
+        drive(
+            ".B",
+            p.friction,
+            ("Viscous friction of the ", " axis"),
+            AxisUnit::Fixed("N.m.s/rad"),
+        ),
+        drive(
+            ".CT",
+            p.torque_constant,
+            ("Torque constant of the ", " motor"),
+            AxisUnit::Fixed("N.m/A"),
+        ),
+        transmission,
+        drive(
+            ".Kvp",
+            p.kvp,
+            ("Proportional gain of the ", " drive's velocity loop"),
+            AxisUnit::Fixed("A.s/rad"),
+        ),
+        drive(
+            ".Kvi",
+            p.kvi,
+            ("Integral gain of the ", " drive's velocity loop"),
+            AxisUnit::Fixed("A/rad"),
+        ),
+    ]
+}
 
 /// The parameters of `axis` from its block `block` of [`FIELDS`] variables starting at
 /// offset `first` in `table`; J, CT and the transmission must be > 0.

@@ -8,69 +8,11 @@ use super::{
     decode_state, encode_state, servo_plant, DefaultExperiment, Environment, Model, ModelInfo,
     ModelResult, StateLayout,
 };
-use crate::plant::{AxisParams, Transmission, XyTable, XyTableParams};
+use crate::plant::{AxisParams, XyTable, XyTableParams};
 
 const P: AxisParams = AxisParams::PAPER;
-const LEAD: f64 = match P.transmission {
-    Transmission::Linear { lead } => lead,
-    Transmission::Rotary { .. } => panic!("the paper's axis is linear"),
-};
-
-/// A drive parameter of every axis (`x.J`, `y.J`, …), > 0 or ≥ 0.
-const fn drive(
-    suffix: &'static str,
-    start: f64,
-    description: (&'static str, &'static str),
-    unit: &'static str,
-) -> AxisTemplate {
-    AxisTemplate::parameter(
-        ("", suffix),
-        (start, start),
-        (description.0, AxisWord::Name, description.1),
-    )
-    .unit(AxisUnit::Fixed(unit))
-    .min(0.0)
-}
-
 /// The drive parameters, in [`AxisParams`] field order.
-const AXIS_FIELDS: [AxisTemplate; 6] = [
-    drive(
-        ".J",
-        P.inertia,
-        ("Inertia of the ", " motor plus reflected load"),
-        "kg.m2",
-    ),
-    drive(
-        ".B",
-        P.friction,
-        ("Viscous friction of the ", " axis"),
-        "N.m.s/rad",
-    ),
-    drive(
-        ".CT",
-        P.torque_constant,
-        ("Torque constant of the ", " motor"),
-        "N.m/A",
-    ),
-    drive(
-        ".lead",
-        LEAD,
-        ("Ball-screw lead of the ", " axis (mm per revolution)"),
-        "mm",
-    ),
-    drive(
-        ".Kvp",
-        P.kvp,
-        ("Proportional gain of the ", " drive's velocity loop"),
-        "A.s/rad",
-    ),
-    drive(
-        ".Kvi",
-        P.kvi,
-        ("Integral gain of the ", " drive's velocity loop"),
-        "A/rad",
-    ),
-];
+const AXIS_FIELDS: [AxisTemplate; servo_plant::FIELDS] = servo_plant::drive_fields(P);
 
 variable_table! {
     static VARIABLES;
