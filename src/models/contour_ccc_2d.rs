@@ -3,9 +3,10 @@
 //! fuzzy-adapted PID gains (docs/design.md §4.2, 4.3). The control law runs every `Ts` inside
 //! `fmi2DoStep` on the inputs held over the step, whatever the communication step.
 
+use super::axis_variables::{COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_IN};
 use super::controller_parameters::{self, axis_gain, nonnegative};
 use super::sample_clock::{check_period, SampleClock};
-use super::variable_table::{axis_block, variable_table, AxisTemplate, AxisUnit, AxisWord, XY};
+use super::variable_table::{axis_block, variable_table, AxisUnit, XY};
 use super::variables::{EnumItem, EnumType, Start, Values, Variable};
 use super::{
     line_arc_parameters, state_check, DefaultExperiment, Environment, Model, ModelInfo,
@@ -49,31 +50,15 @@ const C: CccConfig = DEFAULT.ccc;
 
 variable_table! {
     static VARIABLES;
-    REF: Reals<2> = axis_block(&XY, &[AxisTemplate::input(
-        ("ref.", ""),
-        ("Reference (command) position, ", AxisWord::Name, ""),
-    )
-    .unit(AxisUnit::POSITION)]);
-    POS: Reals<2> = axis_block(&XY, &[AxisTemplate::input(
-        ("pos.", ""),
-        ("Measured position, ", AxisWord::Name, ""),
-    )
-    .unit(AxisUnit::POSITION)]);
-    U: Reals<2> = axis_block(&XY, &[AxisTemplate::output(
-        ("u.", ""),
-        ("Velocity command to the ", AxisWord::Label, " drive"),
-    )
-    .unit(AxisUnit::VELOCITY)]);
+    REF: Reals<2> = axis_block(&XY, &[REFERENCE_IN]);
+    POS: Reals<2> = axis_block(&XY, &[MEASURED_IN]);
+    U: Reals<2> = axis_block(&XY, &[COMMAND_OUT]);
     CONTOUR_ERROR: Real = Variable::output(
         "contourError",
         "Estimated contour error, > 0 when the tool is right of the direction of travel",
     )
     .unit("mm");
-    ERR: Reals<2> = axis_block(&XY, &[AxisTemplate::output(
-        ("err.", ""),
-        ("Following error (ref - pos), ", AxisWord::Name, ""),
-    )
-    .unit(AxisUnit::POSITION)]);
+    ERR: Reals<2> = axis_block(&XY, &[FOLLOWING_ERROR_OUT]);
     CCC_GAINS: Reals<3> = [
         Variable::output("ccc.Kp", "Contour PID gain Kp in use").unit("1/s"),
         Variable::output("ccc.Ki", "Contour PID gain Ki in use").unit("1/s2"),

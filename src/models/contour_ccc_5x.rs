@@ -6,13 +6,12 @@
 //! Jacobian. The control law runs every `Ts` inside `fmi2DoStep` on the inputs held over
 //! the step, whatever the communication step.
 
+use super::axis_variables::{COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_IN};
 use super::controller_parameters::{self, axis_gain, nonnegative};
 use super::kinematics_parameters;
 use super::sample_clock::{check_period, SampleClock};
 use super::state_check;
-use super::variable_table::{
-    axis_block, variable_table, AxisTemplate, AxisUnit, AxisWord, Int, XYZAC,
-};
+use super::variable_table::{axis_block, variable_table, AxisUnit, Int, XYZAC};
 use super::variables::{Start, Values, Variable};
 use super::{
     DefaultExperiment, Environment, Model, ModelInfo, ModelResult, SavedState, StateLayout,
@@ -43,21 +42,9 @@ const fn count(
 
 variable_table! {
     static VARIABLES;
-    REF: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::input(
-        ("ref.", ""),
-        ("Reference (command) joint position, ", AxisWord::Label, ""),
-    )
-    .unit(AxisUnit::POSITION)]);
-    POS: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::input(
-        ("pos.", ""),
-        ("Measured joint position, ", AxisWord::Label, ""),
-    )
-    .unit(AxisUnit::POSITION)]);
-    U: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::output(
-        ("u.", ""),
-        ("Velocity command to the ", AxisWord::Label, " drive"),
-    )
-    .unit(AxisUnit::VELOCITY)]);
+    REF: Reals<5> = axis_block(&XYZAC, &[REFERENCE_IN]);
+    POS: Reals<5> = axis_block(&XYZAC, &[MEASURED_IN]);
+    U: Reals<5> = axis_block(&XYZAC, &[COMMAND_OUT]);
     TIP_ERROR: Real = Variable::output(
         "contourError.tip",
         "Tool-tip contour error: distance from the measured tip to the foot point on the \
@@ -89,11 +76,7 @@ variable_table! {
          the first estimate)",
     )
     .unit("s");
-    ERR: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::output(
-        ("err.", ""),
-        ("Following error (ref - pos), ", AxisWord::Label, ""),
-    )
-    .unit(AxisUnit::POSITION)]);
+    ERR: Reals<5> = axis_block(&XYZAC, &[FOLLOWING_ERROR_OUT]);
     TS: Real = Variable::parameter(
         "Ts",
         Start::Real(DEFAULT.ts),

@@ -3,10 +3,9 @@
 //! (worm gears). Velocity commands in (mm/s, rad/s), positions and velocities out;
 //! integrated exactly, so the trajectory does not depend on the communication step.
 
+use super::axis_variables::{COMMAND_IN, INITIAL_POSITION, POSITION_OUT, VELOCITY_OUT};
 use super::servo_plant::{self, FIELDS};
-use super::variable_table::{
-    axis_block, variable_table, Axis, AxisTemplate, AxisUnit, AxisWord, XYZAC,
-};
+use super::variable_table::{axis_block, variable_table, Axis, XYZAC};
 use super::variables::Values;
 use super::{
     decode_state, encode_state, DefaultExperiment, Environment, Model, ModelInfo, ModelResult,
@@ -20,33 +19,16 @@ const LINEAR: [Axis; 3] = [XYZAC[0], XYZAC[1], XYZAC[2]];
 
 variable_table! {
     static VARIABLES;
-    U: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::input(
-        ("u.", ""),
-        ("Velocity command to the ", AxisWord::Label, " drive"),
-    )
-    .unit(AxisUnit::VELOCITY)]);
-    POS: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::output(
-        ("pos.", ""),
-        ("Position of the ", AxisWord::Label, " axis"),
-    )
-    .unit(AxisUnit::POSITION)]);
-    VEL: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::output(
-        ("vel.", ""),
-        ("Velocity of the ", AxisWord::Label, " axis"),
-    )
-    .unit(AxisUnit::VELOCITY)]);
+    U: Reals<5> = axis_block(&XYZAC, &[COMMAND_IN]);
+    POS: Reals<5> = axis_block(&XYZAC, &[POSITION_OUT]);
+    VEL: Reals<5> = axis_block(&XYZAC, &[VELOCITY_OUT]);
     /// J, B, CT, lead, Kvp, Kvi of X, Y, Z (the same ball-screw drive on each).
     LINEAR_PARAMS: Reals<18> = axis_block(&LINEAR, &servo_plant::drive_fields(PLANT.axes[0]));
     /// J, B, CT, ratio, Kvp, Kvi of A (tilting cradle).
     A_PARAMS: Reals<6> = axis_block(&[XYZAC[3]], &servo_plant::drive_fields(PLANT.axes[3]));
     /// J, B, CT, ratio, Kvp, Kvi of C (rotary table).
     C_PARAMS: Reals<6> = axis_block(&[XYZAC[4]], &servo_plant::drive_fields(PLANT.axes[4]));
-    POS0: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::parameter(
-        ("pos0.", ""),
-        (0.0, 0.0),
-        ("Initial position of the ", AxisWord::Label, " axis"),
-    )
-    .unit(AxisUnit::POSITION)]);
+    POS0: Reals<5> = axis_block(&XYZAC, &[INITIAL_POSITION]);
 }
 
 pub static INFO: ModelInfo = ModelInfo {

@@ -1,6 +1,7 @@
 //! The FMUs' models: each is a plain Rust type with a variable table and a step
 //! function. Nothing here knows FMI types; `crate::fmi2` adapts these to the C ABI.
 
+pub mod axis_variables;
 pub mod contour_ccc_2d;
 pub mod contour_ccc_5x;
 pub mod controller_parameters;

@@ -4,10 +4,9 @@
 
 use std::f64::consts::PI;
 
+use super::axis_variables::REFERENCE_OUT;
 use super::sample_clock::{check_period, SampleClock};
-use super::variable_table::{
-    axis_block, variable_table, AxisTemplate, AxisUnit, AxisWord, Real, XY,
-};
+use super::variable_table::{axis_block, variable_table, Real, XY};
 use super::variables::{Start, Values, Variable};
 use super::{
     line_arc_parameters, state_check, DefaultExperiment, Environment, Model, ModelInfo,
@@ -17,11 +16,7 @@ use crate::path::{Arc, Curve, Interpolator, Line, Path};
 
 variable_table! {
     static VARIABLES;
-    REF: Reals<2> = axis_block(&XY, &[AxisTemplate::output(
-        ("ref.", ""),
-        ("Reference position, ", AxisWord::Name, ""),
-    )
-    .unit(AxisUnit::POSITION)]);
+    REF: Reals<2> = axis_block(&XY, &[REFERENCE_OUT]);
     DONE: Bool = Variable::discrete_output(
         "done",
         Start::Boolean(false),

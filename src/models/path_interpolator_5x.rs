@@ -6,9 +6,10 @@
 
 use std::path::Path;
 
+use super::axis_variables::REFERENCE_OUT;
 use super::kinematics_parameters;
 use super::sample_clock::{check_period, SampleClock};
-use super::variable_table::{axis_block, variable_table, AxisTemplate, AxisUnit, AxisWord, XYZAC};
+use super::variable_table::{axis_block, variable_table, XYZAC};
 use super::variables::{Start, Values, Variable};
 use super::{
     state_check, DefaultExperiment, Environment, Model, ModelInfo, ModelResult, SavedState,
@@ -19,11 +20,7 @@ use crate::path::tool_path::{ToolPath, BUILTIN_TOOL_PATHS};
 
 variable_table! {
     static VARIABLES;
-    REF: Reals<5> = axis_block(&XYZAC, &[AxisTemplate::output(
-        ("ref.", ""),
-        ("Reference joint position, ", AxisWord::Label, ""),
-    )
-    .unit(AxisUnit::POSITION)]);
+    REF: Reals<5> = axis_block(&XYZAC, &[REFERENCE_OUT]);
     DONE: Bool = Variable::discrete_output(
         "done",
         Start::Boolean(false),

@@ -2,7 +2,8 @@
 //! commands in, positions and velocities out; integrated exactly, so the trajectory does
 //! not depend on the communication step.
 
-use super::variable_table::{axis_block, variable_table, AxisTemplate, AxisUnit, AxisWord, XY};
+use super::axis_variables::{COMMAND_IN, INITIAL_POSITION, POSITION_OUT, VELOCITY_OUT};
+use super::variable_table::{axis_block, variable_table, AxisTemplate, XY};
 use super::variables::Values;
 use super::{
     decode_state, encode_state, servo_plant, DefaultExperiment, Environment, Model, ModelInfo,
@@ -16,29 +17,12 @@ const AXIS_FIELDS: [AxisTemplate; servo_plant::FIELDS] = servo_plant::drive_fiel
 
 variable_table! {
     static VARIABLES;
-    U: Reals<2> = axis_block(&XY, &[AxisTemplate::input(
-        ("u.", ""),
-        ("Velocity command to the ", AxisWord::Label, " drive"),
-    )
-    .unit(AxisUnit::VELOCITY)]);
-    POS: Reals<2> = axis_block(&XY, &[AxisTemplate::output(
-        ("pos.", ""),
-        ("Position of the ", AxisWord::Label, " axis"),
-    )
-    .unit(AxisUnit::POSITION)]);
-    VEL: Reals<2> = axis_block(&XY, &[AxisTemplate::output(
-        ("vel.", ""),
-        ("Velocity of the ", AxisWord::Label, " axis"),
-    )
-    .unit(AxisUnit::VELOCITY)]);
+    U: Reals<2> = axis_block(&XY, &[COMMAND_IN]);
+    POS: Reals<2> = axis_block(&XY, &[POSITION_OUT]);
+    VEL: Reals<2> = axis_block(&XY, &[VELOCITY_OUT]);
     /// J, B, CT, lead, Kvp, Kvi of X, then of Y.
     AXIS_PARAMS: Reals<12> = axis_block(&XY, &AXIS_FIELDS);
-    POS0: Reals<2> = axis_block(&XY, &[AxisTemplate::parameter(
-        ("pos0.", ""),
-        (0.0, 0.0),
-        ("Initial position of the ", AxisWord::Label, " axis"),
-    )
-    .unit(AxisUnit::POSITION)]);
+    POS0: Reals<2> = axis_block(&XY, &[INITIAL_POSITION]);
 }
 
 pub static INFO: ModelInfo = ModelInfo {
