@@ -103,7 +103,7 @@ def plot(out, label, runs):
     tip_ax.set_ylim(bottom=1e-2), turn_ax.set_ylim(bottom=1.0)
     tip_ax.legend(fontsize=8), turn_ax.legend(fontsize=8)
     tip_ax.set_title(f"{label}: true tip error"), turn_ax.set_title(f"{label}: true orientation error")
-    fig.tight_layout()
+    fig.tight_layout(w_pad=3.0)  # room for the 3-D plot's z label
     fig.savefig(out / f"five_axis_{label.replace('.', '_')}.png", dpi=120)
     plt.close(fig)
 
