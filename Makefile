@@ -11,7 +11,7 @@ PYTHON := $(VENV)/bin/python
 PIP    := $(PYTHON) -m pip install --quiet --disable-pip-version-check
 CARGO  ?= cargo
 
-.PHONY: demo test fmus ccc-tune bindings lint bench pso-claim setup libclang libtbb
+.PHONY: demo test fmus ccc-tune bindings lint bench pso-claim setup libclang libtbb valgrind leak-check
 
 # --- demo: cargo and python3 only ---------------------------------------------------------
 
@@ -57,8 +57,15 @@ libtbb:
 		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libtbb12; \
 	fi
 
+# The leak test's checker.
+valgrind:
+	@if ! command -v valgrind >/dev/null 2>&1; then \
+		echo "installing valgrind (the leak test)"; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq valgrind; \
+	fi
+
 # Everything `make test` installs.
-setup: libclang libtbb $(VENV)/.test-installed
+setup: libclang libtbb valgrind $(VENV)/.test-installed
 
 lint:
 	$(CARGO) fmt --all -- --check
@@ -80,6 +87,12 @@ bench: fmus ccc-tune $(VENV)/.test-installed
 	$(PYTHON) benches/fuzzy_vs_skfuzzy.py
 	$(PYTHON) benches/tuning_vs_pyswarms_fmu.py
 	$(PYTHON) benches/pso_tables.py
+
+# Every model's life cycle 10 000 times under valgrind's leak checker (about an hour).
+leak-check: valgrind
+	$(CARGO) build --release --example lifecycle
+	valgrind --leak-check=full --errors-for-leak-kinds=definite,indirect,possible \
+		--undef-value-errors=no --error-exitcode=1 target/release/examples/lifecycle 10000
 
 # The paper's PSO claim at its full budget (about 10 minutes).
 pso-claim:

@@ -100,13 +100,14 @@ impl JointReference {
     /// feed, inside its parameter range, and the joints and machine are finite. (The path
     /// checked itself when decoded.) The error names the first violation.
     pub fn check(&self, ts: f64) -> Result<(), String> {
-        let (same_curve, feed, period, u, range) = match (&self.tip, &self.path) {
+        let (same_curve, feed, period, u, range, point) = match (&self.tip, &self.path) {
             (TipInterpolator::Curve(i), ToolPath::Curves { tip, .. }) => (
                 i.path() == tip,
                 i.feed(),
                 i.ts(),
                 i.parameter(),
                 tip.param_range(),
+                i.point(),
             ),
             (TipInterpolator::Polyline(i), ToolPath::Poses { tips, .. }) => (
                 i.path() == tips,
@@ -114,6 +115,7 @@ impl JointReference {
                 i.ts(),
                 i.parameter(),
                 tips.param_range(),
+                i.point(),
             ),
             _ => return Err("the interpolator runs on another kind of path".into()),
         };
@@ -136,9 +138,12 @@ impl JointReference {
         }
         let machine = [self.machine.a_pivot, self.machine.c_pivot];
         if !(crate::geometry::is_finite(&self.joints)
+            && crate::geometry::is_finite(&point)
             && machine.iter().all(crate::geometry::is_finite))
         {
-            return Err("the joints or the machine's pivots are not finite".into());
+            return Err(
+                "the joints, the current tip or the machine's pivots are not finite".into(),
+            );
         }
         Ok(())
     }

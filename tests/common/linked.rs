@@ -12,7 +12,7 @@
 use std::ffi::{c_char, CStr};
 
 use contour_fmu::fmi2::bindings::{
-    fmi2Boolean, fmi2CallbackFunctions, fmi2CallbackLogger, fmi2Component,
+    fmi2Boolean, fmi2Byte, fmi2CallbackFunctions, fmi2CallbackLogger, fmi2Component,
     fmi2ComponentEnvironment, fmi2FMUstate, fmi2Real, fmi2Status, fmi2String, fmi2Type,
     fmi2Type_fmi2CoSimulation, fmi2ValueReference,
 };
@@ -59,6 +59,24 @@ extern "C" {
     pub fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status;
     pub fn fmi2SetFMUstate(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status;
     pub fn fmi2FreeFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status;
+    pub fn fmi2SerializedFMUstateSize(
+        c: fmi2Component,
+        state: fmi2FMUstate,
+        size: *mut usize,
+    ) -> fmi2Status;
+    pub fn fmi2SerializeFMUstate(
+        c: fmi2Component,
+        state: fmi2FMUstate,
+        bytes: *mut fmi2Byte,
+        size: usize,
+    ) -> fmi2Status;
+    pub fn fmi2DeSerializeFMUstate(
+        c: fmi2Component,
+        bytes: *const fmi2Byte,
+        size: usize,
+        state: *mut fmi2FMUstate,
+    ) -> fmi2Status;
+    pub fn fmi2Terminate(c: fmi2Component) -> fmi2Status;
     pub fn fmi2FreeInstance(c: fmi2Component);
 }
 
