@@ -7,10 +7,7 @@ use super::axis_variables::{COMMAND_IN, INITIAL_POSITION, POSITION_OUT, VELOCITY
 use super::servo_plant::{self, FIELDS};
 use super::variable_table::{axis_block, variable_table, Axis, XYZAC};
 use super::variables::Values;
-use super::{
-    decode_state, encode_state, DefaultExperiment, Environment, Model, ModelInfo, ModelResult,
-    StateLayout,
-};
+use super::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult, StateLayout};
 use crate::plant::{AxisParams, ServoAxes, ServoAxesParams};
 
 const PLANT: ServoAxesParams<5> = ServoAxesParams::<5>::TRUNNION;
@@ -58,12 +55,6 @@ const LAYOUT: StateLayout = StateLayout {
     model: "FiveAxisPlant",
     version: 1,
 };
-
-fn decode(bytes: &[u8]) -> Result<ServoAxes<5>, String> {
-    let table: ServoAxes<5> = decode_state(LAYOUT, bytes)?;
-    servo_plant::validate(&table, &XYZAC)?;
-    Ok(table)
-}
 
 /// The plant model; its state is the axes'.
 pub struct FiveAxisPlant {
@@ -116,18 +107,7 @@ impl Model for FiveAxisPlant {
         Ok(())
     }
 
-    fn save_state(&self) -> Result<Vec<u8>, String> {
-        encode_state(LAYOUT, &self.table)
-    }
-
-    fn check_state(&self, bytes: &[u8], _time: f64) -> ModelResult {
-        decode(bytes).map(drop)
-    }
-
-    fn restore_state(&mut self, bytes: &[u8], _time: f64) -> ModelResult {
-        self.table = decode(bytes)?;
-        Ok(())
-    }
+    servo_plant::plant_state_methods!(LAYOUT, XYZAC);
 }
 
 #[cfg(test)]

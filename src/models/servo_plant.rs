@@ -2,9 +2,9 @@
 //! axis's drive parameters from a block of six (J, B, CT, lead or ratio, Kvp, Kvi), and
 //! checking a restored table of axes.
 
-use super::state_check;
 use super::variable_table::{Axis, AxisKind, AxisTemplate, AxisUnit, AxisWord, Reals};
 use super::variables::{Values, Variable};
+use super::{decode_state, state_check, StateLayout};
 use crate::plant::{AxisParams, ServoAxes, ServoAxis, Transmission};
 
 /// Drive parameters per axis, in [`AxisParams`] field order.
@@ -113,6 +113,37 @@ pub fn axis_params<const N: usize>(
         .validate()
         .map_err(|e| format!("axis {}: {e}", axis.name))?;
     Ok(params)
+}
+
+/// The three state methods of a plant model whose internal state is `self.table`, a
+/// [`ServoAxes`] of the axes `$axes`, saved with layout `$layout`: the same in both plants.
+macro_rules! plant_state_methods {
+    ($layout:expr, $axes:expr) => {
+        fn save_state(&self) -> Result<Vec<u8>, String> {
+            $crate::models::encode_state($layout, &self.table)
+        }
+
+        fn check_state(&self, bytes: &[u8], _time: f64) -> $crate::models::ModelResult {
+            $crate::models::servo_plant::decode(bytes, $layout, &$axes).map(drop)
+        }
+
+        fn restore_state(&mut self, bytes: &[u8], _time: f64) -> $crate::models::ModelResult {
+            self.table = $crate::models::servo_plant::decode(bytes, $layout, &$axes)?;
+            Ok(())
+        }
+    };
+}
+pub(crate) use plant_state_methods;
+
+/// A table restored from `bytes` saved with `layout`, checked by [`validate`].
+pub fn decode<const D: usize>(
+    bytes: &[u8],
+    layout: StateLayout,
+    axes: &[Axis; D],
+) -> Result<ServoAxes<D>, String> {
+    let table: ServoAxes<D> = decode_state(layout, bytes)?;
+    validate(&table, axes)?;
+    Ok(table)
 }
 
 /// Checks a restored table like the parameters it was built from: each axis's drive

@@ -6,8 +6,7 @@ use super::axis_variables::{COMMAND_IN, INITIAL_POSITION, POSITION_OUT, VELOCITY
 use super::variable_table::{axis_block, variable_table, AxisTemplate, XY};
 use super::variables::Values;
 use super::{
-    decode_state, encode_state, servo_plant, DefaultExperiment, Environment, Model, ModelInfo,
-    ModelResult, StateLayout,
+    servo_plant, DefaultExperiment, Environment, Model, ModelInfo, ModelResult, StateLayout,
 };
 use crate::plant::{AxisParams, XyTable, XyTableParams};
 
@@ -50,12 +49,6 @@ const LAYOUT: StateLayout = StateLayout {
     model: "XYServoPlant",
     version: 2,
 };
-
-fn decode(bytes: &[u8]) -> Result<XyTable, String> {
-    let table: XyTable = decode_state(LAYOUT, bytes)?;
-    servo_plant::validate(&table, &XY)?;
-    Ok(table)
-}
 
 /// The plant model; its state is the table's.
 pub struct XyServoPlant {
@@ -104,16 +97,5 @@ impl Model for XyServoPlant {
         Ok(())
     }
 
-    fn save_state(&self) -> Result<Vec<u8>, String> {
-        encode_state(LAYOUT, &self.table)
-    }
-
-    fn check_state(&self, bytes: &[u8], _time: f64) -> ModelResult {
-        decode(bytes).map(drop)
-    }
-
-    fn restore_state(&mut self, bytes: &[u8], _time: f64) -> ModelResult {
-        self.table = decode(bytes)?;
-        Ok(())
-    }
+    servo_plant::plant_state_methods!(LAYOUT, XY);
 }
