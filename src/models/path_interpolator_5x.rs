@@ -14,6 +14,7 @@ use super::variables::{Start, Values, Variable};
 use super::{
     DefaultExperiment, Environment, Model, ModelInfo, ModelResult, SavedState, StateLayout,
 };
+use crate::kinematics::TableTiltingAc;
 use crate::path::joint_reference::JointReference;
 use crate::path::tool_path::{ToolPath, BUILTIN_TOOL_PATHS};
 
@@ -88,10 +89,12 @@ const YZ_KNOWNS: [usize; 5] = [
     MACHINE.at(3).vr(),
 ];
 
-/// Version 1: `Option<State>` as below.
+/// Version 1: `Option<State>` as below, the path saved twice (with the interpolator's
+/// copy of its tip curve) and a built-in's poses in full. Version 2: the path once, a
+/// built-in by name (see `JointReference`'s saved form).
 const LAYOUT: StateLayout = StateLayout {
     model: "PathInterpolator5X",
-    version: 1,
+    version: 2,
 };
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
@@ -119,24 +122,36 @@ pub struct PathInterpolator5X {
     warnings: Vec<String>,
 }
 
-/// The path the `path` parameter names (files relative to the resources folder), with
-/// the CL reader's warnings; errors name the file and line.
-fn tool_path(spec: &str, environment: &Environment) -> Result<(ToolPath, Vec<String>), String> {
+/// The reference on the path the `path` parameter names (files relative to the resources
+/// folder), with the CL reader's warnings; errors name the file and line.
+fn joint_reference(
+    spec: &str,
+    environment: &Environment,
+    machine: TableTiltingAc,
+    feed: f64,
+    ts: f64,
+) -> Result<(JointReference, Vec<String>), String> {
     let spec = spec.trim();
     let message = |e: crate::path::PathError| format!("parameter 'path': {e}");
     let file = Path::new(spec);
     // A bare name is a built-in (the error lists them); anything else is a file.
     let bare = file.extension().is_none() && !spec.contains(['/', '\\']);
     if BUILTIN_TOOL_PATHS.contains(&spec) || bare {
-        return ToolPath::builtin(spec)
-            .map(|p| (p, Vec::new()))
+        return JointReference::builtin(spec, machine, feed, ts)
+            .map(|r| (r, Vec::new()))
             .map_err(message);
     }
     let full = match environment.resource_dir.as_deref() {
         Some(dir) if file.is_relative() && !file.exists() => dir.join(file),
         _ => file.to_path_buf(),
     };
-    ToolPath::load(&full.to_string_lossy()).map_err(message)
+    let (path, warnings) = ToolPath::load(&full.to_string_lossy()).map_err(|e| {
+        let e = message(e);
+        let hint = super::path_interpolator_2d::resource_hint(spec, environment, &e);
+        e + hint
+    })?;
+    let reference = JointReference::new(path, machine, feed, ts).map_err(message)?;
+    Ok((reference, warnings))
 }
 
 impl Model for PathInterpolator5X {
@@ -147,10 +162,9 @@ impl Model for PathInterpolator5X {
             return Err(format!("parameter 'feed' must be > 0 (got {feed})"));
         }
         let ts = check_period("Ts", TS.get(values))?;
-        let (path, warnings) = tool_path(PATH.get(values), &self.environment)?;
         let machine = kinematics_parameters::machine(values, MACHINE);
-        let reference = JointReference::new(path, machine, feed, ts)
-            .map_err(|e| format!("parameter 'path': {e}"))?;
+        let (reference, warnings) =
+            joint_reference(PATH.get(values), &self.environment, machine, feed, ts)?;
         self.warnings = warnings
             .into_iter()
             .map(|w| format!("parameter 'path': {w}"))

@@ -59,6 +59,18 @@ fn check(feed: f64, ts: f64) -> Result<(), PathError> {
     Ok(())
 }
 
+/// Where an [`Interpolator`] stands on its path, without the path: what an owner that
+/// already saves the path (or can rebuild it) saves of the interpolator.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Progress<const D: usize> {
+    feed: f64,
+    ts: f64,
+    u: f64,
+    cur: CurvePoint<D>,
+    done: bool,
+    samples: u64,
+}
+
 impl<const D: usize, C: Curve<D>> Interpolator<D, C> {
     /// Starts at the beginning of `path` with feed `feed` (mm/s, ≥ 0) and period `ts` (s, > 0).
     pub fn new(path: C, feed: f64, ts: f64) -> Result<Self, PathError> {
@@ -73,6 +85,48 @@ impl<const D: usize, C: Curve<D>> Interpolator<D, C> {
             cur,
             done: false,
             samples: 0,
+        })
+    }
+
+    /// Where this interpolator stands (see [`Progress`]).
+    pub fn progress(&self) -> Progress<D> {
+        Progress {
+            feed: self.feed,
+            ts: self.ts,
+            u: self.u,
+            cur: self.cur,
+            done: self.done,
+            samples: self.samples,
+        }
+    }
+
+    /// Continues on `path` from `progress`, as saved by [`Self::progress`] on the same
+    /// path. Refuses an unusable feed or period and a parameter outside the path; the
+    /// owner checks that the path is the one the progress was made on.
+    pub fn resume(path: C, progress: Progress<D>) -> Result<Self, PathError> {
+        let Progress {
+            feed,
+            ts,
+            u,
+            cur,
+            done,
+            samples,
+        } = progress;
+        check(feed, ts)?;
+        let (start, end) = path.param_range();
+        if !(start..=end).contains(&u) {
+            return Err(PathError::invalid(format!(
+                "path parameter {u} lies outside the path's [{start}, {end}]"
+            )));
+        }
+        Ok(Interpolator {
+            path,
+            feed,
+            ts,
+            u,
+            cur,
+            done,
+            samples,
         })
     }
 
