@@ -242,7 +242,7 @@ fn the_same_helix_as_cl_data_gives_the_same_errors() {
     let mut cl = String::from("PARTNO/HELIX\n$$ the tilted helix\nMULTAX\nFEDRAT/MMPM,1200\n");
     let (csv, us) = displaced_helix_csv();
     let needed = us[us.len() - 1] as usize + 50;
-    for (p, o) in tips.points().iter().zip(&axes).take(needed) {
+    for (p, o) in tips.points().iter().zip(axes.iter()).take(needed) {
         writeln!(
             cl,
             "GOTO/{:.7},{:.7},{:.7},{:.12},{:.12},{:.12}",

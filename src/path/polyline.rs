@@ -2,15 +2,18 @@
 //! i at u = i, straight in between): the shape of discrete five-axis references (CL
 //! data, sampled built-ins).
 
+use std::sync::Arc;
+
 use serde::{Deserialize, Serialize};
 
 use super::{clamp_param, Curve, CurvePoint, PathError};
 use crate::geometry::{self, Vector};
 
-/// A polyline of at least two points, consecutive points distinct.
+/// A polyline of at least two points, consecutive points distinct. Clones share the
+/// points.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Polyline<const D: usize> {
-    points: Vec<Vector<D>>,
+    points: Arc<[Vector<D>]>,
 }
 
 impl<const D: usize> Polyline<D> {
@@ -32,7 +35,9 @@ impl<const D: usize> Polyline<D> {
                 i + 1
             )));
         }
-        Ok(Polyline { points })
+        Ok(Polyline {
+            points: points.into(),
+        })
     }
 
     /// The vertices.

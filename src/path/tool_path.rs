@@ -3,6 +3,8 @@
 //! point `length` mm up the tool axis) or a sequence of poses joined by straight tip
 //! moves with the axis slerped in between (CL data, sampled built-ins).
 
+use std::sync::{Arc, OnceLock};
+
 use serde::{Deserialize, Serialize};
 
 use super::nurbs::NurbsData;
@@ -29,10 +31,11 @@ pub enum ToolPath {
         second: Nurbs<3>,
         length: f64,
     },
-    /// Poses in order: tips joined by straight moves, axes by slerp.
+    /// Poses in order: tips joined by straight moves, axes by slerp. Clones share the
+    /// poses.
     Poses {
         tips: Polyline<3>,
-        axes: Vec<Vector<3>>,
+        axes: Arc<[Vector<3>]>,
     },
 }
 
@@ -65,7 +68,7 @@ impl From<ToolPath> for ToolPathData {
             },
             ToolPath::Poses { tips, axes } => ToolPathData::Poses {
                 tips: tips.points().to_vec(),
-                axes,
+                axes: axes.to_vec(),
             },
         }
     }
@@ -122,7 +125,7 @@ impl TryFrom<ToolPathData> for ToolPath {
                 match checked {
                     ToolPath::Poses { tips, .. } => Ok(ToolPath::Poses {
                         tips,
-                        axes: poses.iter().map(|p| p.axis).collect(),
+                        axes: poses.iter().map(|p| p.axis).collect::<Vec<_>>().into(),
                     }),
                     curves => Ok(curves),
                 }
@@ -181,8 +184,16 @@ impl ToolPath {
     /// The built-in path called `name` (one of [`BUILTIN_TOOL_PATHS`]).
     pub fn builtin(name: &str) -> Result<ToolPath, PathError> {
         match name {
-            "tilted_helix" => Ok(ToolPath::tilted_helix()),
-            "figure_eight" => Ok(ToolPath::figure_eight()),
+            // Sampled once per process and shared: every instance on a built-in holds
+            // the same 80 001 poses, and instantiating one costs no sampling.
+            "tilted_helix" => {
+                static HELIX: OnceLock<ToolPath> = OnceLock::new();
+                Ok(HELIX.get_or_init(ToolPath::tilted_helix).clone())
+            }
+            "figure_eight" => {
+                static EIGHT: OnceLock<ToolPath> = OnceLock::new();
+                Ok(EIGHT.get_or_init(ToolPath::figure_eight).clone())
+            }
             _ => Err(PathError::invalid(format!(
                 "unknown five-axis path {name:?}: expected a .cl/.apt or .json file, or a \
                  built-in ({})",
@@ -215,7 +226,7 @@ impl ToolPath {
             ToolPath::Poses { tips, axes } => tips
                 .points()
                 .iter()
-                .zip(axes)
+                .zip(axes.iter())
                 .map(|(&tip, &axis)| Pose { tip, axis })
                 .collect(),
             ToolPath::Curves { tip, .. } => {
@@ -303,7 +314,10 @@ impl ToolPath {
                 i + 1
             )));
         }
-        Ok(ToolPath::Poses { tips, axes })
+        Ok(ToolPath::Poses {
+            tips,
+            axes: axes.into(),
+        })
     }
 
     /// The pose at parameter `u` of the tip curve.
