@@ -266,6 +266,14 @@ impl Instance {
             )));
         }
         let end = current + step;
+        // Far from t = 0 a step can vanish in rounding (1e300 + 1e-3 == 1e300): a sampled
+        // model would then wait for ever for its next sample to fall due.
+        if end - current < 0.5 * step {
+            return Err(Failure::error(format!(
+                "communication step size {step:e} s is lost in the rounding of the time \
+                 {current:e} s"
+            )));
+        }
         if let Some(stop) = self.stop_time {
             if end > stop && !time_matches(end, stop) {
                 return Err(Failure::error(format!(
@@ -273,10 +281,30 @@ impl Instance {
                 )));
             }
         }
+        // Refused before anything changes: the mode stays.
+        self.model.check_step(current, step).map_err(|e| {
+            Failure::error(format!("communication step size {step:e} s refused: {e}"))
+        })?;
         if let Err(message) = self.model.do_step(&mut self.values, current, step) {
             self.mode = Mode::Error;
             return Err(Failure::error(format!(
                 "step at t = {current} failed: {message}"
+            )));
+        }
+        // Never report success with a non-finite output: parameters at the edge of f64
+        // (an inertia of 1e-300) can overflow a model, the importer would carry the NaN
+        // on, and a state saved now could not be restored.
+        let overflowed = self.info.variables.iter().find(|v| {
+            v.causality == Causality::Output
+                && matches!(self.values.get(v.vr), Value::Real(x) if !x.is_finite())
+        });
+        if let Some(v) = overflowed {
+            self.mode = Mode::Error;
+            return Err(Failure::error(format!(
+                "step at t = {current} failed: output '{}' = {} is not finite (the model \
+                 overflowed: check the parameters and inputs)",
+                v.name,
+                self.values.real(v.vr)
             )));
         }
         self.time = end;
@@ -467,5 +495,35 @@ impl Instance {
             &format!("{}: {}", call.name(), failure.message),
         );
         failure.status
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::{path_interpolator_2d, Environment};
+
+    fn started_at(start: f64) -> Instance {
+        let logger = Logger::new(None, std::ptr::null_mut(), "t", false);
+        let info = &path_interpolator_2d::INFO;
+        let mut instance = Instance::new(info, Environment::default(), logger);
+        instance.setup_experiment(start, None).unwrap();
+        instance.enter_initialization_mode().unwrap();
+        instance.exit_initialization_mode().unwrap();
+        instance
+    }
+
+    /// At t = 1e300 a 1 ms step is lost in rounding; the interpolator used to loop for
+    /// ever waiting for a sample that never fell due.
+    #[test]
+    fn a_step_lost_in_the_rounding_of_the_time_is_refused() {
+        let mut far = started_at(1e300);
+        let failure = far.do_step(1e300, 1e-3).unwrap_err();
+        assert!(failure.message.contains("rounding"), "{}", failure.message);
+        assert_eq!(far.mode, Mode::StepComplete);
+        assert_eq!(
+            started_at(0.0).do_step(0.0, 1e-3).map_err(|f| f.message),
+            Ok(())
+        );
     }
 }

@@ -21,6 +21,8 @@ pub mod xy_servo_plant;
 
 #[cfg(feature = "test-hooks")]
 pub mod fault_probe;
+#[cfg(feature = "test-hooks")]
+pub mod pass_through;
 
 use std::path::PathBuf;
 
@@ -64,6 +66,12 @@ pub trait Model: Send {
     /// the outputs. Must not allocate on the heap.
     fn do_step(&mut self, values: &mut Values, time: f64, step: f64) -> ModelResult;
 
+    /// Refuses a communication step the model cannot take in reasonable time (a sampled
+    /// model: too many samples), before anything changes. Must not allocate on success.
+    fn check_step(&self, _time: f64, _step: f64) -> ModelResult {
+        Ok(())
+    }
+
     /// The internal state as bytes, for FMU state save/restore: [`encode_state`] with the
     /// model's own [`StateLayout`].
     fn save_state(&self) -> Result<Vec<u8>, String>;
@@ -80,8 +88,8 @@ pub trait Model: Send {
 }
 
 /// The three state methods of a sampled model whose internal state is
-/// `self.state: Option<State>` (`None` before initialization), saved with layout `$layout`:
-/// the same in every such model, written once.
+/// `self.state: Option<State>` (`None` before initialization), saved with layout `$layout`,
+/// and its step check (the sample clock's): the same in every such model, written once.
 macro_rules! sampled_state_methods {
     ($state:ty, $layout:expr) => {
         fn save_state(&self) -> Result<Vec<u8>, String> {
@@ -95,6 +103,14 @@ macro_rules! sampled_state_methods {
         fn restore_state(&mut self, bytes: &[u8], time: f64) -> $crate::models::ModelResult {
             self.state = $crate::models::decode_checked($layout, bytes, time)?;
             Ok(())
+        }
+
+        // Not a state method, but every sampled model has its clock in `self.state`.
+        fn check_step(&self, time: f64, step: f64) -> $crate::models::ModelResult {
+            match &self.state {
+                Some(state) => state.clock.check_step(time + step),
+                None => Ok(()),
+            }
         }
     };
 }
@@ -312,7 +328,7 @@ pub fn instantiable() -> Vec<&'static ModelInfo> {
     #[allow(unused_mut)]
     let mut models = all();
     #[cfg(feature = "test-hooks")]
-    models.push(&fault_probe::INFO);
+    models.extend([&fault_probe::INFO, &pass_through::INFO]);
     models
 }
 

@@ -161,8 +161,25 @@ fn path(values: &Values, environment: &Environment) -> Result<Path, String> {
     match spec.to_ascii_lowercase().as_str() {
         "line" => line_arc_parameters::line(values, GEOMETRY).map(Path::Line),
         "arc" => line_arc_parameters::arc(values, GEOMETRY).map(Path::Arc),
-        _ => Path::from_spec(spec, environment.resource_dir.as_deref())
-            .map_err(|e| format!("parameter 'path': {e}")),
+        _ => Path::from_spec(spec, environment.resource_dir.as_deref()).map_err(|e| {
+            let e = e.to_string();
+            format!(
+                "parameter 'path': {e}{}",
+                resource_hint(spec, environment, &e)
+            )
+        }),
+    }
+}
+
+/// The cause when a relative path file cannot be read and the importer gave no usable
+/// resource location (NULL, or not a local file URI) to look it up in: the file system's
+/// "No such file" alone would hide it.
+pub(super) fn resource_hint(spec: &str, environment: &Environment, error: &str) -> &'static str {
+    let relative = std::path::Path::new(spec.trim()).is_relative();
+    if relative && environment.resource_dir.is_none() && error.contains("cannot read") {
+        " (looked up in the working directory: the importer gave no usable resource location)"
+    } else {
+        ""
     }
 }
 

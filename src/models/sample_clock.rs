@@ -11,6 +11,10 @@ use serde::{Deserialize, Serialize};
 /// per period, so a vanishing `Ts` would make a single `fmi2DoStep` run for hours.
 pub const MIN_PERIOD: f64 = 1e-6;
 
+/// The most samples one communication step may take: 10⁴ s of simulated time at the
+/// usual 1 ms period, far beyond any sensible communication step.
+pub const MAX_SAMPLES_PER_STEP: f64 = 1e7;
+
 /// Checks a sample period parameter; the error names it.
 pub fn check_period(name: &str, period: f64) -> Result<f64, String> {
     if period >= MIN_PERIOD && period.is_finite() {
@@ -71,6 +75,21 @@ impl SampleClock {
     /// The sample period, s.
     pub fn period(&self) -> f64 {
         self.period
+    }
+
+    /// Refuses a communication step to `end` that would take more than
+    /// [`MAX_SAMPLES_PER_STEP`] samples: a step of 1e300 s is finite, so the FMI layer
+    /// accepts it, but one `fmi2DoStep` would then never return.
+    pub fn check_step(&self, end: f64) -> Result<(), String> {
+        let samples = (end - self.due(self.taken)) / self.period;
+        if samples > MAX_SAMPLES_PER_STEP {
+            return Err(format!(
+                "it would take {samples:e} samples of Ts = {} s (at most \
+                 {MAX_SAMPLES_PER_STEP:e} per step)",
+                self.period
+            ));
+        }
+        Ok(())
     }
 
     /// Checks a clock restored from saved bytes at instance time `time` like the

@@ -68,8 +68,12 @@ impl fmt::Display for PathError {
                 column,
                 message,
             } => {
-                if *line > 0 {
+                // A CL record has a line but no column: "file:line:0:" would read as a
+                // position that does not exist.
+                if *line > 0 && *column > 0 {
                     write!(f, "{file}:{line}:{column}: {message}")
+                } else if *line > 0 {
+                    write!(f, "{file}:{line}: {message}")
                 } else {
                     write!(f, "{file}: {message}")
                 }
