@@ -4,14 +4,16 @@
 #   make test   lint, then every test (Rust unit/ABI tests, fmpy/libcosim/ecos and reference
 #               tests); installs libclang-dev and libtbb12 through apt when they are missing
 #               (root), the venv gets the test set and the package
-# Other targets: fmus, ccc-tune, bindings, lint, bench, pso-claim, setup.
+# Other targets: fmus, ccc-tune, bindings, lint, asan, fuzz-smoke, fuzz-long, bench,
+# leak-check, pso-claim, setup.
 
 VENV   := .venv
 PYTHON := $(VENV)/bin/python
 PIP    := $(PYTHON) -m pip install --quiet --disable-pip-version-check
 CARGO  ?= cargo
 
-.PHONY: demo test fmus ccc-tune bindings lint bench pso-claim setup libclang libtbb valgrind leak-check
+.PHONY: demo test fmus ccc-tune bindings lint bench pso-claim setup libclang libtbb valgrind leak-check \
+        asan fuzz-smoke fuzz-long
 
 # --- demo: cargo and python3 only ---------------------------------------------------------
 
@@ -73,7 +75,24 @@ lint:
 
 test: setup lint
 	$(CARGO) test --workspace --features contour-fmu/test-hooks
+	$(MAKE) --no-print-directory asan
 	$(PYTHON) -m pytest -q tests/fmpy tests/reference
+
+# AddressSanitizer, with its leak checker, over the FMI boundary: the library's unit tests
+# and the ABI tests, the dlopened cdylib instrumented as well. The stable toolchain's
+# -Zsanitizer needs RUSTC_BOOTSTRAP; --target keeps build scripts and proc macros
+# uninstrumented; the test executables export the ASan runtime for the cdylib to find.
+HOST       := $(shell rustc -vV 2>/dev/null | sed -n 's/^host: //p')
+ASAN_FLAGS := -Zsanitizer=address -Clink-arg=-Wl,--export-dynamic
+ASAN_TESTS := --lib --test fmi_abi --test abi_handles --test abi_state_validation \
+              --test abi_two_axis_models --test bad_inputs --test exported_symbols \
+              --test no_alloc --test threads
+asan:
+	RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=target/asan RUSTFLAGS="$(ASAN_FLAGS)" \
+		$(CARGO) test -p contour-fmu --target $(HOST) --features test-hooks $(ASAN_TESTS)
+	@nm -D target/asan/$(HOST)/debug/deps/libcontour_fmu.so | grep -q __asan_report_load8 \
+		|| { echo "asan: the library under test is not instrumented"; exit 1; }
+	@echo "asan: no report from AddressSanitizer or LeakSanitizer"
 
 # Regenerates src/fmi2/bindings.rs from the FMI 2.0 headers.
 bindings: libclang
