@@ -13,7 +13,7 @@ PIP    := $(PYTHON) -m pip install --quiet --disable-pip-version-check
 CARGO  ?= cargo
 
 .PHONY: demo test fmus ccc-tune bindings lint bench pso-claim setup libclang libtbb valgrind leak-check \
-        asan fuzz-smoke fuzz-long
+        asan fuzz-smoke fuzz-long cargo-fuzz
 
 # --- demo: cargo and python3 only ---------------------------------------------------------
 
@@ -66,8 +66,15 @@ valgrind:
 		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq valgrind; \
 	fi
 
+# The fuzzer's driver (cargo-fuzz, from crates.io).
+cargo-fuzz:
+	@if ! $(CARGO) fuzz --version >/dev/null 2>&1; then \
+		echo "installing cargo-fuzz (the fuzz smoke run)"; \
+		$(CARGO) install --locked cargo-fuzz; \
+	fi
+
 # Everything `make test` installs.
-setup: libclang libtbb valgrind $(VENV)/.test-installed
+setup: libclang libtbb valgrind cargo-fuzz $(VENV)/.test-installed
 
 lint:
 	$(CARGO) fmt --all -- --check
@@ -76,7 +83,14 @@ lint:
 test: setup lint
 	$(CARGO) test --workspace --features contour-fmu/test-hooks
 	$(MAKE) --no-print-directory asan
+	fuzz/smoke.sh 30
 	$(PYTHON) -m pytest -q tests/fmpy tests/reference
+
+# Every fuzz target (fuzz/README.md) for 30 s each, or 10 M executions each (hours).
+fuzz-smoke: cargo-fuzz
+	fuzz/smoke.sh 30
+fuzz-long: cargo-fuzz
+	fuzz/long.sh 10000000
 
 # AddressSanitizer, with its leak checker, over the FMI boundary: the library's unit tests
 # and the ABI tests, the dlopened cdylib instrumented as well. The stable toolchain's
@@ -100,14 +114,23 @@ bindings: libclang
 
 # --- measurements -------------------------------------------------------------------------
 
-bench: fmus ccc-tune $(VENV)/.test-installed
-	$(CARGO) bench --bench fuzzy --bench controller --bench five_axis --bench fmu_abi
-	$(CARGO) build --release -p contour-fmu --example fuzzy_timing
-	$(PYTHON) benches/fuzzy_vs_skfuzzy.py
-	$(PYTHON) benches/tuning_vs_pyswarms_fmu.py
-	$(PYTHON) benches/pso_tables.py
+# One page of ratios measured in this run (target/bench-report/report.md); a part that
+# fails still lets the page print, marked "not measured".
+BENCH_REPORT := $(or $(CARGO_TARGET_DIR),target)/bench-report
+CRITERION    := --warm-up-time 1 --measurement-time 3 --sample-size 50 --noplot
 
-# Every model's life cycle 10 000 times under valgrind's leak checker (about an hour).
+bench: fmus ccc-tune $(VENV)/.test-installed
+	$(PYTHON) benches/report.py --start
+	-$(CARGO) bench --features test-hooks --bench fuzzy --bench controller --bench five_axis \
+		--bench fmu_abi -- $(CRITERION)
+	-$(CARGO) build --release -p contour-fmu --example fuzzy_timing --example fuzzy_dump
+	-$(PYTHON) benches/fuzzy_vs_skfuzzy.py --evals 30 --json $(BENCH_REPORT)/fuzzy_vs_skfuzzy.json
+	-$(PYTHON) benches/tuning_vs_pyswarms_fmu.py --particles 6 --iters 5 \
+		--json $(BENCH_REPORT)/tuning_vs_pyswarms_fmu.json
+	-$(PYTHON) benches/pso_tables.py --json $(BENCH_REPORT)/pso_tables.json
+	$(PYTHON) benches/report.py
+
+# Every model's life cycle 10 000 times under valgrind's leak checker (hours on 2 cores).
 leak-check: valgrind
 	$(CARGO) build --release --example lifecycle
 	valgrind --leak-check=full --errors-for-leak-kinds=definite,indirect,possible \

@@ -1,13 +1,21 @@
-//! One sample of `ContourCCC5X` as an importer pays for it: `fmi2SetReal` of the ten
-//! inputs (reference and measured joints), `fmi2DoStep` of 1 ms (one control period),
-//! `fmi2GetReal` of the five velocity commands and the two contour errors, through the
-//! exported C functions (linked statically, as tests/no_alloc.rs calls them; an importer
-//! adds only the dlopen'ed call's indirection). The target: at most 5 µs median
-//! per sample, flat in the path length, no allocation (the last is tests/no_alloc.rs).
+//! One controller sample as an importer pays for it, through the exported C functions
+//! (linked statically, as tests/no_alloc.rs calls them; an importer adds only the
+//! dlopen'ed call's indirection): `fmi2SetReal` of the inputs, `fmi2DoStep` of 1 ms (one
+//! control period), `fmi2GetReal` of the outputs an importer reads. Each is set against
+//! the same calls with the same number of values on `PassThrough` (a test-only model that
+//! copies inputs to outputs, hence the `test-hooks` feature): the ratio is the
+//! controller's own cost over the ABI and instance bookkeeping. The target for
+//! ContourCCC5X: at most 5 µs median per sample, flat in the path length, no allocation
+//! (the last is tests/no_alloc.rs).
+//!
+//! `fmu_abi/contour_ccc_2d_sample`: the reference and measured points of the recorded
+//! two-axis closed loop on the paper's circle (4 inputs, u.x, u.y and contourError read);
+//! `fmu_abi/pass_through_2d_round`: the same rows and value counts on `PassThrough`.
 //!
 //! `fmu_abi/contour_ccc_5x_sample`: replays the reference and measured joints of the
 //! recorded five-axis closed loop on the figure-eight (as benches/five_axis.rs does in
-//! process), from the freshly initialized instance each time.
+//! process), from the freshly initialized instance each time (10 inputs, 7 outputs);
+//! `fmu_abi/pass_through_5x_round`: the same rows and value counts on `PassThrough`.
 //!
 //! `fmu_abi/path_1k` and `fmu_abi/path_100k`: the last 500 samples of a helix reference of
 //! 1 000 and of 100 000 distinct points, the tool trailing by 35 samples (the paths of
@@ -15,19 +23,23 @@
 //! once, and is put back there with `fmi2SetFMUstate` before each timed run.
 //!
 //! `fmu_abi/five_axis_plant_round`: the same round on `FiveAxisPlant`, the lightest
-//! five-axis model (five velocity commands in, five positions and velocities out): what
-//! the ABI and the instance bookkeeping cost with next to no model behind them.
+//! packaged five-axis model (five velocity commands in, five positions and velocities out).
 //!
 //! Criterion's throughput gives the time per sample. At the end the bench prints the
-//! median per sample of each group, taken from the same timed runs criterion analyses,
-//! and the two ratios: path_100k / path_1k and contour_ccc_5x_sample / five_axis_plant_round.
+//! median per sample of each benchmark, taken from the same timed runs criterion
+//! analyses, and the ratios controller / pass-through, path_100k / path_1k and
+//! contour_ccc_5x_sample / five_axis_plant_round, measured in alternated passes timed
+//! in short chunks (see [`PASSES`]: robust to other processes on a shared machine), and
+//! writes them to `<target>/bench-report/fmu_abi.json` for benches/report.py.
 
 use std::ffi::CString;
 use std::hint::black_box;
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use contour_fmu::fmi2::bindings::{fmi2CallbackFunctions, fmi2Component, fmi2FMUstate};
-use contour_fmu::sim::{simulate_five_axis, FiveAxisSimConfig};
+use contour_fmu::models::{self, ModelInfo};
+use contour_fmu::sim::{simulate_five_axis, FiveAxisSimConfig, SimConfig, Simulator};
 use criterion::{BenchmarkGroup, Criterion, SamplingMode, Throughput};
 
 #[path = "../tests/common/linked.rs"]
@@ -44,6 +56,8 @@ const H: f64 = 1e-3;
 /// the recorded runs are criterion's samples rather than its warm-up).
 const SAMPLES: usize = 100;
 
+const CCC_2D_INPUTS: [&str; 4] = ["ref.x", "ref.y", "pos.x", "pos.y"];
+const CCC_2D_OUTPUTS: [&str; 3] = ["u.x", "u.y", "contourError"];
 const CCC_INPUTS: [&str; 10] = [
     "ref.X", "ref.Y", "ref.Z", "ref.A", "ref.C", "pos.X", "pos.Y", "pos.Z", "pos.A", "pos.C",
 ];
@@ -60,6 +74,21 @@ const PLANT_INPUTS: [&str; 5] = ["u.X", "u.Y", "u.Z", "u.A", "u.C"];
 const PLANT_OUTPUTS: [&str; 10] = [
     "pos.X", "pos.Y", "pos.Z", "pos.A", "pos.C", "vel.X", "vel.Y", "vel.Z", "vel.A", "vel.C",
 ];
+const PASS_INPUTS: [&str; 10] = [
+    "in1", "in2", "in3", "in4", "in5", "in6", "in7", "in8", "in9", "in10",
+];
+const PASS_OUTPUTS: [&str; 10] = [
+    "out1", "out2", "out3", "out4", "out5", "out6", "out7", "out8", "out9", "out10",
+];
+
+/// The model served under `identifier`, the test-only ones included (`linked::model`
+/// knows the packaged models only).
+fn model(identifier: &str) -> &'static ModelInfo {
+    models::instantiable()
+        .into_iter()
+        .find(|m| m.identifier == identifier)
+        .unwrap_or_else(|| panic!("no model {identifier} (PassThrough needs test-hooks)"))
+}
 
 /// An initialized instance (logging off) with the value references of one round.
 struct Fmu {
@@ -75,7 +104,7 @@ struct Fmu {
 
 impl Fmu {
     fn new(identifier: &str, inputs: &[&str], outputs: &[&str]) -> Fmu {
-        let model = linked::model(identifier);
+        let model = model(identifier);
         let functions = Box::new(linked::quiet_callbacks());
         let name = CString::new("fmu-abi-bench").unwrap();
         // SAFETY: the callbacks are boxed in the returned value, which frees the instance
@@ -89,6 +118,16 @@ impl Fmu {
             states: Vec::new(),
             _functions: functions,
         }
+    }
+
+    /// A `PassThrough` instance called with as many values as `Fmu::new(_, inputs,
+    /// outputs)`: the baseline of that round.
+    fn pass_through(inputs: &[&str], outputs: &[&str]) -> Fmu {
+        Fmu::new(
+            "PassThrough",
+            &PASS_INPUTS[..inputs.len()],
+            &PASS_OUTPUTS[..outputs.len()],
+        )
     }
 
     /// One round per row of `rows`, the first at communication point `first · H`; returns
@@ -140,10 +179,125 @@ impl Drop for Fmu {
     }
 }
 
-/// Per-sample times of every timed call, by benchmark, for the summary at the end.
+/// The ratios the summary prints and writes: (name, numerator, denominator).
+const RATIOS: [(&str, &str, &str); 4] = [
+    (
+        "ccc_2d_over_pass_through",
+        "contour_ccc_2d_sample",
+        "pass_through_2d_round",
+    ),
+    (
+        "ccc_5x_over_pass_through",
+        "contour_ccc_5x_sample",
+        "pass_through_5x_round",
+    ),
+    ("path_100k_over_1k", "path_100k", "path_1k"),
+    (
+        "ccc_5x_over_plant_round",
+        "contour_ccc_5x_sample",
+        "five_axis_plant_round",
+    ),
+];
+
+/// The ratios are measured after criterion, the two rounds of each alternated, in
+/// [`PASSES`] timed passes; each pass times every [`CHUNK`] consecutive samples on their
+/// own, and a round's time is the sum over its chunks of the chunk's median over the
+/// passes. On a shared machine this leaves out the time other processes take: a chunk
+/// (well under a scheduler time slice) is rarely preempted, so its median is undisturbed,
+/// whereas a whole run of milliseconds is preempted in proportion to its length (medians
+/// of whole runs would inflate the longer round's time, and so the ratio, with the load).
+const PASSES: usize = 30;
+const CHUNK: usize = 16;
+
+/// One benchmarked round: `run(chunk, times)` puts the instance back to its starting
+/// state (untimed), then steps it through all its rows, pushing the time (s) of each
+/// `chunk` consecutive rows onto `times`.
+struct Round {
+    name: &'static str,
+    samples: usize,
+    run: Box<Replay>,
+}
+
+/// See [`Round`]'s `run`.
+type Replay = dyn FnMut(usize, &mut Vec<f64>);
+
+impl Round {
+    /// `fmu` stepped through `rows` from `state`, the first row at communication point
+    /// `first · H`.
+    fn new<const N: usize>(
+        name: &'static str,
+        mut fmu: Fmu,
+        state: fmi2FMUstate,
+        first: usize,
+        rows: Vec<[f64; N]>,
+    ) -> Round {
+        Round {
+            name,
+            samples: rows.len(),
+            run: Box::new(move |chunk, times| {
+                fmu.restore(state);
+                for (j, part) in rows.chunks(chunk).enumerate() {
+                    let start = Instant::now();
+                    black_box(fmu.replay(first + j * chunk, part));
+                    times.push(start.elapsed().as_secs_f64());
+                }
+            }),
+        }
+    }
+
+    /// From the instance's state as it is now (freshly initialized).
+    fn fresh<const N: usize>(name: &'static str, mut fmu: Fmu, rows: Vec<[f64; N]>) -> Round {
+        let state = fmu.save();
+        Round::new(name, fmu, state, 0, rows)
+    }
+
+    /// One timed run of all the rows (s).
+    fn whole(&mut self, times: &mut Vec<f64>) -> f64 {
+        times.clear();
+        (self.run)(self.samples, times);
+        times[0]
+    }
+
+    /// One pass in chunks of [`CHUNK`] rows: their times (s).
+    fn chunked(&mut self) -> Vec<f64> {
+        let mut times = Vec::with_capacity(self.samples.div_ceil(CHUNK));
+        (self.run)(CHUNK, &mut times);
+        times
+    }
+}
+
+/// A round's time per sample (s) from its passes (see [`PASSES`]).
+fn per_sample(passes: &[Vec<f64>], samples: usize) -> f64 {
+    let chunks = passes[0].len();
+    let total: f64 = (0..chunks)
+        .map(|j| median(passes.iter().map(|p| p[j]).collect()).expect("PASSES > 0"))
+        .sum();
+    total / samples as f64
+}
+
+fn median(mut values: Vec<f64>) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    let m = values.len() / 2;
+    Some(if values.len() % 2 == 1 {
+        values[m]
+    } else {
+        0.5 * (values[m - 1] + values[m])
+    })
+}
+
+/// One of [`RATIOS`] as measured in passes: (label, ratio, numerator's and denominator's
+/// time per sample in s).
+type Paired = (&'static str, f64, f64, f64);
+
+/// Per-sample times of every timed call, by benchmark, and the paired ratios, for the
+/// summary at the end.
 #[derive(Default)]
 struct Summary {
     runs: Vec<(&'static str, Vec<f64>)>,
+    paired: Vec<Paired>,
 }
 
 impl Summary {
@@ -158,14 +312,27 @@ impl Summary {
     /// [`SAMPLES`] calls (the warm-up calls come first); `None` if it did not run (filtered).
     fn median(&self, name: &str) -> Option<f64> {
         let (_, times) = self.runs.iter().find(|(n, _)| *n == name)?;
-        let mut last = times[times.len().saturating_sub(SAMPLES)..].to_vec();
-        last.sort_by(f64::total_cmp);
-        let m = last.len() / 2;
-        Some(if last.len() % 2 == 1 {
-            last[m]
-        } else {
-            0.5 * (last[m - 1] + last[m])
-        })
+        median(times[times.len().saturating_sub(SAMPLES)..].to_vec())
+    }
+
+    /// Each of [`RATIOS`] whose two rounds ran, measured in alternated passes.
+    fn measure_pairs(&mut self, rounds: &mut [Round]) {
+        for (label, a, b) in RATIOS {
+            let (Some(ia), Some(ib)) = (
+                rounds.iter().position(|r| r.name == a),
+                rounds.iter().position(|r| r.name == b),
+            ) else {
+                continue;
+            };
+            let (mut pa, mut pb) = (Vec::new(), Vec::new());
+            for _ in 0..PASSES {
+                pa.push(rounds[ia].chunked());
+                pb.push(rounds[ib].chunked());
+            }
+            let ta = per_sample(&pa, rounds[ia].samples);
+            let tb = per_sample(&pb, rounds[ib].samples);
+            self.paired.push((label, ta / tb, ta, tb));
+        }
     }
 
     fn print(&self) {
@@ -174,60 +341,120 @@ impl Summary {
             let m = self.median(name).unwrap();
             println!("  {name:<26} {:>8.3} µs", m * 1e6);
         }
-        let ratio = |a: &str, b: &str| match (self.median(a), self.median(b)) {
-            (Some(a), Some(b)) => format!("{:.3}", a / b),
-            _ => "(not run)".to_string(),
-        };
-        println!(
-            "  path_100k / path_1k        {}",
-            ratio("path_100k", "path_1k")
-        );
-        println!(
-            "  sample / plant round       {}",
-            ratio("contour_ccc_5x_sample", "five_axis_plant_round")
-        );
+        println!("ratios ({PASSES} alternated passes, median per {CHUNK}-sample chunk)");
+        for (label, ratio, a, b) in &self.paired {
+            println!(
+                "  {label:<26} {ratio:>8.3}  ({:.3} µs / {:.3} µs)",
+                a * 1e6,
+                b * 1e6
+            );
+        }
+    }
+
+    /// The medians and ratios as JSON for benches/report.py; what did not run is left out.
+    fn json(&self) -> serde_json::Value {
+        let medians: serde_json::Map<String, serde_json::Value> = self
+            .runs
+            .iter()
+            .filter_map(|(name, _)| Some((name.to_string(), self.median(name)?.into())))
+            .collect();
+        let ratios: serde_json::Map<String, serde_json::Value> = self
+            .paired
+            .iter()
+            .map(|(label, ratio, a, b)| {
+                let figures =
+                    serde_json::json!({"ratio": ratio, "a_s_per_sample": a, "b_s_per_sample": b});
+                (label.to_string(), figures)
+            })
+            .collect();
+        serde_json::json!({
+            "criterion_samples": SAMPLES,
+            "median_s_per_sample": medians,
+            "passes": PASSES,
+            "chunk": CHUNK,
+            "paired": ratios,
+        })
     }
 }
 
-/// Benchmarks `name`: each timed run puts `fmu` back to `state` (untimed), then steps it
-/// through `rows` from communication point `first · H`.
-fn bench_replay<const N: usize>(
+/// `<target>/bench-report`, where every part of `make bench` leaves its figures.
+fn report_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map_or_else(
+            || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target"),
+            PathBuf::from,
+        )
+        .join("bench-report")
+}
+
+/// Benchmarks `round`; criterion's throughput gives the time per sample.
+fn bench(
     group: &mut BenchmarkGroup<'_, criterion::measurement::WallTime>,
     summary: &mut Summary,
-    name: &'static str,
-    (fmu, state, first): (&mut Fmu, fmi2FMUstate, usize),
-    rows: &[[f64; N]],
+    round: &mut Round,
 ) {
-    group.throughput(Throughput::Elements(rows.len() as u64));
+    let name = round.name;
+    let samples = round.samples;
+    group.throughput(Throughput::Elements(samples as u64));
     group.bench_function(name, |b| {
+        let mut times = Vec::with_capacity(1);
         b.iter_custom(|iters| {
-            let mut total = Duration::ZERO;
-            for _ in 0..iters {
-                fmu.restore(state);
-                let start = Instant::now();
-                black_box(fmu.replay(first, rows));
-                total += start.elapsed();
-            }
-            summary.record(
-                name,
-                total.as_secs_f64() / (iters as f64 * rows.len() as f64),
-            );
-            total
+            let total: f64 = (0..iters).map(|_| round.whole(&mut times)).sum();
+            summary.record(name, total / (iters as f64 * samples as f64));
+            Duration::from_secs_f64(total)
         })
     });
 }
 
-fn group<'a>(c: &'a mut Criterion) -> BenchmarkGroup<'a, criterion::measurement::WallTime> {
-    let mut group = c.benchmark_group("fmu_abi");
-    // Each run is milliseconds long: the same number of runs per sample (criterion's
-    // advice for long routines).
-    group.sampling_mode(SamplingMode::Flat).sample_size(SAMPLES);
-    group
+/// The largest relative deviation of the commands `fmu` computes from `rows` (stepped
+/// from the state it is in) from the recorded ones.
+fn deviation<const N: usize, const D: usize>(
+    fmu: &mut Fmu,
+    rows: &[[f64; N]],
+    recorded: impl Iterator<Item = [f64; D]>,
+) -> f64 {
+    let mut deviation = 0.0f64;
+    for (k, (row, expected)) in rows.iter().zip(recorded).enumerate() {
+        fmu.replay(k, std::slice::from_ref(row));
+        for (u, expected) in fmu.read[..D].iter().zip(expected) {
+            deviation = deviation.max((u - expected).abs() / expected.abs().max(1.0));
+        }
+    }
+    deviation
 }
 
-/// The recorded closed loop on the figure-eight, replayed on ContourCCC5X and, with its
-/// velocity commands, on FiveAxisPlant.
-fn bench_replays(c: &mut Criterion, summary: &mut Summary) {
+/// The recorded closed loop on the paper's circle, replayed on ContourCCC2D and, with the
+/// same values, on PassThrough.
+fn two_axis() -> Vec<Round> {
+    let sim = Simulator::new(SimConfig::paper_circle()).unwrap();
+    let trace = sim.run().trace;
+    let rows: Vec<[f64; 4]> = trace
+        .reference
+        .iter()
+        .zip(&trace.actual)
+        .map(|(r, p)| [r[0], r[1], p[0], p[1]])
+        .collect();
+
+    let mut ccc = Fmu::new("ContourCCC2D", &CCC_2D_INPUTS, &CCC_2D_OUTPUTS);
+    let fresh = ccc.save();
+    // The FMU's start values are the simulation's controller (ControllerConfig::DEFAULT),
+    // so the replay is the closed loop's work sample for sample.
+    let recorded = trace.u.iter().map(|u| [u[0], u[1]]);
+    let deviation = deviation(&mut ccc, &rows, recorded);
+    assert!(
+        deviation < 1e-9,
+        "ContourCCC2D does not reproduce the recorded commands (relative deviation {deviation:e})"
+    );
+    let pass = Fmu::pass_through(&CCC_2D_INPUTS, &CCC_2D_OUTPUTS);
+    vec![
+        Round::new("contour_ccc_2d_sample", ccc, fresh, 0, rows.clone()),
+        Round::fresh("pass_through_2d_round", pass, rows),
+    ]
+}
+
+/// The recorded closed loop on the figure-eight, replayed on ContourCCC5X, with the same
+/// values on PassThrough, and with its velocity commands on FiveAxisPlant.
+fn five_axis() -> Vec<Round> {
     let config = FiveAxisSimConfig::builtin("figure_eight").unwrap();
     let (_, records) = simulate_five_axis(&config, true).unwrap();
     let ccc_rows: Vec<[f64; 10]> = records
@@ -244,37 +471,19 @@ fn bench_replays(c: &mut Criterion, summary: &mut Summary) {
     // The FMU's start values are the simulation's controller (FiveAxisConfig::DEFAULT):
     // fed the same joints, it gives the same commands, so the replay is the closed loop's
     // work sample for sample.
-    let mut deviation = 0.0f64;
-    for (k, (row, record)) in ccc_rows.iter().zip(&records).enumerate() {
-        ccc.replay(k, std::slice::from_ref(row));
-        for (u, expected) in ccc.read[..5].iter().zip(record.u.iter()) {
-            deviation = deviation.max((u - expected).abs() / expected.abs().max(1.0));
-        }
-    }
+    let recorded = records.iter().map(|r| <[f64; 5]>::from(r.u));
+    let deviation = deviation(&mut ccc, &ccc_rows, recorded);
     assert!(
         deviation < 1e-9,
         "ContourCCC5X does not reproduce the recorded commands (relative deviation {deviation:e})"
     );
-
-    let mut plant = Fmu::new("FiveAxisPlant", &PLANT_INPUTS, &PLANT_OUTPUTS);
-    let plant_fresh = plant.save();
-
-    let mut group = group(c);
-    bench_replay(
-        &mut group,
-        summary,
-        "contour_ccc_5x_sample",
-        (&mut ccc, fresh, 0),
-        &ccc_rows,
-    );
-    bench_replay(
-        &mut group,
-        summary,
-        "five_axis_plant_round",
-        (&mut plant, plant_fresh, 0),
-        &plant_rows,
-    );
-    group.finish();
+    let pass = Fmu::pass_through(&CCC_INPUTS, &CCC_OUTPUTS);
+    let plant = Fmu::new("FiveAxisPlant", &PLANT_INPUTS, &PLANT_OUTPUTS);
+    vec![
+        Round::new("contour_ccc_5x_sample", ccc, fresh, 0, ccc_rows.clone()),
+        Round::fresh("pass_through_5x_round", pass, ccc_rows),
+        Round::fresh("five_axis_plant_round", plant, plant_rows),
+    ]
 }
 
 /// The helix of benches/five_axis.rs as ContourCCC5X inputs: `n` distinct reference
@@ -304,30 +513,51 @@ fn helix(n: usize) -> Vec<[f64; 10]> {
         .collect()
 }
 
-fn bench_path_length(c: &mut Criterion, summary: &mut Summary) {
-    let mut group = group(c);
-    for (name, n) in [("path_1k", 1_000), ("path_100k", 100_000)] {
-        let rows = helix(n);
-        let (before, timed) = rows.split_at(n - 500);
-        let mut ccc = Fmu::new("ContourCCC5X", &CCC_INPUTS, &CCC_OUTPUTS);
-        ccc.replay(0, before);
-        let warmed = ccc.save();
-        bench_replay(
-            &mut group,
-            summary,
-            name,
-            (&mut ccc, warmed, before.len()),
-            timed,
-        );
-    }
-    group.finish();
+/// ContourCCC5X on the last 500 samples of a 1 000 and a 100 000 point helix, each
+/// instance having stepped through all the points before them.
+fn path_lengths() -> Vec<Round> {
+    [("path_1k", 1_000), ("path_100k", 100_000)]
+        .into_iter()
+        .map(|(name, n)| {
+            let mut rows = helix(n);
+            let timed = rows.split_off(n - 500);
+            let mut ccc = Fmu::new("ContourCCC5X", &CCC_INPUTS, &CCC_OUTPUTS);
+            ccc.replay(0, &rows);
+            let warmed = ccc.save();
+            Round::new(name, ccc, warmed, rows.len(), timed)
+        })
+        .collect()
 }
 
 fn main() {
     let mut c = Criterion::default().configure_from_args();
     let mut summary = Summary::default();
-    bench_replays(&mut c, &mut summary);
-    bench_path_length(&mut c, &mut summary);
+    let mut rounds = two_axis();
+    rounds.extend(five_axis());
+    rounds.extend(path_lengths());
+    let mut group = c.benchmark_group("fmu_abi");
+    // Each run is milliseconds long: the same number of runs per sample (criterion's
+    // advice for long routines).
+    group.sampling_mode(SamplingMode::Flat).sample_size(SAMPLES);
+    for round in &mut rounds {
+        bench(&mut group, &mut summary, round);
+    }
+    group.finish();
     c.final_summary();
+    // Criterion's test, list and profile modes time nothing worth keeping; a filter that
+    // left nothing to run neither.
+    let modes = ["--test", "--list", "--profile-time"];
+    if std::env::args().any(|a| modes.contains(&a.as_str())) || summary.runs.is_empty() {
+        return;
+    }
+    // Only the rounds criterion ran (a filter may have left some out).
+    rounds.retain(|r| summary.runs.iter().any(|(name, _)| *name == r.name));
+    summary.measure_pairs(&mut rounds);
     summary.print();
+    let path = report_dir().join("fmu_abi.json");
+    let text = serde_json::to_string_pretty(&summary.json()).expect("plain numbers") + "\n";
+    let written = std::fs::create_dir_all(report_dir()).and_then(|()| std::fs::write(&path, text));
+    if let Err(e) = written {
+        eprintln!("fmu_abi: cannot write {}: {e}", path.display());
+    }
 }

@@ -4,10 +4,12 @@ scikit-fuzzy: `ControlSystemSimulation.compute()` for one (E, EC) pair, all thre
 outputs, built exactly as in tests/reference/test_fuzzy_skfuzzy.py (same sets, rules,
 min/max, centroid). Rust: `examples/fuzzy_timing.rs`, which times N evaluations of all
 three outputs. Prints both and their ratio; the target is a ratio of at least 100.
+The timed scikit-fuzzy points are drawn from the 61 x 61 grid of examples/fuzzy_dump.rs,
+so the same run also gives the largest |Rust - scikit-fuzzy| over them (the agreement).
 
 Run from the repository root:
     .venv/bin/python benches/fuzzy_vs_skfuzzy.py \
-        [--evals 100] [--points 20001 601]
+        [--evals 100] [--points 20001 601] [--json FILE]
 """
 
 import argparse
@@ -21,27 +23,33 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "tests" / "reference"))
-from test_fuzzy_skfuzzy import build_simulation  # noqa: E402  (one definition of the system)
+from test_fuzzy_skfuzzy import GRID, OUTPUTS, build_simulation  # noqa: E402  (one definition of the system)
 
 
-def skfuzzy_seconds_per_eval(points, evals, rng):
-    sim = build_simulation(points)
-    pairs = rng.uniform(-3.0, 3.0, size=(evals + 5, 2))
-    for e, ec in pairs[:5]:  # warm-up
-        sim.input["E"], sim.input["EC"] = e, ec
-        sim.compute()
-    start = time.perf_counter()
-    for e, ec in pairs[5:]:
-        sim.input["E"], sim.input["EC"] = e, ec
-        sim.compute()
-        sim.output["dkp"], sim.output["dki"], sim.output["dkd"]
-    return (time.perf_counter() - start) / evals
-
-
-def rust_seconds_per_eval(evals):
-    cmd = ["cargo", "run", "--quiet", "--release", "--example", "fuzzy_timing", "--", str(evals)]
+def cargo_example(name, *args):
+    cmd = ["cargo", "run", "--quiet", "--release", "--example", name, "--", *map(str, args)]
     out = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, check=True).stdout
-    return json.loads(out)["ns_per_eval"] * 1e-9
+    return json.loads(out)
+
+
+def skfuzzy_seconds_per_eval(points, evals, rng, rust):
+    """Seconds per scikit-fuzzy evaluation on `evals` grid points, and the largest
+    |Rust - scikit-fuzzy| over them (any output)."""
+    grid = np.asarray(rust["grid"])
+    sim = build_simulation(points)
+    idx = rng.integers(0, len(grid), size=(evals + 5, 2))
+    for i, j in idx[:5]:  # warm-up
+        sim.input["E"], sim.input["EC"] = grid[i], grid[j]
+        sim.compute()
+    outputs = np.empty((evals, len(OUTPUTS)))
+    start = time.perf_counter()
+    for k, (i, j) in enumerate(idx[5:]):
+        sim.input["E"], sim.input["EC"] = grid[i], grid[j]
+        sim.compute()
+        outputs[k] = [sim.output[name] for name in OUTPUTS]
+    seconds = (time.perf_counter() - start) / evals
+    ours = np.column_stack([np.asarray(rust[name])[idx[5:, 0], idx[5:, 1]] for name in OUTPUTS])
+    return seconds, float(np.abs(ours - outputs).max())
 
 
 def main():
@@ -55,22 +63,30 @@ def main():
         default=[20001, 601],
         help="scikit-fuzzy universe sizes (20001 = the accuracy test, 601 = a coarse one)",
     )
+    parser.add_argument("--json", type=Path, help="also write the figures to this file")
     args = parser.parse_args()
 
-    rust = rust_seconds_per_eval(args.rust_evals)
+    rust = cargo_example("fuzzy_timing", args.rust_evals)["ns_per_eval"] * 1e-9
+    grid = cargo_example("fuzzy_dump", GRID)
     print(f"rust engine        : {rust * 1e9:10.1f} ns per evaluation (3 outputs)")
     rng = np.random.default_rng(1)
     worst = None
+    figures = {"rust_s_per_eval": rust, "evals": args.evals, "skfuzzy": []}
     for points in args.points:
-        sk = skfuzzy_seconds_per_eval(points, args.evals, rng)
+        sk, deviation = skfuzzy_seconds_per_eval(points, args.evals, rng, grid)
         ratio = sk / rust
         worst = ratio if worst is None else min(worst, ratio)
+        figures["skfuzzy"].append({"universe_points": points, "s_per_eval": sk, "ratio": ratio,
+                                   "max_abs_deviation": deviation})
         print(
             f"scikit-fuzzy {points:>6}: {sk * 1e9:10.1f} ns per evaluation "
-            f"-> rust is {ratio:,.0f}x faster"
+            f"-> rust is {ratio:,.0f}x faster; max |rust - skfuzzy| {deviation:.2g}"
         )
     verdict = "met" if worst >= 100 else "MISSED"
     print(f"target >= 100x: {verdict} (smallest ratio {worst:,.0f}x)")
+    if args.json:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps(figures, indent=2) + "\n")
     return 0 if worst >= 100 else 1
 
 

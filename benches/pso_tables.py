@@ -5,9 +5,10 @@
 2. the paper's claim, improved vs standard PSO on the contour-tuning objective, at a
    reduced budget (m = 20, T = 20, 10 seeds; the full budget is `make pso-claim`).
 
-Run from the repository root: .venv/bin/python benches/pso_tables.py
+Run from the repository root: .venv/bin/python benches/pso_tables.py [--json FILE]
 """
 
+import argparse
 import json
 import logging
 import os
@@ -64,6 +65,11 @@ def summary(values):
 
 
 def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--json", type=Path, help="also write the mean final fitness values to this file")
+    args = parser.parse_args()
+    figures = {"benchmarks": {}, "claim": {}}
+
     ours = example("pso_benchmarks", SEEDS, SWARM, ITERATIONS)
     print(f"PSO benchmarks, D = 5, {SWARM} particles x {ITERATIONS} iterations, mean ± spread over {SEEDS} seeds")
     print(f"{'function':11} {'standard PSO (ours)':>38} {'improved PSO (ours)':>38} {'pyswarms GlobalBestPSO':>38}")
@@ -72,6 +78,8 @@ def main():
         improved = [r["fitness"] for r in ours[name]["improved"]]
         reference = pyswarms_runs(f, BOUNDS[name])
         print(f"{name:11} {summary(standard):>38} {summary(improved):>38} {summary(reference):>38}")
+        figures["benchmarks"][name] = {"standard": statistics.mean(standard), "improved": statistics.mean(improved),
+                                       "pyswarms": statistics.mean(reference)}
 
     claim = example("pso_claim", 10, 20, 20, "json")
     print("\nPSO claim at m = 20, T = 20 (mean final fitness over 10 seeds)")
@@ -80,6 +88,12 @@ def main():
         print(f"{case:14} standard {statistics.mean(runs['standard']):8.4f} um  "
               f"improved {statistics.mean(runs['improved']):8.4f} um  "
               f"paper {runs['paper']:8.4f} um  improved better on {wins}/10 seeds")
+        figures["claim"][case] = {"standard": statistics.mean(runs["standard"]),
+                                  "improved": statistics.mean(runs["improved"]), "wins": wins,
+                                  "seeds": len(runs["improved"])}
+    if args.json:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps(figures, indent=2) + "\n")
 
 
 if __name__ == "__main__":

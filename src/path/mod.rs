@@ -311,8 +311,13 @@ pub(crate) fn gauss_length<const D: usize, C: Curve<D> + ?Sized>(
         let m = 0.5 * (a + b);
         let l = gl5(c, a, m);
         let r = gl5(c, m, b);
-        if depth == 0 || (l + r - whole).abs() <= tol {
-            l + r
+        let sum = l + r;
+        // Halving cannot get below the rounding of the sum (a piece 1e5 mm long has no
+        // digits at 1e-11 mm), nor make a non-finite length finite: either would split
+        // down to all 2^30 leaves (found by fuzz/nurbs_json).
+        let floor = 8.0 * f64::EPSILON * sum.abs();
+        if depth == 0 || !sum.is_finite() || (sum - whole).abs() <= tol.max(floor) {
+            sum
         } else {
             rec(c, a, m, l, 0.5 * tol, depth - 1) + rec(c, m, b, r, 0.5 * tol, depth - 1)
         }

@@ -523,4 +523,33 @@ mod tests {
         assert_eq!(c.point(7.0), c.point(1.0));
         assert!(c.eval(f64::INFINITY).p[0].is_finite());
     }
+
+    /// A control point 3e19 mm out (a typo in a path file) or a length beyond f64 used to
+    /// split the length integral down to all 2^30 pieces, as rounding never let it meet
+    /// 1e-11 mm.
+    #[test]
+    fn length_of_a_huge_or_overflowing_curve_returns() {
+        let far = Nurbs::<3>::new(
+            2,
+            vec![0.0, 0.0, 0.0, 0.4, 1.0, 1.0, 1.0],
+            vec![
+                [3.0, 0.0, 0.0],
+                [10.0, 5.0, 0.0],
+                [20.0, 0.0, 1.0],
+                [3e19, 0.0, 51.0],
+            ],
+            None,
+        )
+        .unwrap();
+        let length = far.length();
+        assert!((length / 3e19 - 1.0).abs() < 1e-6, "{length}");
+        let overflowing = Nurbs::<3>::new(
+            1,
+            vec![0.0, 0.0, 1.0, 1.0],
+            vec![[-1e308, 0.0, 0.0], [1e308, 0.0, 0.0]],
+            None,
+        )
+        .unwrap();
+        assert_eq!(overflowing.length(), f64::INFINITY);
+    }
 }

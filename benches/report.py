@@ -1,0 +1,197 @@
+"""One page of the project's speed as ratios measured in the same `make bench` run.
+
+Reads what the bench parts leave in <target>/bench-report/ (<target> is $CARGO_TARGET_DIR,
+else target/): fmu_abi.json (benches/fmu_abi.rs), fuzzy_vs_skfuzzy.json,
+tuning_vs_pyswarms_fmu.json and pso_tables.json (the Python benches' --json), plus
+criterion's own estimates in <target>/criterion/. Prints the page and writes it to
+<target>/bench-report/report.md. A figure that is missing, or older than the run's start
+(a leftover of an earlier run), is shown as "not measured".
+
+    .venv/bin/python benches/report.py --start   # before the benches: clears the folder
+    .venv/bin/python benches/report.py           # after them: the page
+"""
+
+import argparse
+import datetime
+import json
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+TARGET = Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target")
+REPORT = TARGET / "bench-report"
+STAMP = REPORT / ".started"
+NOT_MEASURED = "not measured"
+
+
+def fresh(path):
+    """Whether `path` exists and was written in this run (after the start stamp, if any)."""
+    if not path.is_file():
+        return False
+    return not STAMP.exists() or path.stat().st_mtime >= STAMP.stat().st_mtime
+
+
+def load(name):
+    """A bench part's JSON from this run, or {}."""
+    path = REPORT / name
+    if not fresh(path):
+        return {}
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return {}
+
+
+def criterion(directory):
+    """Criterion's median (s) per element (per iteration without a throughput) of the
+    benchmark in <target>/criterion/<directory>, when this run measured it."""
+    new = TARGET / "criterion" / directory / "new"
+    if not fresh(new / "estimates.json"):
+        return None
+    try:
+        median = json.loads((new / "estimates.json").read_text())["median"]["point_estimate"]
+        throughput = json.loads((new / "benchmark.json").read_text()).get("throughput") or {}
+    except (OSError, ValueError, KeyError):
+        return None
+    return median * 1e-9 / throughput.get("Elements", 1)
+
+
+def dig(data, *keys):
+    """data[k0][k1]…, or None when any is missing or not a finite number at the end."""
+    for key in keys:
+        if isinstance(data, dict) and key in data:
+            data = data[key]
+        elif isinstance(data, list) and isinstance(key, int) and -len(data) <= key < len(data):
+            data = data[key]
+        else:
+            return None
+    return data if isinstance(data, (int, float)) and math.isfinite(data) else None
+
+
+def seconds(s):
+    """A duration with a unit that keeps 3 significant digits readable."""
+    if s is None:
+        return "?"
+    if s >= 1000:
+        return f"{s:.0f} s"
+    for unit, scale in (("s", 1), ("ms", 1e-3), ("µs", 1e-6)):
+        if s >= scale:
+            return f"{s / scale:.3g} {unit}"
+    return f"{s * 1e9:.3g} ns"
+
+
+def ratio(a, b):
+    return a / b if a is not None and b not in (None, 0) else None
+
+
+def line(label, value, detail="", fmt="{:.3g}x"):
+    shown = fmt.format(value) if value is not None else NOT_MEASURED
+    detail = f"  ({detail})" if detail and value is not None else ""
+    return f"  {label:<44} {shown:>12}{detail}"
+
+
+def page():
+    abi = load("fmu_abi.json")
+    fuzzy = load("fuzzy_vs_skfuzzy.json")
+    tuning = load("tuning_vs_pyswarms_fmu.json")
+    pso = load("pso_tables.json")
+    med = lambda name: dig(abi, "median_s_per_sample", name)  # noqa: E731
+
+    now = datetime.datetime.now(datetime.timezone.utc)
+    lines = [f"# contour-fmu speed, {now:%Y-%m-%d %H:%M} UTC: ratios from one run of `make bench`", ""]
+    if STAMP.exists():
+        wall = time.time() - STAMP.stat().st_mtime
+        lines.append(f"(benches ran {wall / 60:.1f} min on {os.cpu_count()} cores; "
+                     "absolute times are this machine's, the ratios are the result)")
+    else:
+        lines.append("(no start stamp: the figures may come from different runs)")
+
+    def paired(key):
+        a, b = dig(abi, "paired", key, "a_s_per_sample"), dig(abi, "paired", key, "b_s_per_sample")
+        return dig(abi, "paired", key, "ratio"), f"{seconds(a)} vs {seconds(b)} per sample"
+
+    lines.append("\nController sample through the C ABI vs PassThrough (same calls, same value counts)")
+    for label, key in (("ContourCCC2D sample / pass-through", "ccc_2d_over_pass_through"),
+                       ("ContourCCC5X sample / pass-through", "ccc_5x_over_pass_through")):
+        lines.append(line(label, *paired(key)))
+
+    lines.append("\nFuzzy inference (3 outputs), scikit-fuzzy / Rust, time per inference")
+    rust = dig(fuzzy, "rust_s_per_eval")
+    runs = fuzzy.get("skfuzzy") or [{}]
+    for k, run in enumerate(runs):
+        points = run.get("universe_points")
+        sk, dev = dig(fuzzy, "skfuzzy", k, "s_per_eval"), dig(fuzzy, "skfuzzy", k, "max_abs_deviation")
+        agreement = f"; max |Rust - skfuzzy| {dev:.2g}" if dev is not None else ""
+        lines.append(line(f"universe of {points} points" if points else "scikit-fuzzy / Rust", ratio(sk, rust),
+                          f"{seconds(sk)} vs {seconds(rust)}{agreement}", "{:,.0f}x"))
+
+    lines.append("\nTuning: improved PSO (ccc-tune) vs pyswarms driving the FMUs through fmpy")
+    full, evals = dig(tuning, "evaluations_full"), dig(tuning, "pyswarms_evaluations")
+    lines.append(line("wall time, same evaluations, pyswarms / ours", dig(tuning, "wall_ratio"),
+                      f"{full} evaluations: {seconds(dig(tuning, 'ccc_tune_full_s'))} vs "
+                      f"{seconds(dig(tuning, 'pyswarms_scaled_s'))}, pyswarms timed on {evals} and scaled",
+                      "{:,.0f}x"))
+    ours_q, theirs_q = dig(tuning, "ccc_tune_small_best_mm"), dig(tuning, "pyswarms_best_mm")
+    quality = (f"{evals} evaluations each: {ours_q * 1e3:.3g} vs {theirs_q * 1e3:.3g} µm, scored through fmpy"
+               if ours_q and theirs_q else "")
+    lines.append(line("best mean |contour error|, pyswarms / ours", dig(tuning, "quality_ratio"), quality,
+                      "{:.3f}"))
+
+    lines.append("\nContourCCC5X cost per sample, 100 k / 1 k path segments")
+    lines.append(line("through the C ABI (fmu_abi)", *paired("path_100k_over_1k"), "{:.3f}"))
+    p100k, p1k = criterion("five_axis/path_100k"), criterion("five_axis/path_1k")
+    lines.append(line("in process (five_axis, criterion medians)", ratio(p100k, p1k), f"{seconds(p100k)} vs {seconds(p1k)}", "{:.3f}"))
+
+    small = [("fuzzy eval", criterion("fuzzy_evaluate_three_outputs")),
+             ("2-axis sample", criterion("controller_sample_fuzzy")),
+             ("5-axis sample", criterion("five_axis/sample_fuzzy")),
+             ("2 s closed loop in process", criterion("sim_paper_circle_2s_metrics_fuzzy")),
+             ("FiveAxisPlant round through the ABI", med("five_axis_plant_round"))]
+    lines.append("\nMedians (criterion, fuzzy mode; per sample, per evaluation or per run)")
+    lines.append("  " + "; ".join(f"{name} {seconds(s) if s is not None else NOT_MEASURED}"
+                                  for name, s in small[:3]))
+    lines.append("  " + "; ".join(f"{name} {seconds(s) if s is not None else NOT_MEASURED}"
+                                  for name, s in small[3:]))
+    functions = pso.get("benchmarks") or {}
+    shown = [f"{name} {ratio(dig(f, 'pyswarms'), dig(f, 'improved')):.3g}" for name, f in functions.items()
+             if ratio(dig(f, "pyswarms"), dig(f, "improved")) is not None]
+    lines.append("PSO on test functions (D = 5, 30 x 200), mean final fitness pyswarms / improved: "
+                 + (", ".join(shown) if shown else NOT_MEASURED))
+    claim = pso.get("claim") or {}
+    if claim:
+        wins = sum(c.get("wins", 0) for c in claim.values())
+        seeds = sum(c.get("seeds", 0) for c in claim.values())
+        lines.append(f"PSO claim at m = T = 20: improved beats standard PSO on {wins}/{seeds} seeds "
+                     f"over {len(claim)} cases (per case in the pso_tables output)")
+    else:
+        lines.append(f"PSO claim at m = T = 20: {NOT_MEASURED}")
+    return "\n".join(lines) + "\n"
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--start", action="store_true",
+                        help="start a run: clear the report folder and stamp the start time")
+    args = parser.parse_args()
+    if args.start:
+        REPORT.mkdir(parents=True, exist_ok=True)
+        for old in REPORT.iterdir():
+            if old.is_file():
+                old.unlink()
+        STAMP.touch()
+        return 0
+    text = page()
+    print(text, end="")
+    try:
+        REPORT.mkdir(parents=True, exist_ok=True)
+        (REPORT / "report.md").write_text(text)
+    except OSError as e:
+        print(f"cannot write {REPORT / 'report.md'}: {e}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,45 @@
+//! The APT CL reader (`parse_cl`, as PathInterpolator5X reads a .cl/.apt file) on
+//! arbitrary text (lossily UTF-8: a file that is not is refused before parsing). What
+//! parses becomes a tool path (`ToolPath::from_poses`), is evaluated at awkward
+//! parameters and followed for a few samples through the inverse kinematics, as the
+//! model does. Nothing may panic; every loop in there is bounded.
+#![no_main]
+
+use contour_fmu::kinematics::TableTiltingAc;
+use contour_fmu::path::cl_data::parse_cl;
+use contour_fmu::path::joint_reference::JointReference;
+use contour_fmu::path::tool_path::ToolPath;
+use contour_fmu::path::Curve;
+use contour_fmu_fuzz::install_panic_hook;
+use libfuzzer_sys::fuzz_target;
+
+const SAMPLES: usize = 32;
+
+fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
+    let text = String::from_utf8_lossy(data);
+    let Ok(cl) = parse_cl(&text, "fuzz.cl") else {
+        return;
+    };
+    assert!(cl.poses.len() >= 2, "parse_cl accepted fewer than two poses");
+    let Ok(path) = ToolPath::from_poses(&cl.poses) else {
+        return;
+    };
+    let ToolPath::Poses { tips, .. } = &path else {
+        panic!("poses make a pose path");
+    };
+    let (a, b) = tips.param_range();
+    for u in [a, b, 0.5 * (a + b), a - 1.0, b + 1.0, f64::NAN, f64::INFINITY] {
+        let _ = path.pose_at(u);
+    }
+    // The vertices themselves: no sampling for a pose path.
+    assert_eq!(path.poses(0.01).len(), cl.poses.len());
+    let feed = (tips.length() / (SAMPLES as f64 * 1e-3)).clamp(1e-3, 1e6);
+    if let Ok(mut reference) = JointReference::new(path, TableTiltingAc::default(), feed, 1e-3) {
+        for _ in 0..SAMPLES {
+            match reference.step() {
+                Ok(sample) if !sample.done => {}
+                _ => break,
+            }
+        }
+    }
+});

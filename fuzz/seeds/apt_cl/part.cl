@@ -1,0 +1,11 @@
+PARTNO/FUZZ SEED
+$$ a short five-axis move: tip and tool axis
+MULTAX
+FEDRAT/MMPM,1200.0
+GOTO/10.0,20.0,5.0,0.0,0.0,1.0
+GOTO/11.5,20.0,5.25,0.0,0.6,0.8
+GOTO/12.0,21.0,$
+5.5,0.0,0.0,2.0
+RAPID
+GOTO/13.0,21.0,6.0
+FINI
