@@ -86,7 +86,9 @@ test: setup lint
 	fuzz/smoke.sh 30
 	$(PYTHON) -m pytest -q tests/fmpy tests/reference
 
-# Every fuzz target (fuzz/README.md) for 30 s each, or 10 M executions each (hours).
+# Every fuzz target (fuzz/README.md) for 30 s each (about 2 min once built), or 10 M
+# executions each (about 6 h for fmi_calls and deserialize_state on 2 loaded cores;
+# MAX_SECONDS=N fuzz/long.sh caps each target).
 fuzz-smoke: cargo-fuzz
 	fuzz/smoke.sh 30
 fuzz-long: cargo-fuzz

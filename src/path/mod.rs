@@ -307,23 +307,29 @@ pub(crate) fn gauss_length<const D: usize, C: Curve<D> + ?Sized>(
         whole: f64,
         tol: f64,
         depth: u32,
+        budget: &mut u32,
     ) -> f64 {
         let m = 0.5 * (a + b);
         let l = gl5(c, a, m);
         let r = gl5(c, m, b);
         let sum = l + r;
         // Halving cannot get below the rounding of the sum (a piece 1e5 mm long has no
-        // digits at 1e-11 mm), nor make a non-finite length finite: either would split
-        // down to all 2^30 leaves (found by fuzz/nurbs_json).
+        // digits at 1e-11 mm), make a non-finite length finite, or converge on rounding
+        // noise (a control point at 1e121 drowns a derivative of 10 near the others):
+        // each would split down to all 2^30 leaves (found by fuzz/nurbs_json). Hence the
+        // floor, the finiteness test and a budget of splits no smooth piece comes near.
         let floor = 8.0 * f64::EPSILON * sum.abs();
-        if depth == 0 || !sum.is_finite() || (sum - whole).abs() <= tol.max(floor) {
+        *budget = budget.saturating_sub(1);
+        if depth == 0 || *budget == 0 || !sum.is_finite() || (sum - whole).abs() <= tol.max(floor) {
             sum
         } else {
-            rec(c, a, m, l, 0.5 * tol, depth - 1) + rec(c, m, b, r, 0.5 * tol, depth - 1)
+            rec(c, a, m, l, 0.5 * tol, depth - 1, budget)
+                + rec(c, m, b, r, 0.5 * tol, depth - 1, budget)
         }
     }
     if b <= a {
         return 0.0;
     }
-    rec(c, a, b, gl5(c, a, b), tol, 30)
+    let mut budget = 1 << 14;
+    rec(c, a, b, gl5(c, a, b), tol, 30, &mut budget)
 }

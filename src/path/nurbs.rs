@@ -524,9 +524,9 @@ mod tests {
         assert!(c.eval(f64::INFINITY).p[0].is_finite());
     }
 
-    /// A control point 3e19 mm out (a typo in a path file) or a length beyond f64 used to
-    /// split the length integral down to all 2^30 pieces, as rounding never let it meet
-    /// 1e-11 mm.
+    /// A control point 3e19 mm out (a typo in a path file), a length beyond f64, or one
+    /// whose rounding noise swamps the derivative used to split the length integral down
+    /// to all 2^30 pieces, never meeting 1e-11 mm.
     #[test]
     fn length_of_a_huge_or_overflowing_curve_returns() {
         let far = Nurbs::<3>::new(
@@ -551,5 +551,21 @@ mod tests {
         )
         .unwrap();
         assert_eq!(overflowing.length(), f64::INFINITY);
+        // A control point at 3e121 drowns the derivative near the others in rounding
+        // noise: the length is rough, but it comes back.
+        let noisy = Nurbs::<2>::new(
+            3,
+            vec![0.0, 0.0, 0.0, 0.0, 0.5, 1.0, 1.0, 1.0, 1.0],
+            vec![
+                [1.0, 0.0],
+                [10.0, 5.0],
+                [40.0, 1.0],
+                [3.07e121, 5.0],
+                [40.0, 0.0],
+            ],
+            Some(vec![1.0, 1.0, 2.0, 1.0, 1.0]),
+        )
+        .unwrap();
+        assert!(noisy.length() > 1e120, "{}", noisy.length());
     }
 }
