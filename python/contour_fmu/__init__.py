@@ -13,6 +13,9 @@ without fmpy):
 - container_build: a loop packed into one FMU with fmpy's container;
 - cosim_closed_loop, ecos_closed_loop: a loop in libcosim and in ecos (run as
   python -m contour_fmu.cosim_closed_loop / .ecos_closed_loop [--loop five_axis]);
+- campaign: many closed-loop runs (swept plant parameters, feeds, paths, variants) on
+  Dask, one Parquet row each, with a summary and plots
+  (python -m contour_fmu.campaign run FILE --out DIR);
 - repo: where the checkout, its FMUs and ccc-tune are.
 """
 

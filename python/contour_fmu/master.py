@@ -26,6 +26,30 @@ from .wiring import (CLOSED_LOOP_CONNECTIONS, FIVE_AXIS_CONNECTIONS, FIVE_AXIS_P
 SCHEMES = ("gauss-seidel", "jacobi")
 
 
+def set_value(slave, variable, value):
+    """Sets one variable (an fmpy model variable) of an FMU2Slave, by its type."""
+    vr = [variable.valueReference]
+    if variable.type == "Real":
+        slave.setReal(vr, [float(value)])
+    elif variable.type in ("Integer", "Enumeration"):
+        slave.setInteger(vr, [int(value)])
+    elif variable.type == "Boolean":
+        slave.setBoolean(vr, [bool(value)])
+    else:
+        slave.setString(vr, [str(value)])
+
+
+def free_all(slaves):
+    """Terminates (when it can) and frees every FMU2Slave: a failed run still frees its
+    instances."""
+    for slave in slaves:
+        try:
+            slave.terminate()
+        except Exception:  # noqa: BLE001  an instance in an error state may refuse to terminate
+            pass
+        slave.freeInstance()
+
+
 @dataclass
 class Unit:
     name: str
@@ -67,26 +91,12 @@ class Master:
         return self
 
     def __exit__(self, *exc):
-        for slave in self.slaves.values():
-            try:
-                slave.terminate()
-            except Exception:  # noqa: BLE001  a failed run still frees its instances
-                pass
-            slave.freeInstance()
+        free_all(self.slaves.values())
         for d in self._dirs:
             shutil.rmtree(d, ignore_errors=True)
 
     def set(self, unit, name, value):
-        slave, v = self.slaves[unit], self.variables[unit][name]
-        vr = [v.valueReference]
-        if v.type == "Real":
-            slave.setReal(vr, [float(value)])
-        elif v.type in ("Integer", "Enumeration"):
-            slave.setInteger(vr, [int(value)])
-        elif v.type == "Boolean":
-            slave.setBoolean(vr, [bool(value)])
-        else:
-            slave.setString(vr, [str(value)])
+        set_value(self.slaves[unit], self.variables[unit][name], value)
 
     def get(self, unit, name):
         slave, v = self.slaves[unit], self.variables[unit][name]

@@ -1,0 +1,256 @@
+"""Runs on a worker: a batch of a campaign's runs through one set of FMU instances.
+
+A worker receives the FMU archives as bytes (scattered to it once) and parameter sets,
+never fmpy objects. It extracts each archive once per process, instantiates the loop's
+three FMUs once per batch and resets them between runs (fmi2Reset), as fmpy advises for
+loops of simulations. A run that fails (an FMU returns fmi2Error, the path never ends)
+becomes a row with status "error" and the FMU's own log message; the instances are then
+made anew, so the next run starts clean.
+
+The stepping is the Gauss-Seidel scheme of contour_fmu.master (controller, plant,
+interpolator; each input refreshed from its source just before its FMU steps), written
+with the value references resolved once: a campaign run gives exactly what
+master.closed_loop gives for the same start values.
+"""
+
+import atexit
+import os
+import shutil
+import socket
+import tempfile
+import time
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..loops import LOOPS
+from ..master import free_all, set_value
+from . import metrics as campaign_metrics
+
+ORDER = ("controller", "plant", "interpolator")
+FMI_ERROR = 3  # fmi2Error; the logger's status of a refused call
+
+
+@dataclass(frozen=True)
+class Job:
+    """What every run of a campaign shares; small and picklable."""
+    loop: str
+    step: float
+    stop: float | None  # None: at the end of the path, then `settle`
+    settle: float
+    max_stop: float
+    metrics: tuple
+    fmus: dict  # unit -> SHA-256 of its archive (the key of the extraction cache)
+    interpolator_variables: dict  # name -> spec.Variable, for the metrics' defaults
+
+
+class RunFailed(RuntimeError):
+    """A run that cannot finish; its message goes into the row."""
+
+
+_extracted = {}  # SHA-256 -> unzip directory, for this process's lifetime
+
+
+def _scratch():
+    """Where this process unpacks FMUs: the Dask worker's own folder (removed with the
+    worker), else a temporary folder removed at exit."""
+    try:
+        from distributed import get_worker
+
+        return Path(get_worker().local_directory)
+    except (ImportError, ValueError):
+        directory = tempfile.mkdtemp(prefix="contour-fmu-campaign-")
+        atexit.register(shutil.rmtree, directory, ignore_errors=True)
+        return Path(directory)
+
+
+def extracted(sha256, archive):
+    """The unzip directory of an FMU archive (bytes), extracted once per process."""
+    if sha256 not in _extracted:
+        import io
+
+        directory = Path(tempfile.mkdtemp(prefix=f"fmu-{sha256[:12]}-", dir=_scratch()))
+        with zipfile.ZipFile(io.BytesIO(archive)) as z:
+            z.extractall(directory)
+        _extracted[sha256] = directory
+    return _extracted[sha256]
+
+
+class _Log:
+    """The FMUs' log messages of the current run (fmpy's logger callback)."""
+
+    def __init__(self):
+        from ctypes import byref
+
+        from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                               fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, calloc, free)
+        from fmpy.logging import addLoggerProxy
+
+        self.errors = []
+
+        def log(_env, name, status, _category, message):
+            if status >= FMI_ERROR:
+                self.errors.append(f"{name.decode(errors='replace')}: {message.decode(errors='replace')}")
+
+        self.callbacks = fmi2CallbackFunctions()
+        self.callbacks.logger = fmi2CallbackLoggerTYPE(log)
+        self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        addLoggerProxy(byref(self.callbacks))
+
+
+class LoopInstances:
+    """The loop's three FMUs, instantiated once; `run` resets them between runs."""
+
+    def __init__(self, loop, directories):
+        """directories: unit -> unzip directory."""
+        from fmpy import read_model_description
+        from fmpy.fmi2 import FMU2Slave
+
+        self.loop = LOOPS[loop]
+        self.log = _Log()
+        self.slaves, self.variables = {}, {}
+        try:
+            for unit in ORDER:
+                md = read_model_description(str(directories[unit]))
+                self.variables[unit] = {v.name: v for v in md.modelVariables}
+                slave = FMU2Slave(guid=md.guid, unzipDirectory=str(directories[unit]),
+                                  modelIdentifier=md.coSimulation.modelIdentifier, instanceName=unit)
+                slave.instantiate(callbacks=self.log.callbacks)
+                self.slaves[unit] = slave
+        except BaseException:
+            self.free()
+            raise
+        vr = lambda unit, name: self.variables[unit][name].valueReference  # noqa: E731
+        # Inputs of each unit, grouped by source: (source slave, its vrs, our vrs).
+        self.links = {unit: [] for unit in ORDER}
+        for src in ORDER:
+            for dst in ORDER:
+                pairs = [(vr(s, o), vr(d, i)) for s, o, d, i in self.loop.connections if s == src and d == dst]
+                if pairs:
+                    self.links[dst].append((self.slaves[src], *map(list, zip(*pairs))))
+        self.path_start = [(self.slaves[s], vr(s, o), self.slaves[d], vr(d, i))
+                           for s, o, d, i in self.loop.path_start]
+        # Recorded at t_k before the step: the reference and the plant's position; after
+        # it, the controller's outputs (its command and estimates for the sample at t_k).
+        self.before, self.before_vrs = self._grouped([c for c in self.loop.recorded if c[0] != "controller"])
+        self.after, self.after_vrs = self._grouped([c for c in self.loop.recorded if c[0] == "controller"])
+        self.done_vr = [vr("interpolator", "done")]
+        self.fresh = True
+
+    def _grouped(self, columns):
+        """(columns in reading order, [(slave, its vrs)]): one getReal per unit."""
+        ordered, reads = [], []
+        for unit in ORDER:
+            names = [n for u, n in columns if u == unit]
+            if names:
+                ordered += [(unit, n) for n in names]
+                reads.append((self.slaves[unit], [self.variables[unit][n].valueReference for n in names]))
+        return ordered, reads
+
+    def free(self):
+        free_all(self.slaves.values())
+        self.slaves = {}
+
+    def run(self, job, start_values):
+        """One run from t = 0: returns its trace, {"time": ..., "unit.variable": ...} of
+        the loop's recorded outputs, one value per step."""
+        self.log.errors.clear()
+        if not self.fresh:
+            for slave in self.slaves.values():
+                slave.reset()
+        self.fresh = False
+        for unit in ORDER:
+            slave = self.slaves[unit]
+            if job.stop is None:
+                slave.setupExperiment(startTime=0.0)
+            else:
+                slave.setupExperiment(startTime=0.0, stopTime=job.stop)
+            slave.enterInitializationMode()
+            for name, value in start_values.get(unit, {}).items():
+                set_value(slave, self.variables[unit][name], value)
+        for src, out, dst, inp in self.path_start:
+            dst.setReal([inp], src.getReal([out]))
+        for unit in ORDER:
+            self.slaves[unit].exitInitializationMode()
+
+        step = job.step
+        if job.stop is None:
+            limit, steps = int(round(job.max_stop / step)), None
+        else:
+            limit = steps = int(round(job.stop / step))
+        settle = int(round(job.settle / step))
+        interpolator = self.slaves["interpolator"]
+        stepped = [(self.slaves[unit], self.links[unit]) for unit in ORDER]
+        before, after = [], []
+        k = 0
+        while k < (limit if steps is None else steps):
+            if steps is None and interpolator.getBoolean(self.done_vr)[0]:
+                steps = k + settle
+                continue
+            t = k * step
+            row = []
+            for slave, vrs in self.before_vrs:
+                row.extend(slave.getReal(vrs))
+            before.append(row)
+            for slave, links in stepped:
+                for source, source_vrs, vrs in links:
+                    slave.setReal(vrs, source.getReal(source_vrs))
+                slave.doStep(currentCommunicationPoint=t, communicationStepSize=step)
+            row = []
+            for slave, vrs in self.after_vrs:
+                row.extend(slave.getReal(vrs))
+            after.append(row)
+            k += 1
+        if steps is None:
+            raise RunFailed(f"the path did not end within max_stop = {job.max_stop!r} s")
+        trace = {"time": np.arange(k) * step}
+        for columns, values in ((self.before, before), (self.after, after)):
+            table = np.array(values, dtype=float).reshape(k, len(columns))
+            for i, (unit, name) in enumerate(columns):
+                trace[f"{unit}.{name}"] = table[:, i]
+        return trace
+
+
+def worker_name():
+    return f"{socket.gethostname()}:{os.getpid()}"
+
+
+def run_one(job, instances, start_values):
+    """(metrics, trace) of one run."""
+    trace = instances.run(job, start_values)
+    values = campaign_metrics.compute(job.loop, job.metrics, trace,
+                                      start_values.get("interpolator", {}), job.interpolator_variables)
+    return values, trace
+
+
+def run_batch(job, archives, runs):
+    """Rows of a batch of runs [(run id, start values)], in order: run_id, status ("ok"
+    or "error"), message, wall_time_s, worker and each metric (NaN unless ok)."""
+    directories = {unit: extracted(job.fmus[unit], archives[unit]) for unit in ORDER}
+    rows, instances = [], None
+    try:
+        for run_id, start_values in runs:
+            began = time.perf_counter()
+            row = {"run_id": run_id, "status": "ok", "message": "", "worker": worker_name()}
+            try:
+                if instances is None:
+                    instances = LoopInstances(job.loop, directories)
+                values, _ = run_one(job, instances, start_values)
+                row.update(values)
+            except Exception as e:  # noqa: BLE001  every failure of a run is its row's message
+                logged = instances.log.errors if instances is not None else []
+                row.update({m: float("nan") for m in job.metrics})
+                row["status"] = "error"
+                row["message"] = "; ".join([*logged[-3:], f"{type(e).__name__}: {e}"])
+                if instances is not None:
+                    instances.free()
+                    instances = None
+            row["wall_time_s"] = time.perf_counter() - began
+            rows.append(row)
+    finally:
+        if instances is not None:
+            instances.free()
+    return rows

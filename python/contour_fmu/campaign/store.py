@@ -1,0 +1,110 @@
+"""A campaign's result rows on disk, written as they arrive.
+
+OUT/rows/ holds one Parquet file per finished batch, each written under a temporary name
+and renamed, so a campaign killed at any moment leaves only whole files: nothing written
+is lost, and --resume reads them back. A run may appear in several files (a lost batch
+rerun by --resume); its newest row counts. OUT/campaign.json records the campaign's
+digest: --resume refuses an output folder of another campaign, or of other FMUs.
+At the end OUT/results.parquet holds every run's row, sorted by run id.
+"""
+
+import json
+import os
+from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+# A row's outcome. ok and error are final (an FMU error repeats when rerun); lost (the
+# batch died with its worker twice) and failed (the batch raised outside any run, twice)
+# are run again by --resume.
+FINAL = ("ok", "error")
+STATUSES = ("ok", "error", "lost", "failed")
+
+_ARROW_TYPES = {"Real": pa.float64(), "Integer": pa.int64(), "Enumeration": pa.int64(),
+                "Boolean": pa.bool_(), "String": pa.string()}
+
+
+class OutputInUse(RuntimeError):
+    """OUT holds results that this campaign must not overwrite or append to."""
+
+
+def schema(campaign):
+    fields = [("run_id", pa.int64()), ("variant", pa.string()), ("path", pa.string())]
+    for name in campaign.swept:
+        unit, variable = name.split(".", 1)
+        fields.append((name, _ARROW_TYPES[campaign.units[unit].variables[variable].type]))
+    fields += [(m, pa.float64()) for m in campaign.metrics]
+    fields += [("status", pa.string()), ("message", pa.string()), ("attempts", pa.int64()),
+               ("wall_time_s", pa.float64()), ("worker", pa.string())]
+    return pa.schema(fields)
+
+
+class ResultStore:
+    def __init__(self, out, campaign, resume=False):
+        self.out, self.campaign = Path(out), campaign
+        self.rows_dir = self.out / "rows"
+        self.schema = schema(campaign)
+        marker = self.out / "campaign.json"
+        existing = sorted(self.rows_dir.glob("part-*.parquet")) if self.rows_dir.is_dir() else []
+        if marker.is_file() or existing:
+            if not resume:
+                raise OutputInUse(f"{self.out} already holds campaign results: add --resume to "
+                                  "finish that campaign, or choose another --out")
+            recorded = json.loads(marker.read_text()) if marker.is_file() else {}
+            if recorded.get("digest") != campaign.digest:
+                raise OutputInUse(
+                    f"{self.out} holds results of another campaign (its file, its FMUs or its "
+                    f"runs differ: digest {recorded.get('digest', '?')[:12]}, this one "
+                    f"{campaign.digest[:12]}); choose another --out")
+        self.marker = marker
+        self.next_part = 1 + max((int(p.stem.split("-")[1]) for p in existing), default=-1)
+
+    def write(self, rows):
+        """Adds rows (dicts with every schema column but the run's own); durable on return.
+        The first write creates the folder (nothing is written before a run finishes)."""
+        if not self.marker.is_file():
+            self.rows_dir.mkdir(parents=True, exist_ok=True)
+            self.marker.write_text(json.dumps(
+                {"name": self.campaign.name, "source": str(self.campaign.source),
+                 "digest": self.campaign.digest, "runs": len(self.campaign.runs)}, indent=1) + "\n")
+        runs = self.campaign.runs
+        complete = []
+        for row in rows:
+            run = runs[row["run_id"]]
+            complete.append({**row, "variant": run.variant, "path": run.path, **run.swept})
+        table = pa.Table.from_pylist(complete, schema=self.schema)
+        target = self.rows_dir / f"part-{self.next_part:06d}.parquet"
+        temporary = target.with_suffix(".tmp")
+        pq.write_table(table, temporary)
+        with open(temporary, "rb") as f:
+            os.fsync(f.fileno())
+        os.replace(temporary, target)
+        self.next_part += 1
+
+    def table(self):
+        """Every run's newest row, sorted by run id (a pyarrow Table)."""
+        parts = sorted(self.rows_dir.glob("part-*.parquet")) if self.rows_dir.is_dir() else []
+        if not parts:
+            return self.schema.empty_table()
+        table = pa.concat_tables([pq.read_table(p, schema=self.schema) for p in parts])
+        newest = {}
+        for i, run_id in enumerate(table.column("run_id").to_pylist()):
+            newest[run_id] = i
+        order = [newest[r] for r in sorted(newest)]
+        return table.take(order)
+
+    def finished(self):
+        """Run ids whose newest row is final (ok or error)."""
+        table = self.table()
+        return {r for r, s in zip(table.column("run_id").to_pylist(),
+                                  table.column("status").to_pylist()) if s in FINAL}
+
+    def consolidate(self):
+        """Writes OUT/results.parquet; returns the table."""
+        table = self.table()
+        self.out.mkdir(parents=True, exist_ok=True)
+        temporary = self.out / "results.parquet.tmp"
+        pq.write_table(table, temporary)
+        os.replace(temporary, self.out / "results.parquet")
+        return table
