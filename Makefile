@@ -130,6 +130,7 @@ bench: fmus ccc-tune $(VENV)/.test-installed
 	-$(PYTHON) benches/tuning_vs_pyswarms_fmu.py --particles 6 --iters 5 \
 		--json $(BENCH_REPORT)/tuning_vs_pyswarms_fmu.json
 	-$(PYTHON) benches/pso_tables.py --json $(BENCH_REPORT)/pso_tables.json
+	-$(PYTHON) benches/campaign_scaling.py --json $(BENCH_REPORT)/campaign_scaling.json
 	$(PYTHON) benches/report.py
 
 # Every model's life cycle 10 000 times under valgrind's leak checker (hours on 2 cores).

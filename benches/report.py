@@ -2,7 +2,8 @@
 
 Reads what the bench parts leave in <target>/bench-report/ (<target> is $CARGO_TARGET_DIR,
 else target/): fmu_abi.json (benches/fmu_abi.rs), fuzzy_vs_skfuzzy.json,
-tuning_vs_pyswarms_fmu.json and pso_tables.json (the Python benches' --json), plus
+tuning_vs_pyswarms_fmu.json, pso_tables.json and campaign_scaling.json (the Python
+benches' --json), plus
 criterion's own estimates in <target>/criterion/. Prints the page and writes it to
 <target>/bench-report/report.md. A figure that is missing, or older than the run's start
 (a leftover of an earlier run), is shown as "not measured".
@@ -98,6 +99,7 @@ def page():
     fuzzy = load("fuzzy_vs_skfuzzy.json")
     tuning = load("tuning_vs_pyswarms_fmu.json")
     pso = load("pso_tables.json")
+    campaign = load("campaign_scaling.json")
     med = lambda name: dig(abi, "median_s_per_sample", name)  # noqa: E731
 
     now = datetime.datetime.now(datetime.timezone.utc)
@@ -144,6 +146,16 @@ def page():
     lines.append(line("through the C ABI (fmu_abi)", *paired("path_100k_over_1k"), "{:.3f}"))
     p100k, p1k = criterion("five_axis/path_100k"), criterion("five_axis/path_1k")
     lines.append(line("in process (five_axis, criterion medians)", ratio(p100k, p1k), f"{seconds(p100k)} vs {seconds(p1k)}", "{:.3f}"))
+
+    lines.append("\nCampaigns on a Dask LocalCluster (two-axis circle runs, medians of paired rounds)")
+    one, two = dig(campaign, "one_worker_runs_per_s"), dig(campaign, "two_workers_runs_per_s")
+    lines.append(line("runs/s, 2 workers / 1 worker", dig(campaign, "scaling_two_over_one"),
+                      f"{two:.3g} vs {one:.3g} runs/s" if one and two else ""))
+    overhead, plain = dig(campaign, "overhead_per_run_s"), dig(campaign, "plain_runs_per_s")
+    lines.append(line("time per run, 1 worker / plain Python loop",
+                      None if dig(campaign, "overhead_fraction") is None else 1 + campaign["overhead_fraction"],
+                      f"{seconds(overhead)} more per run; plain loop {plain:.3g} runs/s" if overhead and plain else "",
+                      "{:.3f}"))
 
     small = [("fuzzy eval", criterion("fuzzy_evaluate_three_outputs")),
              ("2-axis sample", criterion("controller_sample_fuzzy")),

@@ -8,7 +8,7 @@ from pathlib import Path
 from . import report
 from .execute import SchedulerUnreachable, archives_of, execute, job_of
 from .metrics import errors
-from .runner import ORDER, LoopInstances, extracted, run_one
+from .runner import LoopInstances, run_one, unpacked
 from .spec import CampaignError, load
 from .store import OutputInUse
 
@@ -67,9 +67,8 @@ def command_replay(args):
 
     campaign = load(args.file, args.fmu_dir)
     run = campaign.run(args.run)
-    job, archives = job_of(campaign), archives_of(campaign)
-    directories = {unit: extracted(job.fmus[unit], archives[unit]) for unit in ORDER}
-    instances = LoopInstances(job.loop, directories)
+    job = job_of(campaign)
+    instances = LoopInstances(job.loop, unpacked(job, archives_of(campaign)))
     try:
         values, trace = run_one(job, instances, run.start_values)
     finally:

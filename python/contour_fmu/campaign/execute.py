@@ -1,8 +1,9 @@
 """Running a campaign's batches: on Dask (a LocalCluster of this machine, or a scheduler
 given by address) or serially in this process, writing each batch's rows as it finishes.
 
-Every batch is a task of plain data: the Job, the FMU archives (bytes, scattered to every
-worker once) and the runs' start values. A batch lost with its worker, or raising
+Every batch is a task of plain data: the Job and the runs' start values. The FMU archives
+go to each worker once, as bytes in a worker plugin that Dask also runs on a worker that
+joins or restarts later (scattered data would die with the workers holding it). A batch lost with its worker, or raising
 outside any run, is submitted once more; if that attempt is lost too, its runs are
 recorded as "lost" (or "failed") with the reason, never dropped. Our LocalCluster's
 scheduler is told not to retry by itself (allowed-failures = 0), so "once more" means
@@ -12,8 +13,13 @@ once; a remote scheduler applies its own allowed-failures before reporting a los
 import contextlib
 import time
 
-from .runner import Job, run_batch
+from .runner import Job, extracted, run_batch
 from .store import ResultStore
+
+try:
+    from distributed.diagnostics.plugin import WorkerPlugin
+except ImportError:  # serial runs do not need distributed
+    WorkerPlugin = object
 
 CONNECT_TIMEOUT = "10s"
 
@@ -39,6 +45,18 @@ def batches(runs, size):
     return [pairs[i:i + size] for i in range(0, len(pairs), size)]
 
 
+class FmuArchives(WorkerPlugin):
+    """Extracts a campaign's FMU archives on each worker as it starts."""
+
+    def __init__(self, job, archives):
+        self.name = f"contour-fmu-archives-{'-'.join(sorted(job.fmus.values()))[:64]}"
+        self.archives = {job.fmus[unit]: data for unit, data in archives.items()}
+
+    def setup(self, worker):
+        for sha256, data in self.archives.items():
+            extracted(sha256, data)
+
+
 @contextlib.contextmanager
 def dask_client(scheduler=None, workers=None):
     """A distributed Client: to `scheduler` (an address), else to a new LocalCluster of
@@ -55,9 +73,15 @@ def dask_client(scheduler=None, workers=None):
         with client:
             yield client
         return
-    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+    # allowed-failures 0: we resubmit a lost batch ourselves, once. worker-saturation 1: a
+    # worker holds only the batch it runs, so its death loses that batch alone (and long
+    # batches are not queued behind each other while another worker idles). No worker
+    # profiler: its 10 ms stack sampling takes the GIL from the stepping loop.
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0,
+                          "distributed.scheduler.worker-saturation": 1.0,
+                          "distributed.worker.profile.enabled": False}):
         with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                          dashboard_address=None) as cluster, Client(cluster) as client:
+                          dashboard_address=":0") as cluster, Client(cluster) as client:
             yield client
 
 
@@ -76,7 +100,7 @@ def run_serial(campaign, store, progress=None, batch_fn=run_batch):
     """Every pending batch in this process, in order."""
     job, archives = job_of(campaign), archives_of(campaign)
     for batch in batches(pending_runs(campaign, store), campaign.batch_size):
-        rows = batch_fn(job, archives, batch)
+        rows = batch_fn(job, batch, archives)
         store.write([{**row, "attempts": 1} for row in rows])
         if progress is not None:
             progress.update(len(rows))
@@ -88,12 +112,12 @@ def run_on_dask(campaign, store, client, progress=None, batch_fn=run_batch):
     from distributed.scheduler import KilledWorker
 
     job = job_of(campaign)
-    archives = client.scatter(archives_of(campaign), broadcast=True)
+    client.register_plugin(FmuArchives(job, archives_of(campaign)))
     tag = f"{campaign.digest[:8]}-{time.time_ns()}"
     submitted = {}
 
     def submit(batch, attempt):
-        future = client.submit(batch_fn, job, archives, batch, pure=False,
+        future = client.submit(batch_fn, job, batch, pure=False,
                                key=f"campaign-{tag}-run{batch[0][0]}-attempt{attempt}")
         submitted[future.key] = (batch, attempt)
         return future

@@ -116,6 +116,14 @@ def summary(campaign, table, out):
     return "\n".join(lines)
 
 
+def _log_if_wide(ax, data):
+    """A log scale when the values span more than 20× (with and without CCC differ by
+    orders of magnitude)."""
+    positive = np.concatenate([d[d > 0] for d in data] + [np.empty(0)])
+    if len(positive) and positive.max() > 20 * positive.min():
+        ax.set_yscale("log")
+
+
 def plot(campaign, table, out):
     """OUT/distribution.png and, with swept parameters, OUT/sensitivity.png."""
     import matplotlib
@@ -133,9 +141,7 @@ def plot(campaign, table, out):
         factor, unit = _scaled(m)
         data = [np.asarray([c[m][i] for i in rows], float) * factor for rows in groups.values()]
         ax.boxplot(data, tick_labels=labels)
-        positive = np.concatenate([d[d > 0] for d in data] + [np.empty(0)])
-        if len(positive) and positive.max() > 20 * positive.min():
-            ax.set_yscale("log")  # with and without CCC differ by orders of magnitude
+        _log_if_wide(ax, data)
         ax.set_ylabel(f"{m} ({unit})"), ax.set_title(m)
         ax.tick_params(axis="x", labelsize=7)
     fig.suptitle(f"{campaign.name}: distribution per variant and path")
@@ -151,9 +157,11 @@ def plot(campaign, table, out):
     rows_ = -(-n // cols)
     fig, axes = plt.subplots(rows_, cols, figsize=(4.8 * cols, 3.8 * rows_), squeeze=False)
     for ax, name in zip(axes.flat, campaign.swept):
+        data = []
         for (variant, path), rows in groups.items():
-            ax.plot([c[name][i] for i in rows], [c[first][i] * factor for i in rows], ".",
-                    ms=4, label=f"{variant} / {path}")
+            data.append(np.asarray([c[first][i] * factor for i in rows], float))
+            ax.plot([c[name][i] for i in rows], data[-1], ".", ms=4, label=f"{variant} / {path}")
+        _log_if_wide(ax, data)
         ax.set_xlabel(name), ax.set_ylabel(f"{first} ({unit})")
     for ax in list(axes.flat)[n:]:
         ax.axis("off")

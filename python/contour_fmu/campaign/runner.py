@@ -1,7 +1,8 @@
 """Runs on a worker: a batch of a campaign's runs through one set of FMU instances.
 
-A worker receives the FMU archives as bytes (scattered to it once) and parameter sets,
-never fmpy objects. It extracts each archive once per process, instantiates the loop's
+A worker receives the FMU archives as bytes once, through a worker plugin (which Dask
+also gives a worker that joins or restarts later), and then parameter sets only, never
+fmpy objects. It extracts each archive once per process, instantiates the loop's
 three FMUs once per batch and resets them between runs (fmi2Reset), as fmpy advises for
 loops of simulations. A run that fails (an FMU returns fmi2Error, the path never ends)
 becomes a row with status "error" and the FMU's own log message; the instances are then
@@ -226,10 +227,23 @@ def run_one(job, instances, start_values):
     return values, trace
 
 
-def run_batch(job, archives, runs):
+def unpacked(job, archives=None):
+    """unit -> unzip directory of the job's FMUs: extracted from `archives` (unit ->
+    bytes) if not yet, else from this process's cache (filled by the worker plugin)."""
+    if archives is not None:
+        return {unit: extracted(job.fmus[unit], archives[unit]) for unit in ORDER}
+    missing = [unit for unit in ORDER if job.fmus[unit] not in _extracted]
+    if missing:
+        raise RunFailed(f"{worker_name()} has no copy of the {', '.join(missing)} FMU "
+                        "(the campaign's worker plugin did not run here)")
+    return {unit: _extracted[job.fmus[unit]] for unit in ORDER}
+
+
+def run_batch(job, runs, archives=None):
     """Rows of a batch of runs [(run id, start values)], in order: run_id, status ("ok"
-    or "error"), message, wall_time_s, worker and each metric (NaN unless ok)."""
-    directories = {unit: extracted(job.fmus[unit], archives[unit]) for unit in ORDER}
+    or "error"), message, wall_time_s, worker and each metric (NaN unless ok). The FMUs
+    come from `archives` (unit -> bytes) or, on a Dask worker, from the plugin."""
+    directories = unpacked(job, archives)
     rows, instances = [], None
     try:
         for run_id, start_values in runs:
