@@ -226,6 +226,32 @@ def test_the_summary_lists_the_worst_runs_with_their_replay_command(sixteen, ser
     assert "| no CCC | trident | 4/4 |" in text
 
 
+def test_a_run_the_fmu_refuses_is_an_error_row_and_the_batch_goes_on(tmp_path, fmus):
+    """A path file that does not exist passes the campaign's checks (the FMU resolves
+    paths) but not the FMU: those runs are rows with status error and the FMU's message;
+    the runs after them in the same batch, on new instances, are untouched."""
+    text = SIXTEEN.replace('path = "trident"', 'path = "missing.json"').replace(
+        '"contour_error.max", "contour_error.mean", ', "").replace("batch_size = 2", "batch_size = 16")
+    table = execute(load(write_campaign(tmp_path, fmus, text)), tmp_path / "out", serial=True,
+                    show_progress=False).consolidate().to_pydict()
+    good = execute(load(write_campaign(tmp_path, fmus, SIXTEEN.replace("batch_size = 2", "batch_size = 16"),
+                                       "good.toml")), tmp_path / "good", serial=True,
+                   show_progress=False).consolidate().to_pydict()
+    for i in range(16):
+        if table["path"][i] == "missing.json":
+            assert table["status"][i] == "error"
+            assert "missing.json" in table["message"][i] and "fmi2" in table["message"][i]
+            assert math.isnan(table["estimated_contour_error.max"][i])
+        else:
+            assert table["status"][i] == "ok"
+            assert table["estimated_contour_error.max"][i] == good["estimated_contour_error.max"][i]
+
+
+def test_replay_of_a_run_that_does_not_exist_is_refused(sixteen):
+    done = run_cli("replay", str(sixteen.source), "--run", "16")
+    assert done.returncode == 2 and "no run 16 (runs 0 to 15)" in done.stderr
+
+
 # --- the Latin hypercube ----------------------------------------------------------------
 
 LHS = """
@@ -303,6 +329,14 @@ BAD = [
     ("a step beyond the stop", lambda t: t.replace("stop = 0.4", "stop = 0.0001"),
      r"stop = 0\.0001 is shorter than one step"),
     ("not TOML", lambda t: t + "\n[[[", r"not a TOML file"),
+    ("NaN", lambda t: t.replace("feed = 50.0", "feed = nan"), r"feed = nan: not a finite number"),
+    ("below the model description's minimum", lambda t: t.replace('[[variants]]\nname = "fuzzy-PID CCC"',
+                                                                   '[[variants]]\nname = "fuzzy-PID CCC"\n'
+                                                                   'parameters = {{ "plant.x.J" = -0.015 }}'),
+     r"plant\.x\.J = -0\.015: below the variable's minimum 0\.0"),
+    ("a factor range beyond the minimum", lambda t: t.replace('method = "grid"', 'method = "latin_hypercube"\nsamples = 4')
+     .replace("factors = [0.8, 1.2]", "factor_range = [-1.0, 1.2]").replace('"plant.y.Kvp" = {{ factors = [0.9, 1.1] }}', ''),
+     r"factor_range = -0\.015: below the variable's minimum"),
 ]
 
 

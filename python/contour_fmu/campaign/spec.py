@@ -72,6 +72,8 @@ class Variable:
     type: str  # Real, Integer, Boolean, String, Enumeration
     causality: str
     start: object  # the model description's start value, converted, or None
+    min: float | None = None  # the model description's bounds (numbers only)
+    max: float | None = None
 
 
 @dataclass(frozen=True)
@@ -261,7 +263,8 @@ class _Reader:
             if md.coSimulation is None or md.modelName != expected:
                 self.fail(f"{path} is {md.modelName!r}, not the {unit} of the {self.loop} "
                           f"loop ({expected}, FMI 2.0 Co-Simulation)")
-            variables = {v.name: Variable(v.type, v.causality, _start(v)) for v in md.modelVariables}
+            variables = {v.name: Variable(v.type, v.causality, _start(v), _bound(v.min), _bound(v.max))
+                         for v in md.modelVariables}
             units[unit] = Unit(unit, path.resolve(), _sha256(path), variables)
         return units
 
@@ -282,21 +285,29 @@ class _Reader:
 
     def value(self, variable, value, where):
         """`value` checked against the variable's type (TOML types: numbers for Real and
-        Integer, true/false for Boolean, strings for String)."""
+        Integer, true/false for Boolean, strings for String) and its bounds in the model
+        description."""
         kind = variable.type
         if kind == "Real" and isinstance(value, (int, float)) and not isinstance(value, bool):
             if not math.isfinite(value):
                 self.fail(f"{where} = {value!r}: not a finite number")
-            return float(value)
+            return self.bounded(variable, float(value), where)
         if kind in ("Integer", "Enumeration") and isinstance(value, int) and not isinstance(value, bool):
             if not -2**31 <= value < 2**31:
                 self.fail(f"{where} = {value!r}: outside the 32-bit range of an FMI Integer")
-            return value
+            return self.bounded(variable, value, where)
         if kind == "Boolean" and isinstance(value, bool):
             return value
         if kind == "String" and isinstance(value, str):
             return value
         self.fail(f"{where} = {value!r}: expected a {kind} value")
+
+    def bounded(self, variable, value, where):
+        if variable.min is not None and value < variable.min:
+            self.fail(f"{where} = {value!r}: below the variable's minimum {variable.min!r}")
+        if variable.max is not None and value > variable.max:
+            self.fail(f"{where} = {value!r}: above the variable's maximum {variable.max!r}")
+        return value
 
     def assignments(self, table, where):
         result = {}
@@ -442,6 +453,8 @@ class _Reader:
                 lo, hi = sorted((lo * base, hi * base))
             if not lo < hi:
                 self.fail(f"{where}: empty range [{lo!r}, {hi!r}]")
+            self.bounded(variable, lo, f"{where} {kind}")
+            self.bounded(variable, hi, f"{where} {kind}")
             names.append((unit, name))
             bounds.append((lo, hi))
         unit_cube = qmc.LatinHypercube(d=len(names), rng=seed).random(samples)
@@ -463,6 +476,10 @@ def _start(variable):
     if variable.type == "Boolean":
         return start in (True, "true", "1", 1)
     return start
+
+
+def _bound(text):
+    return None if text is None else float(text)
 
 
 def _sha256(path):
