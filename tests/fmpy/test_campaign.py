@@ -29,14 +29,15 @@ cloudpickle.register_pickle_by_value(campaign_faults)
 
 CIRCLE_FEED = 10 * math.pi
 
-# 2 variants × 2 paths × 2 × 2 grid points = 16 runs, 0.4 s each, 2 runs per batch.
+# 2 variants × 2 paths × 2 × 2 grid points = 16 runs, 0.4 s each, 3 runs per batch (so a
+# batch holds runs of both variants: a reset must bring back ccc.enable's default).
 SIXTEEN = """
 name = "sixteen"
 loop = "two_axis"
 step = 0.001
 stop = 0.4
 metrics = ["contour_error.max", "contour_error.mean", "estimated_contour_error.max"]
-batch_size = 2
+batch_size = 3
 
 [fmus]
 directory = "{fmus}"
@@ -112,7 +113,8 @@ def test_serial_rows_are_the_fmpy_masters_with_fresh_instances(sixteen, serial_t
     the closed-form distance to the circle."""
     table = serial_table.to_pydict()
     assert table["status"] == ["ok"] * 16
-    for run in (sixteen.runs[1], sixteen.runs[6], sixteen.runs[11]):
+    # run 8 (CCC on) follows run 7 (CCC off) in one batch, on the same instances
+    for run in (sixteen.runs[1], sixteen.runs[6], sixteen.runs[8], sixteen.runs[11]):
         values = run.start_values
         before, after = closed_loop(fmus, stop=0.4, controller=values.get("controller"),
                                     plant=values["plant"], interpolator=values["interpolator"])
@@ -145,16 +147,16 @@ def test_a_local_cluster_gives_exactly_the_serial_rows(sixteen, serial_table, tm
 
 
 def test_a_worker_killed_mid_campaign_loses_no_row(sixteen, serial_table, tmp_path):
-    """The worker running run 5's batch dies (SIGKILL) on the first attempt; the batch
-    is run again on the restarted worker, every row arrives."""
+    """The worker running run 5's batch (runs 3-5) dies (SIGKILL) on the first attempt;
+    the batch is run again, every row arrives."""
     fault = campaign_faults.KillWorker(run_id=5, marker_dir=tmp_path)
     table = execute(sixteen, tmp_path / "out", workers=2, show_progress=False,
                     batch_fn=fault).consolidate()
     assert (tmp_path / "killed-5").exists()
     assert rows(table) == rows(serial_table)
-    # run 5's batch (runs 4, 5) ran twice; so did any batch queued on that worker
+    # only run 5's batch ran twice: the client keeps no batch queued behind another
     attempts = table.column("attempts").to_pylist()
-    assert {4, 5} <= {i for i, a in enumerate(attempts) if a == 2} and set(attempts) == {1, 2}
+    assert [i for i, a in enumerate(attempts) if a == 2] == [3, 4, 5]
 
 
 def test_a_batch_lost_twice_is_recorded_and_resume_runs_it_again(sixteen, serial_table, tmp_path):
@@ -164,7 +166,7 @@ def test_a_batch_lost_twice_is_recorded_and_resume_runs_it_again(sixteen, serial
     t = table.to_pydict()
     assert t["run_id"] == list(range(16))
     lost = [i for i, s in enumerate(t["status"]) if s != "ok"]
-    assert lost == [8, 9]
+    assert lost == [9, 10, 11]
     for i in lost:
         assert t["status"][i] == "lost" and t["attempts"][i] == 2
         assert "died twice" in t["message"][i] and math.isnan(t["contour_error.max"][i])
@@ -173,8 +175,8 @@ def test_a_batch_lost_twice_is_recorded_and_resume_runs_it_again(sixteen, serial
 
 
 def test_resume_after_an_interrupt_gives_the_uninterrupted_rows(sixteen, serial_table, tmp_path):
-    """Ctrl-C after 3 batches: the 6 finished rows are on disk; the command line's
-    --resume runs the other 10 only and ends with the serial rows."""
+    """Ctrl-C after 3 batches: the 9 finished rows are on disk; the command line's
+    --resume runs the other 7 only and ends with the serial rows."""
     campaign = sixteen
     with pytest.raises(KeyboardInterrupt):
         execute(campaign, tmp_path, serial=True, show_progress=False,
@@ -189,7 +191,7 @@ def test_resume_after_an_interrupt_gives_the_uninterrupted_rows(sixteen, serial_
     assert "16 of 16 runs recorded (16 ok)" in done.stdout
     table = pq.read_table(tmp_path / "results.parquet")
     assert rows(table) == rows(serial_table)
-    assert len(list((tmp_path / "rows").glob("part-*.parquet"))) == 3 + 5  # 10 runs, 2 per batch
+    assert len(list((tmp_path / "rows").glob("part-*.parquet"))) == 3 + 3  # 7 runs, 3 per batch
     for name in ("summary.md", "distribution.png", "sensitivity.png"):
         assert (tmp_path / name).stat().st_size > 0
 
@@ -231,10 +233,10 @@ def test_a_run_the_fmu_refuses_is_an_error_row_and_the_batch_goes_on(tmp_path, f
     paths) but not the FMU: those runs are rows with status error and the FMU's message;
     the runs after them in the same batch, on new instances, are untouched."""
     text = SIXTEEN.replace('path = "trident"', 'path = "missing.json"').replace(
-        '"contour_error.max", "contour_error.mean", ', "").replace("batch_size = 2", "batch_size = 16")
+        '"contour_error.max", "contour_error.mean", ', "").replace("batch_size = 3", "batch_size = 16")
     table = execute(load(write_campaign(tmp_path, fmus, text)), tmp_path / "out", serial=True,
                     show_progress=False).consolidate().to_pydict()
-    good = execute(load(write_campaign(tmp_path, fmus, SIXTEEN.replace("batch_size = 2", "batch_size = 16"),
+    good = execute(load(write_campaign(tmp_path, fmus, SIXTEEN.replace("batch_size = 3", "batch_size = 16"),
                                        "good.toml")), tmp_path / "good", serial=True,
                    show_progress=False).consolidate().to_pydict()
     for i in range(16):
@@ -250,6 +252,49 @@ def test_a_run_the_fmu_refuses_is_an_error_row_and_the_batch_goes_on(tmp_path, f
 def test_replay_of_a_run_that_does_not_exist_is_refused(sixteen):
     done = run_cli("replay", str(sixteen.source), "--run", "16")
     assert done.returncode == 2 and "no run 16 (runs 0 to 15)" in done.stderr
+
+
+FIVE_AXIS = """
+loop = "five_axis"
+stop = 0.3
+metrics = ["tip_error.max", "tip_error.mean", "orientation_error.max", "orientation_error.mean",
+           "estimated_tip_error.max"]
+batch_size = 2
+[fmus]
+directory = "{fmus}"
+[[paths]]
+path = "tilted_helix"
+feed = 50.0
+[sweep]
+method = "grid"
+[sweep.parameters]
+"controller.ccc.enable" = {{ values = [false, true] }}
+"""
+
+
+def test_five_axis_rows_are_the_fmpy_masters_and_a_boolean_sweep_is_reported(tmp_path, fmus):
+    """Run 1 (CCC on) follows run 0 (CCC off) on reset instances; both equal the master's
+    fresh runs, and the Boolean swept column reaches the rows, summary and plots."""
+    from contour_fmu.campaign import report
+    from contour_fmu.master import five_axis_closed_loop
+
+    campaign = load(write_campaign(tmp_path, fmus, FIVE_AXIS))
+    table = execute(campaign, tmp_path / "out", serial=True, show_progress=False).consolidate()
+    t = table.to_pydict()
+    assert t["controller.ccc.enable"] == [False, True] and t["status"] == ["ok", "ok"]
+    for run in campaign.runs:
+        values = run.start_values
+        before, after = five_axis_closed_loop(fmus, stop=0.3, controller=values["controller"],
+                                              interpolator=values["interpolator"])
+        trace = {name: before[name] for name in before.dtype.names}
+        trace.update({name: after[name] for name in after.dtype.names if name.startswith("controller.")})
+        expected = compute("five_axis", campaign.metrics, trace, values["interpolator"],
+                           campaign.units["interpolator"].variables)
+        assert {m: t[m][run.id] for m in campaign.metrics} == expected
+    assert t["tip_error.max"][1] < t["tip_error.max"][0]
+    text = report.write(campaign, table, tmp_path / "out")
+    assert "controller.ccc.enable = False" in text  # the worst run: without CCC
+    assert (tmp_path / "out" / "sensitivity.png").stat().st_size > 0
 
 
 # --- the Latin hypercube ----------------------------------------------------------------
@@ -321,7 +366,7 @@ BAD = [
      r"metrics: unknown 'tip_error\.max' for the two_axis loop"),
     ("a true error on a user's path", lambda t: t.replace('path = "trident"', 'path = "part.json"'),
      r"contour_error\.\* needs a built-in path"),
-    ("a typo in a key", lambda t: t.replace("batch_size = 2", "batchsize = 2"),
+    ("a typo in a key", lambda t: t.replace("batch_size = 3", "batchsize = 3"),
      r"unknown key batchsize"),
     ("a latin hypercube given a grid's levels", lambda t: t.replace('method = "grid"',
                                                                    'method = "latin_hypercube"\nsamples = 4'),
@@ -329,6 +374,16 @@ BAD = [
     ("a step beyond the stop", lambda t: t.replace("stop = 0.4", "stop = 0.0001"),
      r"stop = 0\.0001 is shorter than one step"),
     ("not TOML", lambda t: t + "\n[[[", r"not a TOML file"),
+    ("a feed of 0 in [fixed]", lambda t: t.replace("[[paths]]", '[fixed]\n"interpolator.feed" = 0.0\n\n[[paths]]', 1)
+     .replace("feed = 50.0", "").replace("feed = {circle_feed!r}", ""), r"interpolator\.feed = 0\.0: expected a feed > 0"),
+    ("the path outside [[paths]]", lambda t: t.replace("[[paths]]", '[fixed]\n"interpolator.path" = "line"\n\n[[paths]]', 1),
+     r"the path is chosen in \[\[paths\]\]"),
+    ("an enumeration value that does not exist", lambda t: t.replace("[[paths]]", '[fixed]\n"controller.estimator" = 7\n\n[[paths]]', 1),
+     r"estimator = 7: not one of the enumeration's values 1 \(free_curve\)"),
+    ("settle with a stop time", lambda t: t.replace("stop = 0.4", "stop = 0.4\nsettle = 0.1"),
+     r"settle applies to stop = \"end_of_path\""),
+    ("an FMU folder that is not a string", lambda t: t.replace('directory = "{fmus}"', "directory = 5"),
+     r"\[fmus\] directory = 5: expected a file or folder name"),
     ("NaN", lambda t: t.replace("feed = 50.0", "feed = nan"), r"feed = nan: not a finite number"),
     ("below the model description's minimum", lambda t: t.replace('[[variants]]\nname = "fuzzy-PID CCC"',
                                                                    '[[variants]]\nname = "fuzzy-PID CCC"\n'
@@ -364,12 +419,27 @@ def test_the_command_line_reports_bad_input_and_writes_nothing(tmp_path, fmus, c
     assert not (tmp_path / "out").exists()
 
 
-def test_an_unreachable_scheduler_is_reported_before_any_run(sixteen, tmp_path):
-    done = run_cli("run", str(sixteen.source), "--out", str(tmp_path / "out"),
-                   "--scheduler", "tcp://127.0.0.1:9")
+@pytest.mark.parametrize("address", ["tcp://127.0.0.1:9", "localhost", "http://127.0.0.1:8786"])
+def test_an_unreachable_scheduler_is_reported_before_any_run(sixteen, tmp_path, address):
+    done = run_cli("run", str(sixteen.source), "--out", str(tmp_path / "out"), "--scheduler", address)
     assert done.returncode == 2, done.stderr
-    assert "error: cannot reach the Dask scheduler at tcp://127.0.0.1:9" in done.stderr
+    assert f"error: cannot reach the Dask scheduler at {address}" in done.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_one_writer_per_output_folder(sixteen, tmp_path):
+    from contour_fmu.campaign.store import ResultStore
+
+    first = ResultStore(tmp_path / "out", sixteen)
+    first.write([{"run_id": 0, "status": "ok", "message": "", "attempts": 1, "wall_time_s": 0.0,
+                  "worker": "", **{m: 1.0 for m in sixteen.metrics}}])
+    with pytest.raises(OutputInUse, match="another process is writing"):
+        ResultStore(tmp_path / "out", sixteen, resume=True)
+    first.close()
+    assert ResultStore(tmp_path / "out", sixteen, resume=True).finished() == {0}
+    (tmp_path / "file").write_text("")
+    with pytest.raises(OutputInUse, match="is a file, not a folder"):
+        ResultStore(tmp_path / "file", sixteen)
 
 
 def test_the_readme_example_runs_on_a_local_cluster_with_a_progress_bar(tmp_path, fmu_dir):

@@ -71,6 +71,11 @@ def command_replay(args):
     instances = LoopInstances(job.loop, unpacked(job, archives_of(campaign)))
     try:
         values, trace = run_one(job, instances, run.start_values)
+    except Exception as e:  # noqa: BLE001  a failed run's reason, as its row gives it
+        for line in instances.log.errors:
+            print(line, file=sys.stderr)
+        print(f"run {run.id} failed: {type(e).__name__}: {e}", file=sys.stderr)
+        return 1
     finally:
         instances.free()
     interpolator = run.start_values.get("interpolator", {})

@@ -10,7 +10,9 @@ scheduler is told not to retry by itself (allowed-failures = 0), so "once more" 
 once; a remote scheduler applies its own allowed-failures before reporting a loss.
 """
 
+import asyncio
 import contextlib
+import hashlib
 import time
 
 from .runner import Job, extracted, run_batch
@@ -22,6 +24,7 @@ except ImportError:  # serial runs do not need distributed
     WorkerPlugin = object
 
 CONNECT_TIMEOUT = "10s"
+WORKER_TIMEOUT = 60  # seconds a remote scheduler may take to have a worker
 
 
 class SchedulerUnreachable(RuntimeError):
@@ -46,15 +49,17 @@ def batches(runs, size):
 
 
 class FmuArchives(WorkerPlugin):
-    """Extracts a campaign's FMU archives on each worker as it starts."""
+    """Extracts a campaign's FMU archives on each worker as it starts, into the worker's
+    own folder (removed with the worker)."""
 
     def __init__(self, job, archives):
-        self.name = f"contour-fmu-archives-{'-'.join(sorted(job.fmus.values()))[:64]}"
+        together = hashlib.sha256("".join(sorted(job.fmus.values())).encode()).hexdigest()
+        self.name = f"contour-fmu-archives-{together[:16]}"
         self.archives = {job.fmus[unit]: data for unit, data in archives.items()}
 
     def setup(self, worker):
         for sha256, data in self.archives.items():
-            extracted(sha256, data)
+            extracted(sha256, data, within=worker.local_directory)
 
 
 @contextlib.contextmanager
@@ -67,16 +72,21 @@ def dask_client(scheduler=None, workers=None):
     if scheduler is not None:
         try:
             client = Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, TimeoutError) as e:
+        except (OSError, TimeoutError, ValueError) as e:
             raise SchedulerUnreachable(f"cannot reach the Dask scheduler at {scheduler} within "
                                        f"{CONNECT_TIMEOUT}: {e}") from None
         with client:
+            try:
+                client.wait_for_workers(1, timeout=WORKER_TIMEOUT)
+            except TimeoutError:
+                raise SchedulerUnreachable(f"the Dask scheduler at {scheduler} has no worker "
+                                           f"(none joined within {WORKER_TIMEOUT} s)") from None
             yield client
         return
-    # allowed-failures 0: we resubmit a lost batch ourselves, once. worker-saturation 1: a
-    # worker holds only the batch it runs, so its death loses that batch alone (and long
-    # batches are not queued behind each other while another worker idles). No worker
-    # profiler: its 10 ms stack sampling takes the GIL from the stepping loop.
+    # allowed-failures 0: we resubmit a lost batch ourselves, once. worker-saturation 1:
+    # the scheduler gives a worker only the batch it runs (the client limits what it has
+    # in flight as well). No worker profiler: its 10 ms stack sampling takes the GIL from
+    # the stepping loop.
     with dask.config.set({"distributed.scheduler.allowed-failures": 0,
                           "distributed.scheduler.worker-saturation": 1.0,
                           "distributed.worker.profile.enabled": False}):
@@ -96,55 +106,92 @@ def _failure_rows(batch, status, message, attempts, metrics):
             for run_id, _ in batch]
 
 
+class _Outcomes:
+    """What becomes of a batch's attempt: its rows, or (first attempt) a second try, or
+    (second attempt) rows recording the loss. Shared by the serial and the Dask loop."""
+
+    def __init__(self, campaign, store, progress):
+        self.metrics, self.store, self.progress = campaign.metrics, store, progress
+
+    def finished(self, rows, attempt):
+        self.write([{**row, "attempts": attempt} for row in rows])
+
+    def failed(self, batch, attempt, status, message):
+        """Returns True when the batch should be tried again."""
+        if attempt == 1:
+            return True
+        self.write(_failure_rows(batch, status, message, attempt, self.metrics))
+        return False
+
+    def write(self, rows):
+        self.store.write(rows)
+        if self.progress is not None:
+            self.progress.update(len(rows))
+
+
 def run_serial(campaign, store, progress=None, batch_fn=run_batch):
-    """Every pending batch in this process, in order."""
+    """Every pending batch in this process, in order, with the Dask loop's rules: a batch
+    raising outside any run is tried once more, then recorded as failed."""
     job, archives = job_of(campaign), archives_of(campaign)
+    outcomes = _Outcomes(campaign, store, progress)
     for batch in batches(pending_runs(campaign, store), campaign.batch_size):
-        rows = batch_fn(job, batch, archives)
-        store.write([{**row, "attempts": 1} for row in rows])
-        if progress is not None:
-            progress.update(len(rows))
+        for attempt in (1, 2):
+            try:
+                rows = batch_fn(job, batch, archives)
+            except Exception as e:  # noqa: BLE001  recorded in the rows
+                if outcomes.failed(batch, attempt, "failed", f"{type(e).__name__}: {e}"):
+                    continue
+                break
+            outcomes.finished(rows, attempt)
+            break
 
 
 def run_on_dask(campaign, store, client, progress=None, batch_fn=run_batch):
-    """Every pending batch as a task on `client`'s workers; rows written as tasks finish."""
+    """Every pending batch as a task on `client`'s workers; rows written as tasks finish.
+    No more batches are in flight than the workers have threads, so a worker's death
+    loses only what it was running, on any scheduler."""
     from distributed import as_completed
     from distributed.scheduler import KilledWorker
 
     job = job_of(campaign)
-    client.register_plugin(FmuArchives(job, archives_of(campaign)))
+    plugin = FmuArchives(job, archives_of(campaign))
+    client.register_plugin(plugin)
     tag = f"{campaign.digest[:8]}-{time.time_ns()}"
+    outcomes = _Outcomes(campaign, store, progress)
+    waiting = [(b, 1) for b in reversed(batches(pending_runs(campaign, store), campaign.batch_size))]
     submitted = {}
+    running = as_completed(loop=client.loop)
 
-    def submit(batch, attempt):
-        future = client.submit(batch_fn, job, batch, pure=False,
-                               key=f"campaign-{tag}-run{batch[0][0]}-attempt{attempt}")
-        submitted[future.key] = (batch, attempt)
-        return future
+    def top_up():
+        capacity = max(1, sum(client.nthreads().values()))
+        while waiting and running.count() < capacity:
+            batch, attempt = waiting.pop()
+            future = client.submit(batch_fn, job, batch, pure=False,
+                                   key=f"campaign-{tag}-run{batch[0][0]}-attempt{attempt}")
+            submitted[future.key] = (batch, attempt)
+            running.add(future)
 
-    pending = as_completed([submit(b, 1) for b in batches(pending_runs(campaign, store),
-                                                          campaign.batch_size)])
-    for future in pending:
-        batch, attempt = submitted.pop(future.key)
+    try:
+        top_up()
+        while running.count() or waiting:
+            future = next(running)
+            batch, attempt = submitted.pop(future.key)
+            try:
+                outcomes.finished(future.result(), attempt)
+            except KilledWorker as e:
+                if outcomes.failed(batch, attempt, "lost", f"the batch's worker died twice: {e}"):
+                    waiting.append((batch, 2))
+            except (Exception, asyncio.CancelledError) as e:  # noqa: BLE001  recorded in the rows
+                if outcomes.failed(batch, attempt, "failed", f"{type(e).__name__}: {e}"):
+                    waiting.append((batch, 2))
+            finally:
+                future.release()
+            top_up()
+    finally:
         try:
-            rows = [{**row, "attempts": attempt} for row in future.result()]
-        except KilledWorker as e:
-            if attempt == 1:
-                pending.add(submit(batch, 2))
-                continue
-            rows = _failure_rows(batch, "lost", f"the batch's worker died twice: {e}", attempt,
-                                 campaign.metrics)
-        except Exception as e:  # noqa: BLE001  a batch that raised outside any run
-            if attempt == 1:
-                pending.add(submit(batch, 2))
-                continue
-            rows = _failure_rows(batch, "failed", f"{type(e).__name__}: {e}", attempt,
-                                 campaign.metrics)
-        finally:
-            future.release()
-        store.write(rows)
-        if progress is not None:
-            progress.update(len(rows))
+            client.unregister_worker_plugin(plugin.name)
+        except Exception:  # noqa: BLE001  a scheduler already gone keeps nothing
+            pass
 
 
 def execute(campaign, out, *, scheduler=None, workers=None, resume=False, serial=False,
@@ -157,10 +204,13 @@ def execute(campaign, out, *, scheduler=None, workers=None, resume=False, serial
     total = len(campaign.runs)
     todo = len(pending_runs(campaign, store))
     where = contextlib.nullcontext() if serial or todo == 0 else dask_client(scheduler, workers)
-    with where as client, tqdm(total=total, initial=total - todo, unit="run", desc=campaign.name,
-                               disable=not show_progress, smoothing=0.1) as progress:
-        if client is None:
-            run_serial(campaign, store, progress, batch_fn)
-        else:
-            run_on_dask(campaign, store, client, progress, batch_fn)
+    try:
+        with where as client, tqdm(total=total, initial=total - todo, unit="run", desc=campaign.name,
+                                   disable=not show_progress, smoothing=0.1) as progress:
+            if client is None:
+                run_serial(campaign, store, progress, batch_fn)
+            else:
+                run_on_dask(campaign, store, client, progress, batch_fn)
+    finally:
+        store.close()
     return store

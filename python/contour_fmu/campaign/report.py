@@ -12,6 +12,7 @@ OUT/sensitivity.png).
 """
 
 import shlex
+from pathlib import Path
 
 import numpy as np
 
@@ -25,8 +26,11 @@ def _scaled(metric):
 
 
 def replay_command(campaign, run_id, out):
+    """The command that runs one run alone, from any folder (absolute paths; the same
+    FMUs when the campaign ran with --fmu-dir)."""
+    fmus = f" --fmu-dir {shlex.quote(str(campaign.fmu_dir))}" if campaign.fmu_dir else ""
     return (f"python -m contour_fmu.campaign replay {shlex.quote(str(campaign.source))} "
-            f"--run {run_id} --out {shlex.quote(str(out / 'replay'))}")
+            f"--run {run_id} --out {shlex.quote(str(Path(out).resolve() / 'replay'))}{fmus}")
 
 
 def _groups(columns):
@@ -40,9 +44,12 @@ def _groups(columns):
 
 
 def sensitivity(x, y):
-    """(Spearman's rho, elasticity) of y against x; NaN when either is constant."""
+    """(Spearman's rho, elasticity) of y against x; NaN when either is constant or x is
+    not a number (a swept string)."""
     from scipy.stats import spearmanr
 
+    if any(isinstance(v, str) for v in x):
+        return float("nan"), float("nan")
     x, y = np.asarray(x, float), np.asarray(y, float)
     if len(x) < 3 or np.ptp(x) == 0 or np.ptp(y) == 0:
         return float("nan"), float("nan")
@@ -160,7 +167,9 @@ def plot(campaign, table, out):
         data = []
         for (variant, path), rows in groups.items():
             data.append(np.asarray([c[first][i] * factor for i in rows], float))
-            ax.plot([c[name][i] for i in rows], data[-1], ".", ms=4, label=f"{variant} / {path}")
+            x = [c[name][i] for i in rows]
+            ax.plot([str(v) for v in x] if any(isinstance(v, str) for v in x) else x, data[-1], ".",
+                    ms=4, label=f"{variant} / {path}")
         _log_if_wide(ax, data)
         ax.set_xlabel(name), ax.set_ylabel(f"{first} ({unit})")
     for ax in list(axes.flat)[n:]:

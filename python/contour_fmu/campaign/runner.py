@@ -55,24 +55,19 @@ _extracted = {}  # SHA-256 -> unzip directory, for this process's lifetime
 
 
 def _scratch():
-    """Where this process unpacks FMUs: the Dask worker's own folder (removed with the
-    worker), else a temporary folder removed at exit."""
-    try:
-        from distributed import get_worker
-
-        return Path(get_worker().local_directory)
-    except (ImportError, ValueError):
-        directory = tempfile.mkdtemp(prefix="contour-fmu-campaign-")
-        atexit.register(shutil.rmtree, directory, ignore_errors=True)
-        return Path(directory)
+    """A temporary folder removed at exit, for a process that is not a Dask worker."""
+    directory = tempfile.mkdtemp(prefix="contour-fmu-campaign-")
+    atexit.register(shutil.rmtree, directory, ignore_errors=True)
+    return Path(directory)
 
 
-def extracted(sha256, archive):
-    """The unzip directory of an FMU archive (bytes), extracted once per process."""
+def extracted(sha256, archive, within=None):
+    """The unzip directory of an FMU archive (bytes), extracted once per process into
+    `within` (a Dask worker's own folder, removed with the worker) or a temporary one."""
     if sha256 not in _extracted:
         import io
 
-        directory = Path(tempfile.mkdtemp(prefix=f"fmu-{sha256[:12]}-", dir=_scratch()))
+        directory = Path(tempfile.mkdtemp(prefix=f"fmu-{sha256[:12]}-", dir=within or _scratch()))
         with zipfile.ZipFile(io.BytesIO(archive)) as z:
             z.extractall(directory)
         _extracted[sha256] = directory
@@ -247,21 +242,22 @@ def run_batch(job, runs, archives=None):
     rows, instances = [], None
     try:
         for run_id, start_values in runs:
+            # Instances that cannot be made are the worker's trouble, not the run's: the
+            # exception fails the batch, which is retried (elsewhere, on Dask).
+            if instances is None:
+                instances = LoopInstances(job.loop, directories)
             began = time.perf_counter()
             row = {"run_id": run_id, "status": "ok", "message": "", "worker": worker_name()}
             try:
-                if instances is None:
-                    instances = LoopInstances(job.loop, directories)
                 values, _ = run_one(job, instances, start_values)
                 row.update(values)
             except Exception as e:  # noqa: BLE001  every failure of a run is its row's message
-                logged = instances.log.errors if instances is not None else []
+                logged = instances.log.errors
                 row.update({m: float("nan") for m in job.metrics})
                 row["status"] = "error"
                 row["message"] = "; ".join([*logged[-3:], f"{type(e).__name__}: {e}"])
-                if instances is not None:
-                    instances.free()
-                    instances = None
+                instances.free()
+                instances = None
             row["wall_time_s"] = time.perf_counter() - began
             rows.append(row)
     finally:

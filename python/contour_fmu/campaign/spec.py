@@ -58,6 +58,8 @@ METHODS = ("grid", "latin_hypercube")
 STOP_AT_END = "end_of_path"
 # A run that has not reached the end of its path after this long is an error, not a hang.
 DEFAULT_MAX_STOP = 600.0
+# More runs than this is a typo in a grid, not a campaign (and would fill memory first).
+MAX_RUNS = 1_000_000
 TOP_KEYS = {"name", "loop", "step", "stop", "settle", "max_stop", "metrics", "batch_size",
             "fmus", "fixed", "paths", "variants", "sweep"}
 
@@ -74,6 +76,7 @@ class Variable:
     start: object  # the model description's start value, converted, or None
     min: float | None = None  # the model description's bounds (numbers only)
     max: float | None = None
+    items: tuple = ()  # an Enumeration's values
 
 
 @dataclass(frozen=True)
@@ -108,13 +111,16 @@ class Campaign:
     batch_size: int
     swept: tuple  # "unit.variable" names, in file order
     runs: tuple = field(repr=False)
+    fmu_dir: Path | None = None  # --fmu-dir, when given (replay commands repeat it)
 
     @property
     def digest(self):
         """SHA-256 of everything that decides the results: the FMUs, the loop, the timing,
         the metrics and every run's start values. --resume refuses another digest."""
+        from .. import __version__
+
         document = {
-            "loop": self.loop, "step": self.step, "stop": self.stop, "settle": self.settle,
+            "package": __version__, "swept": list(self.swept), "loop": self.loop, "step": self.step, "stop": self.stop, "settle": self.settle,
             "max_stop": self.max_stop, "metrics": list(self.metrics),
             "fmus": {name: unit.sha256 for name, unit in self.units.items()},
             "runs": [[r.id, r.variant, r.path, r.start_values] for r in self.runs],
@@ -171,6 +177,8 @@ class _Reader:
         max_stop = self.positive("max_stop", DEFAULT_MAX_STOP)
         if isinstance(stop, float) and stop > max_stop:
             self.fail(f"stop = {stop!r} is beyond max_stop = {max_stop!r}")
+        if isinstance(stop, float) and "settle" in self.doc:
+            self.fail("settle applies to stop = \"end_of_path\"; with a stop time, lengthen the stop")
         if max_stop / step > 1e8:
             self.fail(f"max_stop / step = {max_stop / step:.3g} steps: more than 1e8 per run")
         batch_size = self.doc.get("batch_size", 4)
@@ -186,6 +194,9 @@ class _Reader:
         paths = self.read_paths()
         variants = self.read_variants()
         swept, points = self.read_sweep()
+        if len(variants) * len(paths) * len(points) > MAX_RUNS:
+            self.fail(f"{len(variants)} variants × {len(paths)} paths × {len(points)} sweep points "
+                      f"is more than {MAX_RUNS} runs")
         runs = []
         for variant, variant_values in variants:
             for label, path_values in paths:
@@ -197,13 +208,18 @@ class _Reader:
                     runs.append(Run(len(runs), variant, label,
                                     {f"{u}.{n}": v for (u, n), v in point.items()}, values))
         for run in runs:
+            interpolator = run.start_values.get("interpolator", {})
+            feed = interpolator.get("feed", self.units["interpolator"].variables["feed"].start)
+            if feed is not None and feed <= 0:
+                self.fail(f"run {run.id} ({run.variant}, {run.path}): interpolator.feed = {feed!r}: "
+                          "expected a feed > 0")
             try:
-                check_metrics(loop, metrics, run.start_values.get("interpolator", {}),
-                              self.units["interpolator"].variables)
+                check_metrics(loop, metrics, interpolator, self.units["interpolator"].variables)
             except ValueError as e:
                 self.fail(f"path {run.path!r}: {e}")
         return Campaign(
             name=str(self.doc.get("name", self.source.stem)), source=self.source.resolve(),
+            fmu_dir=None if self.fmu_dir is None else Path(self.fmu_dir).resolve(),
             loop=loop, units=self.units, step=step, stop=None if stop == STOP_AT_END else stop,
             settle=settle, max_stop=max_stop, metrics=tuple(metrics), batch_size=batch_size,
             swept=tuple(swept), runs=tuple(runs))
@@ -238,6 +254,9 @@ class _Reader:
         fmus = self.table("fmus", name="[fmus]")
         loop = LOOPS[self.loop]
         self.only(fmus, {"directory", *loop.units}, "[fmus]")
+        for key, value in fmus.items():
+            if not isinstance(value, str):
+                self.fail(f"[fmus] {key} = {value!r}: expected a file or folder name (a string)")
         if self.fmu_dir is not None:
             directory = Path(self.fmu_dir)
         elif "directory" in fmus:
@@ -250,7 +269,7 @@ class _Reader:
         units = {}
         for unit, default in loop.units.items():
             path = Path(directory) / default
-            if unit in fmus:
+            if unit in fmus and self.fmu_dir is None:  # --fmu-dir replaces every entry
                 path = self.source.parent / fmus[unit]
             if not path.is_file():
                 self.fail(f"no FMU {path} for the {unit} (build the FMUs with `make fmus`, "
@@ -263,12 +282,12 @@ class _Reader:
             if md.coSimulation is None or md.modelName != expected:
                 self.fail(f"{path} is {md.modelName!r}, not the {unit} of the {self.loop} "
                           f"loop ({expected}, FMI 2.0 Co-Simulation)")
-            variables = {v.name: Variable(v.type, v.causality, _start(v), _bound(v.min), _bound(v.max))
-                         for v in md.modelVariables}
+            variables = {v.name: Variable(v.type, v.causality, _start(v), _bound(v.min), _bound(v.max),
+                                          _items(v)) for v in md.modelVariables}
             units[unit] = Unit(unit, path.resolve(), _sha256(path), variables)
         return units
 
-    def variable(self, target, where):
+    def variable(self, target, where, path_allowed=False):
         """(unit, variable name) of a "unit.variable" that a campaign may set."""
         unit, _, name = str(target).partition(".")
         if unit not in self.units or not name:
@@ -279,6 +298,9 @@ class _Reader:
             self.fail(f"{where}: {self.units[unit].path.name} has no variable {name!r}")
         if variable.causality != "parameter":
             self.fail(f"{where}: {unit}.{name} is an {variable.causality}, not a parameter")
+        if (unit, name) == ("interpolator", "path") and not path_allowed:
+            self.fail(f"{where}: the path is chosen in [[paths]] (each path is a group of its own "
+                      "in the summary)")
         if (unit, name) in {(dst, inp) for _, _, dst, inp in LOOPS[self.loop].path_start}:
             self.fail(f"{where}: {unit}.{name} is set by the loop (the plant starts where the path does)")
         return unit, name, variable
@@ -295,6 +317,9 @@ class _Reader:
         if kind in ("Integer", "Enumeration") and isinstance(value, int) and not isinstance(value, bool):
             if not -2**31 <= value < 2**31:
                 self.fail(f"{where} = {value!r}: outside the 32-bit range of an FMI Integer")
+            if variable.items and value not in dict(variable.items):
+                self.fail(f"{where} = {value!r}: not one of the enumeration's values "
+                          + ", ".join(f"{v} ({n})" for v, n in variable.items))
             return self.bounded(variable, value, where)
         if kind == "Boolean" and isinstance(value, bool):
             return value
@@ -480,6 +505,13 @@ def _start(variable):
 
 def _bound(text):
     return None if text is None else float(text)
+
+
+def _items(variable):
+    """((value, name), ...) of an Enumeration variable's type."""
+    if variable.type != "Enumeration" or variable.declaredType is None:
+        return ()
+    return tuple((int(item.value), item.name) for item in variable.declaredType.items)
 
 
 def _sha256(path):

@@ -41,50 +41,80 @@ def schema(campaign):
 
 
 class ResultStore:
+    """OUT's rows. One process writes to an OUT at a time: the first write takes an
+    exclusive lock on OUT/.lock, held until `close` (a second writer is refused when it
+    opens the store)."""
+
     def __init__(self, out, campaign, resume=False):
         self.out, self.campaign = Path(out), campaign
         self.rows_dir = self.out / "rows"
         self.schema = schema(campaign)
-        marker = self.out / "campaign.json"
-        existing = sorted(self.rows_dir.glob("part-*.parquet")) if self.rows_dir.is_dir() else []
-        if marker.is_file() or existing:
+        self.marker = self.out / "campaign.json"
+        self.lock = None
+        if self.out.exists() and not self.out.is_dir():
+            raise OutputInUse(f"--out {self.out} is a file, not a folder")
+        if (self.out / ".lock").is_file() and not _lockable(self.out / ".lock"):
+            raise OutputInUse(f"another process is writing campaign results to {self.out}")
+        existing = self.parts()
+        if self.marker.is_file() or existing:
             if not resume:
                 raise OutputInUse(f"{self.out} already holds campaign results: add --resume to "
                                   "finish that campaign, or choose another --out")
-            recorded = json.loads(marker.read_text()) if marker.is_file() else {}
+            try:
+                recorded = json.loads(self.marker.read_text())
+            except (OSError, ValueError):
+                recorded = {}
             if recorded.get("digest") != campaign.digest:
                 raise OutputInUse(
-                    f"{self.out} holds results of another campaign (its file, its FMUs or its "
-                    f"runs differ: digest {recorded.get('digest', '?')[:12]}, this one "
-                    f"{campaign.digest[:12]}); choose another --out")
-        self.marker = marker
-        self.next_part = 1 + max((int(p.stem.split("-")[1]) for p in existing), default=-1)
+                    f"{self.out} holds results of another campaign (its file, its FMUs, its runs "
+                    f"or this package's version differ: digest {str(recorded.get('digest', '?'))[:12]}, "
+                    f"this one {campaign.digest[:12]}); choose another --out")
+
+    def parts(self):
+        return sorted(self.rows_dir.glob("part-*.parquet")) if self.rows_dir.is_dir() else []
+
+    def _take(self):
+        """Creates OUT, takes its lock and writes campaign.json (atomically)."""
+        import fcntl
+
+        self.rows_dir.mkdir(parents=True, exist_ok=True)
+        self.lock = open(self.out / ".lock", "a")
+        try:
+            fcntl.flock(self.lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise OutputInUse(f"another process is writing campaign results to {self.out}") from None
+        _write_atomically(self.marker, json.dumps(
+            {"name": self.campaign.name, "source": str(self.campaign.source),
+             "digest": self.campaign.digest, "runs": len(self.campaign.runs)}, indent=1).encode() + b"\n")
+
+    def close(self):
+        """Releases OUT's lock (the rows stay readable)."""
+        if self.lock is not None:
+            self.lock.close()
+            self.lock = None
 
     def write(self, rows):
         """Adds rows (dicts with every schema column but the run's own); durable on return.
         The first write creates the folder (nothing is written before a run finishes)."""
-        if not self.marker.is_file():
-            self.rows_dir.mkdir(parents=True, exist_ok=True)
-            self.marker.write_text(json.dumps(
-                {"name": self.campaign.name, "source": str(self.campaign.source),
-                 "digest": self.campaign.digest, "runs": len(self.campaign.runs)}, indent=1) + "\n")
+        if self.lock is None:
+            self._take()
         runs = self.campaign.runs
         complete = []
         for row in rows:
             run = runs[row["run_id"]]
             complete.append({**row, "variant": run.variant, "path": run.path, **run.swept})
         table = pa.Table.from_pylist(complete, schema=self.schema)
-        target = self.rows_dir / f"part-{self.next_part:06d}.parquet"
+        number = 1 + max((int(p.stem.split("-")[1]) for p in self.parts()), default=-1)
+        target = self.rows_dir / f"part-{number:06d}.parquet"
         temporary = target.with_suffix(".tmp")
         pq.write_table(table, temporary)
         with open(temporary, "rb") as f:
             os.fsync(f.fileno())
         os.replace(temporary, target)
-        self.next_part += 1
 
     def table(self):
         """Every run's newest row, sorted by run id (a pyarrow Table)."""
-        parts = sorted(self.rows_dir.glob("part-*.parquet")) if self.rows_dir.is_dir() else []
+        parts = self.parts()
         if not parts:
             return self.schema.empty_table()
         table = pa.concat_tables([pq.read_table(p, schema=self.schema) for p in parts])
@@ -108,3 +138,22 @@ class ResultStore:
         pq.write_table(table, temporary)
         os.replace(temporary, self.out / "results.parquet")
         return table
+
+
+def _lockable(path):
+    """Whether no other process holds the lock on `path`."""
+    import fcntl
+
+    with open(path, "a") as f:
+        try:
+            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            return False
+        fcntl.flock(f, fcntl.LOCK_UN)
+        return True
+
+
+def _write_atomically(path, data):
+    temporary = path.with_suffix(".tmp")
+    temporary.write_bytes(data)
+    os.replace(temporary, path)
