@@ -4,13 +4,13 @@ rows) against the same runs in a plain Python loop (one set of instances, reset 
 runs, no Dask, nothing written).
 
 The campaign: the two-axis loop on the paper's circle to the end of the path (2 s, 2 000
-steps), RUNS plants from a grid of x.J and y.Kvp, true contour error max and mean, two
-runs per batch. Every part is warmed first (FMUs extracted, the circle's reference
+steps), RUNS plants from a grid of x.J and y.Kvp, true contour error max and mean, four
+runs per batch (the default). Every part is warmed first (FMUs extracted, the circle's reference
 built in each process), so the figures are steady-state rates; starting the cluster is
 reported apart. The machine's speed drifts (shared cores), so each round times the three
 one after the other, and the ratios are the medians of the rounds' ratios.
 
-    .venv/bin/python benches/campaign_scaling.py [--runs 24] [--rounds 5] [--json FILE]
+    .venv/bin/python benches/campaign_scaling.py [--runs 48] [--rounds 7] [--json FILE]
 """
 
 import argparse
@@ -39,7 +39,7 @@ name = "bench"
 loop = "two_axis"
 stop = "end_of_path"
 metrics = ["contour_error.max", "contour_error.mean"]
-batch_size = 2
+batch_size = 4
 [fmus]
 directory = "{fmus}"
 [[paths]]
@@ -82,21 +82,25 @@ def plain_loop():
     return time.perf_counter() - began
 
 
-def on_cluster(c, client, directory):
-    """Seconds for the campaign's runs on `client`'s workers (rows written as usual)."""
-    began = time.perf_counter()
+def on_cluster(c, client, directory, cpu=None):
+    """Seconds for the campaign's runs on `client`'s workers (rows written as usual);
+    adds this process's CPU seconds (client, scheduler, Parquet) to `cpu`."""
+    began, used = time.perf_counter(), time.process_time()
     run_on_dask(c, ResultStore(directory, c), client)
+    if cpu is not None:
+        cpu.append(time.process_time() - used)
     return time.perf_counter() - began
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--runs", type=int, default=24, help="runs per round (even)")
-    parser.add_argument("--rounds", type=int, default=5,
+    parser.add_argument("--runs", type=int, default=48, help="runs per round (even)")
+    parser.add_argument("--rounds", type=int, default=7,
                         help="rounds; each times the plain loop, 1 worker and 2 workers in turn")
     parser.add_argument("--json", type=Path, help="write the figures to this file")
     args = parser.parse_args()
     times = {"plain": [], "one": [], "two": []}
+    client_cpu = []
     with tempfile.TemporaryDirectory() as directory, contextlib.ExitStack() as stack:
         c, warm = campaign(directory, args.runs), campaign(directory, 4)
         # The plain loop runs in a process of its own: this one hosts the schedulers.
@@ -113,7 +117,8 @@ def main():
         for r in range(args.rounds):
             times["plain"].append(plain.submit(plain_loop).result())
             for name in ("one", "two"):
-                times[name].append(on_cluster(c, clients[name], Path(directory) / f"{name}-{r}"))
+                times[name].append(on_cluster(c, clients[name], Path(directory) / f"{name}-{r}",
+                                              client_cpu if name == "two" else None))
     n = len(c.runs)
     median = {k: statistics.median(v) for k, v in times.items()}
     # Ratios per round (the three ran within seconds of each other), then their median.
@@ -126,9 +131,11 @@ def main():
         "scaling_two_over_one": scaling, "overhead_fraction": overhead,
         "overhead_per_run_s": overhead * median["plain"] / n,
         "cluster_start_s": [starts["one"], starts["two"]], "seconds": times,
+        "client_cpu_fraction_two_workers": statistics.median(
+            u / t for u, t in zip(client_cpu, times["two"])),
     }
     print(f"{args.rounds} rounds of {n} runs of the two-axis loop on the circle (2 000 steps each), "
-          "2 runs per batch; medians")
+          "4 runs per batch (the default); medians")
     print(f"  plain Python loop        {figures['plain_runs_per_s']:6.2f} runs/s")
     print(f"  LocalCluster, 1 worker   {figures['one_worker_runs_per_s']:6.2f} runs/s")
     print(f"  LocalCluster, 2 workers  {figures['two_workers_runs_per_s']:6.2f} runs/s")
@@ -136,6 +143,8 @@ def main():
           + ", ".join(f"{o / t:.2f}" for o, t in zip(times["one"], times["two"])) + ")")
     print(f"  overhead per run, 1 worker vs plain loop: {figures['overhead_per_run_s'] * 1e3:.1f} ms "
           f"({100 * overhead:.1f} %)")
+    print(f"  CPU of the client process (scheduler, client, Parquet) with 2 workers: "
+          f"{100 * figures['client_cpu_fraction_two_workers']:.1f} % of one core")
     print(f"  cluster start (not in the rates): {starts['one']:.1f} s and {starts['two']:.1f} s")
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)

@@ -42,6 +42,7 @@ number and its start values depend on the file and the FMUs only, which is what 
 --resume and replay find it again.
 """
 
+import functools
 import hashlib
 import json
 import math
@@ -113,7 +114,7 @@ class Campaign:
     runs: tuple = field(repr=False)
     fmu_dir: Path | None = None  # --fmu-dir, when given (replay commands repeat it)
 
-    @property
+    @functools.cached_property
     def digest(self):
         """SHA-256 of everything that decides the results: the FMUs, the loop, the timing,
         the metrics and every run's start values. --resume refuses another digest."""
