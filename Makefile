@@ -4,7 +4,7 @@
 #   make test   lint, then every test (Rust unit/ABI tests, fmpy/libcosim/ecos and reference
 #               tests); installs libclang-dev and libtbb12 through apt when they are missing
 #               (root), the venv gets the test set and the package
-# Other targets: fmus, ccc-tune, bindings, lint, asan, fuzz-smoke, fuzz-long, bench,
+# Other targets: check (the fast development loop), fmus, ccc-tune, bindings, lint, asan, fuzz-smoke, fuzz-long, bench,
 # leak-check, pso-claim, setup.
 
 VENV   := .venv
@@ -12,7 +12,7 @@ PYTHON := $(VENV)/bin/python
 PIP    := $(PYTHON) -m pip install --quiet --disable-pip-version-check
 CARGO  ?= cargo
 
-.PHONY: demo test fmus ccc-tune bindings lint bench pso-claim setup libclang libtbb valgrind leak-check \
+.PHONY: demo test check fmus ccc-tune bindings lint bench pso-claim setup libclang libtbb valgrind leak-check \
         asan fuzz-smoke fuzz-long cargo-fuzz
 
 # --- demo: cargo and python3 only ---------------------------------------------------------
@@ -76,6 +76,11 @@ cargo-fuzz:
 # Everything `make test` installs.
 setup: libclang libtbb valgrind cargo-fuzz $(VENV)/.test-installed
 
+# The fast development loop: format, lints, the libraries' unit tests and the Rust
+# integration and ABI tests; nothing installed, no Python, no sanitizer, no fuzzer.
+check: lint
+	$(CARGO) test -p contour-core -p contour-fmu --features contour-fmu/test-hooks
+
 lint:
 	$(CARGO) fmt --all -- --check
 	$(CARGO) clippy --workspace --all-targets --features contour-fmu/test-hooks -- -D warnings
@@ -94,8 +99,8 @@ fuzz-smoke: cargo-fuzz
 fuzz-long: cargo-fuzz
 	fuzz/long.sh 10000000
 
-# AddressSanitizer, with its leak checker, over the FMI boundary: the library's unit tests
-# and the ABI tests, the dlopened cdylib instrumented as well. The stable toolchain's
+# AddressSanitizer, with its leak checker, over the FMI boundary: the libraries' unit tests
+# (contour-fmu's and contour-core's) and the ABI tests, the dlopened cdylib instrumented as well. The stable toolchain's
 # -Zsanitizer needs RUSTC_BOOTSTRAP; --target keeps build scripts and proc macros
 # uninstrumented; the test executables export the ASan runtime for the cdylib to find.
 HOST       := $(shell rustc -vV 2>/dev/null | sed -n 's/^host: //p')
@@ -106,6 +111,8 @@ ASAN_TESTS := --lib --test fmi_abi --test abi_handles --test abi_state_validatio
 asan:
 	RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=target/asan RUSTFLAGS="$(ASAN_FLAGS)" \
 		$(CARGO) test -p contour-fmu --target $(HOST) --features test-hooks $(ASAN_TESTS)
+	RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=target/asan RUSTFLAGS="$(ASAN_FLAGS)" \
+		$(CARGO) test -p contour-core --target $(HOST) --lib
 	@nm -D target/asan/$(HOST)/debug/deps/libcontour_fmu.so | grep -q __asan_report_load8 \
 		|| { echo "asan: the library under test is not instrumented"; exit 1; }
 	@echo "asan: no report from AddressSanitizer or LeakSanitizer"

@@ -9,10 +9,10 @@
 
 use std::hint::black_box;
 
-use contour_fmu::contour::FreeCurveEstimator;
-use contour_fmu::control::{CccConfig, CccMode, ControllerConfig, CrossCoupledController};
-use contour_fmu::geometry::Vector2;
-use contour_fmu::sim::{SimConfig, Simulator};
+use contour_core::contour::planar::FreeCurveEstimator;
+use contour_core::control::{CccConfig, CccMode, ControllerConfig, CrossCoupledController};
+use contour_core::geometry::Vector2;
+use contour_core::sim::{SimConfig, Simulator};
 use criterion::{criterion_group, criterion_main, Criterion};
 
 /// The estimator the controller FMU runs by default.

@@ -12,9 +12,9 @@
 
 use std::hint::black_box;
 
-use contour_fmu::control::{CccMode, FiveAxisConfig, FiveAxisController};
-use contour_fmu::kinematics::Joints;
-use contour_fmu::sim::{simulate_five_axis, FiveAxisSimConfig};
+use contour_core::control::{CccMode, FiveAxisConfig, FiveAxisController};
+use contour_core::kinematics::Joints;
+use contour_core::sim::{simulate_five_axis, FiveAxisSimConfig};
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 
 fn replay(controller: &mut FiveAxisController, samples: &[(Joints, Joints)]) -> f64 {

@@ -37,9 +37,10 @@ use std::hint::black_box;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+use contour_core::sim::{simulate_five_axis, FiveAxisSimConfig, SimConfig, Simulator};
 use contour_fmu::fmi2::bindings::{fmi2CallbackFunctions, fmi2Component, fmi2FMUstate};
-use contour_fmu::models::{self, ModelInfo};
-use contour_fmu::sim::{simulate_five_axis, FiveAxisSimConfig, SimConfig, Simulator};
+use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::models;
 use criterion::{BenchmarkGroup, Criterion, SamplingMode, Throughput};
 
 #[path = "../tests/common/linked.rs"]

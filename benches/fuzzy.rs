@@ -3,9 +3,9 @@
 
 use std::hint::black_box;
 
-use contour_fmu::control::fuzzy::evaluate_table;
-use contour_fmu::control::rules::KP_RULES;
-use contour_fmu::control::FuzzyEngine;
+use contour_core::control::evaluate_table;
+use contour_core::control::FuzzyEngine;
+use contour_core::control::KP_RULES;
 use criterion::{criterion_group, criterion_main, Criterion};
 
 /// Inputs spread over [−3.5, 3.5]² (clamping included), cycled so that the branch

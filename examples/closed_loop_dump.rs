@@ -1,4 +1,4 @@
-//! Prints one recorded closed-loop run (`contour_fmu::sim`) as JSON, for comparison with
+//! Prints one recorded closed-loop run (`contour_core::sim`) as JSON, for comparison with
 //! an independent model (tests/reference/test_closed_loop_scipy.py).
 //!
 //! Usage: `closed_loop_dump [PATH] [PLANT] [MODE] [FEED] [SETTLE]`
@@ -11,9 +11,9 @@
 //! Output: the run's parameters (Ts, feed, plant, axis gain), the time series (t,
 //! reference, actual, true and estimated contour error, gains, u) and the metrics.
 
-use contour_fmu::control::CccMode;
-use contour_fmu::plant::XyTableParams;
-use contour_fmu::sim::{SimConfig, Simulator};
+use contour_core::control::CccMode;
+use contour_core::plant::XyTableParams;
+use contour_core::sim::{SimConfig, Simulator};
 use serde_json::json;
 
 fn fail(msg: impl std::fmt::Display) -> ! {

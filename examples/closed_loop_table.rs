@@ -14,9 +14,9 @@
 //! default, docs/design.md §4.5). Every run is from rest at the path start to the sample where the
 //! interpolator reaches the path end (no settle time); Ts = 1 ms, free-curve estimator.
 
-use contour_fmu::control::CccMode;
-use contour_fmu::plant::XyTableParams;
-use contour_fmu::sim::{Metrics, SimConfig, Simulator};
+use contour_core::control::CccMode;
+use contour_core::plant::XyTableParams;
+use contour_core::sim::{Metrics, SimConfig, Simulator};
 
 /// Metrics of a run and its peak drive current (A, at the sample instants, where the
 /// held command steps and the current peaks).

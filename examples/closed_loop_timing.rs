@@ -9,8 +9,8 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use contour_fmu::control::CccMode;
-use contour_fmu::sim::{SimConfig, Simulator};
+use contour_core::control::CccMode;
+use contour_core::sim::{SimConfig, Simulator};
 
 fn main() {
     let runs: usize = std::env::args()

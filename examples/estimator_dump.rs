@@ -6,8 +6,8 @@
 //! ±20 mm (20 %). Output per point: the point, the global brute-force result and the
 //! hint-accelerated index result (hint = the generating parameter).
 
-use contour_fmu::contour::{true_error, TrueErrorIndex};
-use contour_fmu::path::{builtin, Curve};
+use contour_core::contour::planar::{true_error, TrueErrorIndex};
+use contour_core::path::{builtin, Curve};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use serde_json::json;

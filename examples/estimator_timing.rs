@@ -4,8 +4,9 @@
 
 use std::time::Instant;
 
-use contour_fmu::contour::{true_error, ContourEstimator, FreeCurveEstimator, TrueErrorIndex};
-use contour_fmu::path::{builtin, Curve, Interpolator};
+use contour_core::contour::planar::{true_error, FreeCurveEstimator, TrueErrorIndex};
+use contour_core::contour::ContourEstimator;
+use contour_core::path::{builtin, Curve, Interpolator};
 
 fn main() {
     let name = std::env::args().nth(1).unwrap_or_else(|| "trident".into());

@@ -4,7 +4,7 @@
 //!
 //! Usage:
 //! - `five_axis_dump kinematics SEED N`: N pseudo-random cases of the table-tilting A–C
-//!   machine (`contour_fmu::kinematics`). Joints X, Y, Z in ±200 mm, A in [0, 1.5] rad,
+//!   machine (`contour_core::kinematics`). Joints X, Y, Z in ±200 mm, A in [0, 1.5] rad,
 //!   C in ±7 rad; pivots with every component nonzero (5 to 120 mm, either sign, so the
 //!   components the kinematics must ignore are set as well). Output per case: joints,
 //!   pivots, the forward pose (tip, axis), the previous C handed to the inverse (the true
@@ -20,17 +20,17 @@
 //!   the axis parameters, the start, the command of every step and the positions and
 //!   velocities after every step (row k is after step k + 1).
 //! - `five_axis_dump closed_loop PATH MODE [FEED]`: the in-process five-axis closed loop
-//!   (`contour_fmu::sim::five_axis`) on a built-in path or a CL/JSON file, CCC `off`,
+//!   (`contour_core::sim::five_axis`) on a built-in path or a CL/JSON file, CCC `off`,
 //!   `fixed` or `fuzzy`, at FEED mm/s (default 50): the metrics and every sample's record
 //!   (time, reference and actual joints, command, true and estimated errors), for the
 //!   FMU closed loop to reproduce (tests/fmpy/test_five_axis_fmus.py).
 
-use contour_fmu::control::CccMode;
-use contour_fmu::geometry::Vector;
-use contour_fmu::kinematics::{Joints, Pose, TableTiltingAc};
-use contour_fmu::path::tool_path::ToolPath;
-use contour_fmu::plant::{ServoAxes, ServoAxesParams};
-use contour_fmu::sim::{simulate_five_axis, FiveAxisSimConfig};
+use contour_core::control::CccMode;
+use contour_core::geometry::Vector;
+use contour_core::kinematics::{Joints, Pose, TableTiltingAc};
+use contour_core::path::ToolPath;
+use contour_core::plant::{ServoAxes, ServoAxesParams};
+use contour_core::sim::{simulate_five_axis, FiveAxisSimConfig};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use serde_json::{json, Value};

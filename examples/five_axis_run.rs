@@ -8,9 +8,9 @@
 
 use std::io::Write;
 
-use contour_fmu::control::CccMode;
-use contour_fmu::path::tool_path::ToolPath;
-use contour_fmu::sim::{simulate_five_axis, FiveAxisSimConfig};
+use contour_core::control::CccMode;
+use contour_core::path::ToolPath;
+use contour_core::sim::{simulate_five_axis, FiveAxisSimConfig};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -3,9 +3,9 @@
 //!
 //! `cargo run --release --example five_axis_table [PATH …]`
 
-use contour_fmu::control::CccMode;
-use contour_fmu::path::tool_path::BUILTIN_TOOL_PATHS;
-use contour_fmu::sim::{simulate_five_axis, FiveAxisSimConfig};
+use contour_core::control::CccMode;
+use contour_core::path::BUILTIN_TOOL_PATHS;
+use contour_core::sim::{simulate_five_axis, FiveAxisSimConfig};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let names: Vec<String> = std::env::args().skip(1).collect();

@@ -5,7 +5,7 @@
 //! Output: `{"grid": [..n values..], "dkp": [[..]], "dki": [[..]], "dkd": [[..]]}` with
 //! `dkp[i][j]` the output for E = grid[i], EC = grid[j].
 
-use contour_fmu::control::FuzzyEngine;
+use contour_core::control::FuzzyEngine;
 
 fn main() {
     let n: usize = match std::env::args().nth(1) {

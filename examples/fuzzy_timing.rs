@@ -8,7 +8,7 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use contour_fmu::control::FuzzyEngine;
+use contour_core::control::FuzzyEngine;
 
 fn main() {
     let n: usize = match std::env::args().nth(1) {

@@ -10,7 +10,9 @@ mod linked;
 use std::ffi::CString;
 use std::ptr;
 
-use contour_fmu::models::{self, Causality, ModelInfo, VarType};
+use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::framework::variables::{Causality, VarType};
+use contour_fmu::models;
 use linked::*;
 
 /// One cycle of `model`; panics on a failed call.

@@ -3,7 +3,7 @@
 //!
 //! Usage: `nurbs_dump <infinity|trident|unit_circle|FILE.json> [COUNT]` (COUNT = 1000).
 
-use contour_fmu::path::{builtin, file, Curve, Nurbs};
+use contour_core::path::{builtin, file, Curve, Nurbs};
 use serde_json::json;
 
 fn main() {

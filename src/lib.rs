@@ -1,15 +1,10 @@
 //! Cross-coupled contour control for CNC axes, shipped as FMI 2.0 Co-Simulation FMUs.
 //!
-//! The algorithm modules (`path`, `contour`, `control`, `plant`, `sim`) know nothing of
-//! FMI; `models` wraps them as variable tables plus step functions, and `fmi2` is the only
-//! place that speaks the FMI C ABI.
+//! The algorithms live in the `contour-core` crate and know nothing of FMI. Here,
+//! [`framework`] is what every FMU is built from (model trait, variable tables, units,
+//! sample clock, state codec and checks), [`models`] holds the six FMUs (and two test-only
+//! ones), and [`fmi2`] is the only place that speaks the FMI C ABI (the only `unsafe`).
 
-pub mod contour;
-pub mod control;
 pub mod fmi2;
-pub mod geometry;
-pub mod kinematics;
+pub mod framework;
 pub mod models;
-pub mod path;
-pub mod plant;
-pub mod sim;

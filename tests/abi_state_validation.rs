@@ -10,12 +10,13 @@
 mod common;
 
 use common::*;
-use contour_fmu::contour::{Estimator, FreeCurveEstimator};
-use contour_fmu::control::{ControllerConfig, CrossCoupledController};
-use contour_fmu::geometry::Vector2;
+use contour_core::contour::planar::{Estimator, FreeCurveEstimator};
+use contour_core::control::{ControllerConfig, CrossCoupledController};
+use contour_core::geometry::Vector2;
+use contour_fmu::framework::variables::Value;
 use contour_fmu::models::{
     contour_ccc_2d as ccc, line_arc_parameters as geometry, path_interpolator_2d as interp,
-    xy_servo_plant as plant, Value,
+    xy_servo_plant as plant,
 };
 
 /// A Ts that appears nowhere else in the state.

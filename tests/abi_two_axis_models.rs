@@ -8,14 +8,15 @@ mod common;
 use std::collections::BTreeMap;
 
 use common::*;
-use contour_fmu::contour::{Estimator, FreeCurveEstimator};
-use contour_fmu::control::{ControllerConfig, CrossCoupledController};
-use contour_fmu::geometry::Vector2;
+use contour_core::contour::planar::{Estimator, FreeCurveEstimator};
+use contour_core::control::{ControllerConfig, CrossCoupledController};
+use contour_core::geometry::Vector2;
+use contour_core::path::{builtin, Interpolator};
+use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::framework::variables::Start;
 use contour_fmu::models::{
     contour_ccc_2d as ccc, line_arc_parameters as geometry, path_interpolator_2d as interp,
-    ModelInfo, Start,
 };
-use contour_fmu::path::{builtin, Interpolator};
 
 const INPUTS: [u32; 4] = [
     ccc::REF.at(0).vr() as u32,
@@ -326,7 +327,7 @@ fn fmusim_sequence<T: PartialEq + std::fmt::Debug>(
 // ---------------------------------------------------------------------------------------
 // Bad parameters
 
-fn real_start(vr: usize, table: &contour_fmu::models::ModelInfo) -> f64 {
+fn real_start(vr: usize, table: &contour_fmu::framework::model::ModelInfo) -> f64 {
     match table.variables[vr].start {
         Start::Real(x) => x,
         other => panic!("{other:?}"),

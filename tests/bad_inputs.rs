@@ -29,9 +29,11 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use common::*;
+use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::framework::variables::{Causality, VarType};
 use contour_fmu::models::{
     contour_ccc_2d, contour_ccc_5x, fault_probe, five_axis_plant, path_interpolator_2d,
-    path_interpolator_5x, xy_servo_plant, Causality, ModelInfo, VarType,
+    path_interpolator_5x, xy_servo_plant,
 };
 
 const C2: &ModelInfo = &contour_ccc_2d::INFO;
@@ -1375,7 +1377,7 @@ static CASES: &[Case] = &[
         Stepping,
         |s| {
             let vr = s.vr("u.x") as usize;
-            s.resealed(|e| e.values.set(vr, contour_fmu::models::Value::Real(f64::NAN)))
+            s.resealed(|e| e.values.set(vr, contour_fmu::framework::variables::Value::Real(f64::NAN)))
         },
         ERROR,
         Some("fmi2DeSerializeFMUstate: the FMU state is invalid: variable 'u.x' refuses the non-finite value NaN"),
@@ -2059,10 +2061,18 @@ impl Subject {
                 continue;
             }
             let status = match v.start {
-                contour_fmu::models::Start::Real(x) => self.set_real(&v.name.to_string(), x),
-                contour_fmu::models::Start::Integer(x) => self.set_integer(&v.name.to_string(), x),
-                contour_fmu::models::Start::Boolean(x) => self.set_boolean(&v.name.to_string(), x),
-                contour_fmu::models::Start::String(x) => self.set_string(&v.name.to_string(), x),
+                contour_fmu::framework::variables::Start::Real(x) => {
+                    self.set_real(&v.name.to_string(), x)
+                }
+                contour_fmu::framework::variables::Start::Integer(x) => {
+                    self.set_integer(&v.name.to_string(), x)
+                }
+                contour_fmu::framework::variables::Start::Boolean(x) => {
+                    self.set_boolean(&v.name.to_string(), x)
+                }
+                contour_fmu::framework::variables::Start::String(x) => {
+                    self.set_string(&v.name.to_string(), x)
+                }
             };
             self.ok(status);
         }

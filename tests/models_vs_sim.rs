@@ -1,5 +1,5 @@
 //! The three FMU models, driven in-process through their variable values the way the FMI
-//! layer drives them (no FMI types), reproduce the in-process simulator (`contour_fmu::sim`)
+//! layer drives them (no FMI types), reproduce the in-process simulator (`contour_core::sim`)
 //! sample for sample.
 //!
 //! The importer here is a few lines over `contour_fmu::models`: each unit holds its
@@ -28,11 +28,11 @@
 //! copy inputs and outputs, and the sample clocks fire once per step at h = Ts). Any
 //! difference at all means the models and the simulator have drifted apart.
 
-use contour_fmu::control::CccMode;
-use contour_fmu::models::{
-    self, Causality, Environment, Model, ModelInfo, Value, Values, Variable, Vr,
-};
-use contour_fmu::sim::{SimConfig, Simulator, Trace};
+use contour_core::control::CccMode;
+use contour_core::sim::{SimConfig, Simulator, Trace};
+use contour_fmu::framework::model::{Environment, Model, ModelInfo};
+use contour_fmu::framework::variables::{Causality, Value, Values, Variable, Vr};
+use contour_fmu::models;
 
 /// One model instance with its values.
 struct Unit {

@@ -10,17 +10,16 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::hint::black_box;
 
-use contour_fmu::contour::{
-    ContourEstimate, ContourEstimator, Estimator, EstimatorKind, TrueErrorIndex,
-};
-use contour_fmu::control::{
+use contour_core::contour::planar::{Estimator, EstimatorKind, TrueErrorIndex};
+use contour_core::contour::{ContourEstimate, ContourEstimator};
+use contour_core::control::{
     CccConfig, CccMode, ControllerConfig, CrossCoupledController, FiveAxisConfig,
     FiveAxisController, FuzzyEngine,
 };
-use contour_fmu::geometry::Vector2;
-use contour_fmu::kinematics::Joints;
-use contour_fmu::path::{builtin, Curve, Interpolator};
-use contour_fmu::sim::{SimConfig, Simulator};
+use contour_core::geometry::Vector2;
+use contour_core::kinematics::Joints;
+use contour_core::path::{builtin, Curve, Interpolator};
+use contour_core::sim::{SimConfig, Simulator};
 
 thread_local! {
     // Const-initialised and without a destructor, so reading it never allocates.
@@ -91,7 +90,8 @@ fn an_fmi_step_round_allocates_nothing_with_logging_off() {
             .variables
             .iter()
             .filter(|v| {
-                v.causality == models::Causality::Input && v.var_type() == models::VarType::Real
+                v.causality == contour_fmu::framework::variables::Causality::Input
+                    && v.var_type() == contour_fmu::framework::variables::VarType::Real
             })
             .map(|v| v.vr as u32)
             .collect();
@@ -99,7 +99,8 @@ fn an_fmi_step_round_allocates_nothing_with_logging_off() {
             .variables
             .iter()
             .filter(|v| {
-                v.causality == models::Causality::Output && v.var_type() == models::VarType::Real
+                v.causality == contour_fmu::framework::variables::Causality::Output
+                    && v.var_type() == contour_fmu::framework::variables::VarType::Real
             })
             .map(|v| v.vr as u32)
             .collect();

@@ -14,7 +14,9 @@ use common::linked::{
 use contour_fmu::fmi2::bindings::{
     fmi2CallbackFunctions, fmi2Component, fmi2Type_fmi2CoSimulation, fmi2ValueReference,
 };
-use contour_fmu::models::{self, Causality, ModelInfo, VarType};
+use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::framework::variables::{Causality, VarType};
+use contour_fmu::models;
 
 const INSTANCES: usize = 64;
 const THREADS: usize = 8;

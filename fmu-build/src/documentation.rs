@@ -3,7 +3,8 @@
 
 use std::fmt::Write;
 
-use contour_fmu::models::{Causality, ModelInfo, Start, Variability};
+use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::framework::variables::{Causality, Start, Variability};
 
 use crate::escape;
 

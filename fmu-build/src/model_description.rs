@@ -5,8 +5,9 @@
 use std::fmt::Write;
 
 use contour_fmu::fmi2::LogCategory;
-use contour_fmu::models::units::{self, UnitDefinition};
-use contour_fmu::models::{Causality, EnumType, ModelInfo, Start, Variable};
+use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::framework::units::{self, UnitDefinition};
+use contour_fmu::framework::variables::{Causality, EnumType, Start, Variable};
 
 use crate::escape;
 

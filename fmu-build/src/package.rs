@@ -8,7 +8,8 @@ use std::path::{Path, PathBuf};
 use zip::write::SimpleFileOptions;
 use zip::CompressionMethod;
 
-use contour_fmu::models::{self, ModelInfo};
+use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::models;
 
 use crate::{documentation, model_description};
 
@@ -67,7 +68,7 @@ impl Resource {
             })?
             .to_string();
         if model == PATH_MODEL && name.to_ascii_lowercase().ends_with(".json") {
-            contour_fmu::path::file::load_nurbs::<2>(&source)
+            contour_core::path::file::load_nurbs::<2>(&source)
                 .map_err(|e| format!("--resource {model}={}: {e}", source.display()))?;
         }
         Ok(Resource {

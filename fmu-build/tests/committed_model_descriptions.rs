@@ -32,7 +32,7 @@ fn every_output_is_listed_once_in_outputs_and_initial_unknowns() {
         let outputs = model
             .variables
             .iter()
-            .filter(|v| v.causality == models::Causality::Output)
+            .filter(|v| v.causality == contour_fmu::framework::variables::Causality::Output)
             .count();
         // Every Unknown states its dependencies explicitly; outputs have no direct
         // feedthrough (empty list), initial values depend on the listed parameters.

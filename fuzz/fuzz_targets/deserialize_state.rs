@@ -27,7 +27,9 @@ use std::ptr;
 use contour_fmu::fmi2::bindings::{
     fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Status, fmi2String,
 };
-use contour_fmu::models::{self, Environment, ModelInfo, Values, VarType};
+use contour_fmu::models;
+use contour_fmu::framework::model::{Environment, ModelInfo};
+use contour_fmu::framework::variables::{Values, VarType};
 use contour_fmu_fuzz::envelope::{self, Mode, Snapshot};
 use contour_fmu_fuzz::*;
 use libfuzzer_sys::fuzz_target;

@@ -23,7 +23,9 @@ use contour_fmu::fmi2::bindings::{
     fmi2Boolean, fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Integer, fmi2Real,
     fmi2Status, fmi2String, fmi2ValueReference,
 };
-use contour_fmu::models::{self, ModelInfo, VarType};
+use contour_fmu::models;
+use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::framework::variables::VarType;
 use contour_fmu_fuzz::*;
 use libfuzzer_sys::fuzz_target;
 

@@ -10,10 +10,10 @@
 //! kinematics. Nothing may panic; every loop in there is bounded.
 #![no_main]
 
-use contour_fmu::kinematics::TableTiltingAc;
-use contour_fmu::path::joint_reference::JointReference;
-use contour_fmu::path::tool_path::ToolPath;
-use contour_fmu::path::{file, Curve, Interpolator, Nurbs, Path};
+use contour_core::kinematics::TableTiltingAc;
+use contour_core::path::JointReference;
+use contour_core::path::ToolPath;
+use contour_core::path::{file, Curve, Interpolator, Nurbs, Path};
 use contour_fmu_fuzz::install_panic_hook;
 use libfuzzer_sys::fuzz_target;
 

@@ -225,7 +225,7 @@ pub fn checking_callbacks(environment: usize) -> fmi2CallbackFunctions {
 /// decoder and the models' `check_state` instead of dying at the CRC. `check_envelope`
 /// (called from each target's init) fails loudly if the library's format moves on.
 pub mod envelope {
-    use contour_fmu::models::Values;
+    use contour_fmu::framework::variables::Values;
     use serde::{Deserialize, Serialize};
 
     pub const MAGIC: &[u8; 8] = b"CCCFMUst";
@@ -292,7 +292,7 @@ pub mod envelope {
 /// # Safety
 /// `functions` outlives the instance.
 pub unsafe fn started(
-    model: &contour_fmu::models::ModelInfo,
+    model: &contour_fmu::framework::model::ModelInfo,
     functions: *const fmi2CallbackFunctions,
 ) -> fmi2Component {
     let guid = std::ffi::CString::new(model.guid()).expect("GUID without NUL");

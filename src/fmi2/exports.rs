@@ -17,7 +17,9 @@ use super::registry::{self, InstanceCell};
 use super::resource_uri::resource_dir;
 use super::state_machine::{Call, Mode};
 use super::status::{Failure, Outcome, Status};
-use crate::models::{self, Environment, Value, VarType};
+use crate::framework::model::Environment;
+use crate::framework::variables::{Value, VarType};
+use crate::models;
 
 fn lock(cell: &InstanceCell) -> MutexGuard<'_, Instance> {
     // A poisoned lock means an earlier call panicked: the instance is already marked

@@ -3,14 +3,14 @@
 //!
 //! Layout: `MAGIC` (8 bytes) · format version (u16 LE) · postcard payload · CRC-32 of
 //! everything before it (u32 LE). The payload's model part starts with the model's own
-//! state layout version (`crate::models::StateLayout`), checked by the model.
+//! state layout version (`crate::framework::state_codec::StateLayout`), checked by the model.
 //!
 //! Format versions: 1 had model bytes without a layout version; 2 adds it.
 
 use serde::{Deserialize, Serialize};
 
 use super::state_machine::Mode;
-use crate::models::Values;
+use crate::framework::variables::Values;
 
 const MAGIC: &[u8; 8] = b"CCCFMUst";
 /// The library that wrote a state, for messages (each model's state layout version, not
@@ -80,7 +80,7 @@ pub fn decode(bytes: &[u8]) -> Result<Snapshot, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::{Value, Values};
+    use crate::framework::variables::{Value, Values};
 
     fn sample() -> Snapshot {
         let mut values = Values::from_table(crate::models::xy_servo_plant::INFO.variables);

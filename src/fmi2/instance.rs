@@ -10,7 +10,8 @@ use super::logger::{to_c_string, Category, Logger};
 use super::registry;
 use super::state_machine::{Call, Mode};
 use super::status::{Failure, Outcome, Status};
-use crate::models::{Causality, Environment, Model, ModelInfo, Value, Values, Variability, Vr};
+use crate::framework::model::{Environment, Model, ModelInfo};
+use crate::framework::variables::{Causality, Value, Values, Variability, Vr};
 
 /// Relative tolerance when comparing the importer's communication point with our clock:
 /// importers accumulate time in floating point (fmpy: 0.009999999999999998).
@@ -154,7 +155,7 @@ impl Instance {
         Ok(())
     }
 
-    fn variable(&self, vr: u32) -> Outcome<&'static crate::models::Variable> {
+    fn variable(&self, vr: u32) -> Outcome<&'static crate::framework::variables::Variable> {
         self.info
             .variable(vr as Vr)
             .ok_or_else(|| Failure::error(format!("unknown value reference {vr}")))
@@ -175,7 +176,11 @@ impl Instance {
     }
 
     /// `fmi2GetReal` and friends for one type: checks the type of every reference first.
-    pub fn check_type(&self, vrs: &[u32], expected: crate::models::VarType) -> Outcome {
+    pub fn check_type(
+        &self,
+        vrs: &[u32],
+        expected: crate::framework::variables::VarType,
+    ) -> Outcome {
         for &vr in vrs {
             let v = self.variable(vr)?;
             if v.var_type() != expected {
@@ -192,7 +197,7 @@ impl Instance {
 
     /// Keeps C copies of strings alive until the next call on this instance.
     pub fn hold_strings(&mut self, vrs: &[u32]) -> Outcome<&[CString]> {
-        self.check_type(vrs, crate::models::VarType::String)?;
+        self.check_type(vrs, crate::framework::variables::VarType::String)?;
         if self.mode == Mode::Initialization {
             self.initialize_if_needed()?;
         }
@@ -501,7 +506,8 @@ impl Instance {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::{path_interpolator_2d, Environment};
+    use crate::framework::model::Environment;
+    use crate::models::path_interpolator_2d;
 
     fn started_at(start: f64) -> Instance {
         let logger = Logger::new(None, std::ptr::null_mut(), "t", false);

@@ -2,7 +2,7 @@
 //! one description wherever it appears (the two-axis models name their axes x, y; the
 //! five-axis ones X … C, with rad for the rotary joints).
 
-use super::variable_table::{AxisTemplate, AxisUnit, AxisWord};
+use crate::framework::variable_table::{AxisTemplate, AxisUnit, AxisWord};
 
 /// A reference output of an interpolator: `ref.<axis>`.
 pub const REFERENCE_OUT: AxisTemplate =

@@ -5,19 +5,21 @@
 
 use super::axis_variables::{COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_IN};
 use super::controller_parameters::{self, axis_gain, nonnegative};
-use super::sample_clock::{check_period, SampleClock};
-use super::variable_table::{axis_block, variable_table, AxisUnit, XY};
-use super::variables::{EnumItem, EnumType, Start, Values, Variable};
-use super::{
-    line_arc_parameters, state_check, DefaultExperiment, Environment, Model, ModelInfo,
-    ModelResult, SavedState, StateLayout,
+use super::line_arc_parameters;
+use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
+use crate::framework::sample_clock::{check_period, SampleClock};
+use crate::framework::state_check;
+use crate::framework::state_codec::{SavedState, StateLayout};
+use crate::framework::variable_table::{axis_block, variable_table, AxisUnit, XY};
+use crate::framework::variables::{EnumItem, EnumType, Start, Values, Variable};
+use contour_core::contour::planar::{
+    ArcEstimator, Estimator, EstimatorKind, FreeCurveEstimator, LineEstimator,
 };
-use crate::contour::{ArcEstimator, Estimator, EstimatorKind, FreeCurveEstimator, LineEstimator};
-use crate::control::{
+use contour_core::control::{
     CccConfig, ConfigError, ControllerConfig, CrossCoupledController, FuzzyFactor, FuzzyFactors,
     Parameter, PidGains,
 };
-use crate::geometry::{Vector, Vector2};
+use contour_core::geometry::{Vector, Vector2};
 
 /// The three contour gains in use, as one block.
 type Vector3 = Vector<3>;
@@ -129,7 +131,7 @@ pub static INFO: ModelInfo = ModelInfo {
     },
     // Every output starts at 0: the control law first runs in fmi2DoStep.
     initial_dependencies: &[],
-    create: |_: &Environment| Box::new(ContourCcc2D { state: None }),
+    create: |_: &Environment| Box::new(ContourCCC2D { state: None }),
 };
 
 /// `Option<State>` as below. Version 2: the controller became N-axis (per-axis contour
@@ -163,18 +165,26 @@ impl SavedState for State {
             ));
         }
         for (axis, pid) in XY.iter().zip(controller.axes()) {
-            state_check::check_pid(&format!("{} position loop", axis.label), pid, config.ts)?;
+            controller_parameters::check_pid(
+                &format!("{} position loop", axis.label),
+                pid,
+                config.ts,
+            )?;
         }
-        state_check::check_pid("contour PID", controller.law().pid(), config.ts)?;
+        controller_parameters::check_pid("contour PID", controller.law().pid(), config.ts)?;
         for (axis, pid) in XY.iter().zip(controller.contour_axes()) {
-            state_check::check_pid(&format!("{} contour PID", axis.label), pid, config.ts)?;
+            controller_parameters::check_pid(
+                &format!("{} contour PID", axis.label),
+                pid,
+                config.ts,
+            )?;
         }
         state_check::all_positive(self, "radius").map_err(|e| format!("estimator: {e}"))?;
         state_check::all_finite(self)
     }
 }
 
-pub struct ContourCcc2D {
+pub struct ContourCCC2D {
     state: Option<State>,
 }
 
@@ -266,7 +276,7 @@ fn estimator(values: &Values) -> Result<Estimator, String> {
     })
 }
 
-impl Model for ContourCcc2D {
+impl Model for ContourCCC2D {
     fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult {
         check_period("Ts", TS.get(values))?;
         let config = config(values);
@@ -298,7 +308,7 @@ impl Model for ContourCcc2D {
         Ok(())
     }
 
-    super::sampled_state_methods!(State, LAYOUT);
+    crate::framework::state_codec::sampled_state_methods!(State, LAYOUT);
 }
 
 #[cfg(test)]
@@ -343,11 +353,17 @@ mod tests {
             .enumerate()
         {
             assert_eq!(item.name, kind.as_str());
-            values.set(ESTIMATOR.vr(), super::super::Value::Integer(i as i32 + 1));
+            values.set(
+                ESTIMATOR.vr(),
+                crate::framework::variables::Value::Integer(i as i32 + 1),
+            );
             assert_eq!(estimator_kind(&values), Ok(kind));
         }
         for bad in [0, 4, -1] {
-            values.set(ESTIMATOR.vr(), super::super::Value::Integer(bad));
+            values.set(
+                ESTIMATOR.vr(),
+                crate::framework::variables::Value::Integer(bad),
+            );
             let message = estimator_kind(&values).unwrap_err();
             assert!(
                 message.contains("1 = free_curve, 2 = line, 3 = arc"),

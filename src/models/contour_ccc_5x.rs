@@ -9,19 +9,17 @@
 use super::axis_variables::{COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_IN};
 use super::controller_parameters::{self, axis_gain, nonnegative};
 use super::kinematics_parameters;
-use super::sample_clock::{check_period, SampleClock};
-use super::state_check;
-use super::variable_table::{axis_block, variable_table, AxisUnit, Int, XYZAC};
-use super::variables::{Start, Values, Variable};
-use super::{
-    DefaultExperiment, Environment, Model, ModelInfo, ModelResult, SavedState, StateLayout,
-};
-use crate::contour::hmm::HmmParams;
-use crate::control::five_axis::{FiveAxisConfig, FiveAxisController};
-use crate::control::{
+use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
+use crate::framework::sample_clock::{check_period, SampleClock};
+use crate::framework::state_codec::{SavedState, StateLayout};
+use crate::framework::variable_table::{axis_block, variable_table, AxisUnit, Int, XYZAC};
+use crate::framework::variables::{Start, Values, Variable};
+use contour_core::contour::five_axis::hmm::HmmParams;
+use contour_core::control::{
     CccConfig, CccMode, ConfigError, FuzzyFactor, FuzzyFactors, Parameter, PidGains,
 };
-use crate::geometry::Vector;
+use contour_core::control::{FiveAxisConfig, FiveAxisController};
+use contour_core::geometry::Vector;
 
 /// Start values: the controller library's documented defaults.
 const DEFAULT: FiveAxisConfig = FiveAxisConfig::DEFAULT;
@@ -211,7 +209,7 @@ pub static INFO: ModelInfo = ModelInfo {
     },
     // Every output starts at 0: the control law first runs in fmi2DoStep.
     initial_dependencies: &[],
-    create: |_: &Environment| Box::new(ContourCcc5X { state: None }),
+    create: |_: &Environment| Box::new(ContourCCC5X { state: None }),
 };
 
 /// Version 1: `Option<State>` as below.
@@ -242,19 +240,27 @@ impl SavedState for State {
             ));
         }
         for (axis, pid) in XYZAC.iter().zip(controller.axes()) {
-            state_check::check_pid(&format!("{} position loop", axis.label), pid, config.ts)?;
+            controller_parameters::check_pid(
+                &format!("{} position loop", axis.label),
+                pid,
+                config.ts,
+            )?;
         }
         for (name, law) in ["tip", "orientation"].iter().zip(controller.laws()) {
-            state_check::check_pid(&format!("{name} law"), law.law().pid(), config.ts)?;
+            controller_parameters::check_pid(&format!("{name} law"), law.law().pid(), config.ts)?;
             for (axis, pid) in ["x", "y", "z"].iter().zip(law.components()) {
-                state_check::check_pid(&format!("{name} law, {axis} component"), pid, config.ts)?;
+                controller_parameters::check_pid(
+                    &format!("{name} law, {axis} component"),
+                    pid,
+                    config.ts,
+                )?;
             }
         }
         controller.check_memory()
     }
 }
 
-pub struct ContourCcc5X {
+pub struct ContourCCC5X {
     state: Option<State>,
 }
 
@@ -343,7 +349,7 @@ fn config_message(e: ConfigError) -> String {
     }
 }
 
-impl ContourCcc5X {
+impl ContourCCC5X {
     fn write_zero_outputs(values: &mut Values) {
         U.set(values, &Vector::<5>::zeros());
         ERR.set(values, &Vector::<5>::zeros());
@@ -359,7 +365,7 @@ impl ContourCcc5X {
     }
 }
 
-impl Model for ContourCcc5X {
+impl Model for ContourCCC5X {
     fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult {
         check_period("Ts", TS.get(values))?;
         let config = config(values);
@@ -386,7 +392,7 @@ impl Model for ContourCcc5X {
             U.set(values, &out.u);
             ERR.set(values, &out.following_error);
             let (tip, orientation) = out.error.map_or((0.0, 0.0), |e| {
-                (crate::geometry::norm(&e.tip), e.orientation)
+                (contour_core::geometry::norm(&e.tip), e.orientation)
             });
             TIP_ERROR.set(values, tip);
             ORIENTATION_ERROR.set(values, orientation);
@@ -400,7 +406,7 @@ impl Model for ContourCcc5X {
         Ok(())
     }
 
-    super::sampled_state_methods!(State, LAYOUT);
+    crate::framework::state_codec::sampled_state_methods!(State, LAYOUT);
 }
 
 #[cfg(test)]

@@ -2,9 +2,9 @@
 //! gains that must be ≥ 0, per-axis position-loop gains, and the CCC mode from the two
 //! switches.
 
-use super::variable_table::{AxisTemplate, AxisUnit, AxisWord};
-use super::variables::{Start, Variable};
-use crate::control::{CccMode, Gain};
+use crate::framework::variable_table::{AxisTemplate, AxisUnit, AxisWord};
+use crate::framework::variables::{Start, Variable};
+use contour_core::control::{CccMode, Gain, Pid};
 
 /// A Real parameter ≥ 0 (a gain or factor).
 pub const fn nonnegative(name: &'static str, start: f64, description: &'static str) -> Variable {
@@ -43,4 +43,40 @@ pub fn gain_index(gain: Gain) -> usize {
         Gain::Ki => 1,
         Gain::Kd => 2,
     }
+}
+
+/// A PID restored from bytes: its period, gains, limit and memory (integral and previous
+/// error) as the configuration would have made them.
+pub fn check_pid(name: &str, pid: &Pid, ts: f64) -> Result<(), String> {
+    if pid.ts() != ts {
+        return Err(format!(
+            "{name}: PID sample period {} s differs from Ts = {ts} s",
+            pid.ts()
+        ));
+    }
+    if !pid.integral().is_finite() {
+        return Err(format!(
+            "{name}: PID memory (integral) = {} is not finite",
+            pid.integral()
+        ));
+    }
+    if let Some(e) = pid.previous_error().filter(|e| !e.is_finite()) {
+        return Err(format!(
+            "{name}: PID memory (previous error) = {e} is not finite"
+        ));
+    }
+    let g = pid.gains();
+    for (gain, value) in [("Kp", g.kp), ("Ki", g.ki), ("Kd", g.kd)] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(format!(
+                "{name}: PID gain {gain} = {value} must be finite and >= 0"
+            ));
+        }
+    }
+    if let Some(limit) = pid.limit().filter(|l| !(l.is_finite() && *l > 0.0)) {
+        return Err(format!(
+            "{name}: PID output limit {limit} must be finite and > 0"
+        ));
+    }
+    Ok(())
 }

@@ -2,12 +2,11 @@
 //! panics on demand, so the ABI tests can drive the FMI layer into its `Error` and
 //! `Fatal` modes and check that a panic becomes `fmi2Fatal`, never an abort.
 
-use super::variable_table::variable_table;
-use super::variables::{Start, Values, Variable};
-use super::{
-    decode_state, encode_state, DefaultExperiment, Environment, Model, ModelInfo, ModelResult,
-    StateLayout, Value,
-};
+use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
+use crate::framework::state_codec::{decode_state, encode_state, StateLayout};
+use crate::framework::variable_table::variable_table;
+use crate::framework::variables::Value;
+use crate::framework::variables::{Start, Values, Variable};
 
 variable_table! {
     static VARIABLES;

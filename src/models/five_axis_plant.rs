@@ -5,10 +5,11 @@
 
 use super::axis_variables::{COMMAND_IN, INITIAL_POSITION, POSITION_OUT, VELOCITY_OUT};
 use super::servo_plant::{self, FIELDS};
-use super::variable_table::{axis_block, variable_table, Axis, XYZAC};
-use super::variables::Values;
-use super::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult, StateLayout};
-use crate::plant::{AxisParams, ServoAxes, ServoAxesParams};
+use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
+use crate::framework::state_codec::StateLayout;
+use crate::framework::variable_table::{axis_block, variable_table, Axis, XYZAC};
+use crate::framework::variables::Values;
+use contour_core::plant::{AxisParams, ServoAxes, ServoAxesParams};
 
 const PLANT: ServoAxesParams<5> = ServoAxesParams::<5>::TRUNNION;
 
@@ -69,7 +70,7 @@ impl Default for FiveAxisPlant {
     }
 }
 
-type Vector5 = crate::geometry::Vector<5>;
+type Vector5 = contour_core::geometry::Vector<5>;
 
 /// The parameters of joint `index` (X, Y, Z, A, C).
 fn axis_params(values: &Values, index: usize) -> Result<AxisParams, String> {

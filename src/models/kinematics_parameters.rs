@@ -3,10 +3,10 @@
 //! defaults in both, so one set of values describes one machine. Default: both pivots
 //! at the machine origin, LinuxCNC's A–C trunnion convention (docs/design.md §5.1).
 
-use super::variable_table::Reals;
-use super::variables::{Start, Values, Variable};
-use crate::geometry::Vector;
-use crate::kinematics::TableTiltingAc;
+use crate::framework::variable_table::Reals;
+use crate::framework::variables::{Start, Values, Variable};
+use contour_core::geometry::Vector;
+use contour_core::kinematics::TableTiltingAc;
 
 /// Number of variables in the block.
 pub const COUNT: usize = 4;

@@ -1,13 +1,13 @@
 //! The line and arc geometry parameters shared by `PathInterpolator2D` (the path to
 //! follow) and `ContourCCC2D` (the exact line/arc estimators): the same names and
 //! defaults in both FMUs, so one set of values describes one path. The defaults are the
-//! built-in `line` and `arc` paths (crate::path::builtin).
+//! built-in `line` and `arc` paths (contour_core::path::builtin).
 
 use std::f64::consts::PI;
 
-use super::variable_table::Reals;
-use super::variables::{Start, Values, Variable};
-use crate::path::{Arc, Line};
+use crate::framework::variable_table::Reals;
+use crate::framework::variables::{Start, Values, Variable};
+use contour_core::path::{CircularArc, Line};
 
 /// Number of variables in the block.
 pub const COUNT: usize = 9;
@@ -61,8 +61,8 @@ pub fn line(values: &Values, block: Block) -> Result<Line, String> {
 }
 
 /// The arc of the block.
-pub fn arc(values: &Values, block: Block) -> Result<Arc, String> {
+pub fn arc(values: &Values, block: Block) -> Result<CircularArc, String> {
     let v = block.get(values);
-    Arc::new([v[ARC_CX], v[ARC_CY]], v[ARC_R], v[ARC_START], v[ARC_SWEEP])
+    CircularArc::new([v[ARC_CX], v[ARC_CY]], v[ARC_R], v[ARC_START], v[ARC_SWEEP])
         .map_err(|e| format!("parameters 'arc.*': {e}"))
 }

@@ -6,12 +6,11 @@
 //! number of values as for each of them: `fmi2SetReal` of 4 inputs / `fmi2GetReal` of 3
 //! outputs for `ContourCCC2D`, 10 / 7 for `ContourCCC5X`.
 
-use super::variable_table::variable_table;
-use super::variables::Values;
-use super::{
-    decode_state, encode_state, DefaultExperiment, Environment, Model, ModelInfo, ModelResult,
-    StateLayout, Variable,
-};
+use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
+use crate::framework::state_codec::{decode_state, encode_state, StateLayout};
+use crate::framework::variable_table::variable_table;
+use crate::framework::variables::Values;
+use crate::framework::variables::Variable;
 
 variable_table! {
     static VARIABLES;

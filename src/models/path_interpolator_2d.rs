@@ -5,14 +5,14 @@
 use std::f64::consts::PI;
 
 use super::axis_variables::REFERENCE_OUT;
-use super::sample_clock::{check_period, SampleClock};
-use super::variable_table::{axis_block, variable_table, Real, XY};
-use super::variables::{Start, Values, Variable};
-use super::{
-    line_arc_parameters, state_check, DefaultExperiment, Environment, Model, ModelInfo,
-    ModelResult, SavedState, StateLayout,
-};
-use crate::path::{Arc, Curve, Interpolator, Line, Path};
+use super::line_arc_parameters;
+use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
+use crate::framework::sample_clock::{check_period, SampleClock};
+use crate::framework::state_check;
+use crate::framework::state_codec::{SavedState, StateLayout};
+use crate::framework::variable_table::{axis_block, variable_table, Real, XY};
+use crate::framework::variables::{Start, Values, Variable};
+use contour_core::path::{CircularArc, Curve, Interpolator, Line, Path};
 
 variable_table! {
     static VARIABLES;
@@ -122,7 +122,7 @@ impl SavedState for State {
             Path::Line(l) => Line::new(l.start(), l.end())
                 .map(drop)
                 .map_err(|e| format!("interpolator path: {e}"))?,
-            Path::Arc(a) => Arc::new(a.center(), a.radius(), a.start_angle(), a.sweep())
+            Path::Arc(a) => CircularArc::new(a.center(), a.radius(), a.start_angle(), a.sweep())
                 .map(drop)
                 .map_err(|e| format!("interpolator path: {e}"))?,
             Path::Nurbs(_) => {}
@@ -216,13 +216,13 @@ impl Model for PathInterpolator2D {
         Ok(())
     }
 
-    super::sampled_state_methods!(State, LAYOUT);
+    crate::framework::state_codec::sampled_state_methods!(State, LAYOUT);
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::path::builtin;
+    use contour_core::path::builtin;
 
     #[test]
     fn start_values_give_the_papers_circle_and_geometry_defaults_the_built_ins() {
@@ -233,7 +233,10 @@ mod tests {
             builtin::by_name("circle").unwrap()
         );
         for name in ["line", "arc"] {
-            values.set(PATH.vr(), super::super::Value::String(name.into()));
+            values.set(
+                PATH.vr(),
+                crate::framework::variables::Value::String(name.into()),
+            );
             assert_eq!(
                 path(&values, &env).unwrap(),
                 builtin::by_name(name).unwrap()

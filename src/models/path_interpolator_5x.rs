@@ -8,15 +8,14 @@ use std::path::Path;
 
 use super::axis_variables::REFERENCE_OUT;
 use super::kinematics_parameters;
-use super::sample_clock::{check_period, SampleClock};
-use super::variable_table::{axis_block, variable_table, XYZAC};
-use super::variables::{Start, Values, Variable};
-use super::{
-    DefaultExperiment, Environment, Model, ModelInfo, ModelResult, SavedState, StateLayout,
-};
-use crate::kinematics::TableTiltingAc;
-use crate::path::joint_reference::JointReference;
-use crate::path::tool_path::{ToolPath, BUILTIN_TOOL_PATHS};
+use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
+use crate::framework::sample_clock::{check_period, SampleClock};
+use crate::framework::state_codec::{SavedState, StateLayout};
+use crate::framework::variable_table::{axis_block, variable_table, XYZAC};
+use crate::framework::variables::{Start, Values, Variable};
+use contour_core::kinematics::TableTiltingAc;
+use contour_core::path::JointReference;
+use contour_core::path::{ToolPath, BUILTIN_TOOL_PATHS};
 
 variable_table! {
     static VARIABLES;
@@ -132,7 +131,7 @@ fn joint_reference(
     ts: f64,
 ) -> Result<(JointReference, Vec<String>), String> {
     let spec = spec.trim();
-    let message = |e: crate::path::PathError| format!("parameter 'path': {e}");
+    let message = |e: contour_core::path::PathError| format!("parameter 'path': {e}");
     let file = Path::new(spec);
     // A bare name is a built-in (the error lists them); anything else is a file.
     let bare = file.extension().is_none() && !spec.contains(['/', '\\']);
@@ -195,7 +194,7 @@ impl Model for PathInterpolator5X {
         Ok(())
     }
 
-    super::sampled_state_methods!(State, LAYOUT);
+    crate::framework::state_codec::sampled_state_methods!(State, LAYOUT);
 }
 
 impl PathInterpolator5X {

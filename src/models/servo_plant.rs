@@ -2,10 +2,11 @@
 //! axis's drive parameters from a block of six (J, B, CT, lead or ratio, Kvp, Kvi), and
 //! checking a restored table of axes.
 
-use super::variable_table::{Axis, AxisKind, AxisTemplate, AxisUnit, AxisWord, Reals};
-use super::variables::{Values, Variable};
-use super::{decode_state, state_check, StateLayout};
-use crate::plant::{AxisParams, ServoAxes, ServoAxis, Transmission};
+use crate::framework::state_check;
+use crate::framework::state_codec::{decode_state, StateLayout};
+use crate::framework::variable_table::{Axis, AxisKind, AxisTemplate, AxisUnit, AxisWord, Reals};
+use crate::framework::variables::{Values, Variable};
+use contour_core::plant::{AxisParams, ServoAxes, ServoAxis, Transmission};
 
 /// Drive parameters per axis, in [`AxisParams`] field order.
 pub const FIELDS: usize = 6;
@@ -120,14 +121,18 @@ pub fn axis_params<const N: usize>(
 macro_rules! plant_state_methods {
     ($layout:expr, $axes:expr) => {
         fn save_state(&self) -> Result<Vec<u8>, String> {
-            $crate::models::encode_state($layout, &self.table)
+            $crate::framework::state_codec::encode_state($layout, &self.table)
         }
 
-        fn check_state(&self, bytes: &[u8], _time: f64) -> $crate::models::ModelResult {
+        fn check_state(&self, bytes: &[u8], _time: f64) -> $crate::framework::model::ModelResult {
             $crate::models::servo_plant::decode(bytes, $layout, &$axes).map(drop)
         }
 
-        fn restore_state(&mut self, bytes: &[u8], _time: f64) -> $crate::models::ModelResult {
+        fn restore_state(
+            &mut self,
+            bytes: &[u8],
+            _time: f64,
+        ) -> $crate::framework::model::ModelResult {
             self.table = $crate::models::servo_plant::decode(bytes, $layout, &$axes)?;
             Ok(())
         }

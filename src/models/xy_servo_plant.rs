@@ -3,12 +3,12 @@
 //! not depend on the communication step.
 
 use super::axis_variables::{COMMAND_IN, INITIAL_POSITION, POSITION_OUT, VELOCITY_OUT};
-use super::variable_table::{axis_block, variable_table, AxisTemplate, XY};
-use super::variables::Values;
-use super::{
-    servo_plant, DefaultExperiment, Environment, Model, ModelInfo, ModelResult, StateLayout,
-};
-use crate::plant::{AxisParams, XyTable, XyTableParams};
+use super::servo_plant;
+use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
+use crate::framework::state_codec::StateLayout;
+use crate::framework::variable_table::{axis_block, variable_table, AxisTemplate, XY};
+use crate::framework::variables::Values;
+use contour_core::plant::{AxisParams, XyTable, XyTableParams};
 
 const P: AxisParams = AxisParams::PAPER;
 /// The drive parameters, in [`AxisParams`] field order.
@@ -40,7 +40,7 @@ pub static INFO: ModelInfo = ModelInfo {
         (POS.at(0).vr(), &[POS0.at(0).vr()]),
         (POS.at(1).vr(), &[POS0.at(1).vr()]),
     ],
-    create: |_: &Environment| Box::new(XyServoPlant::default()),
+    create: |_: &Environment| Box::new(XYServoPlant::default()),
 };
 
 /// The [`XyTable`] as it serialises. Version 2: each axis's lead became a
@@ -51,13 +51,13 @@ const LAYOUT: StateLayout = StateLayout {
 };
 
 /// The plant model; its state is the table's.
-pub struct XyServoPlant {
+pub struct XYServoPlant {
     table: XyTable,
 }
 
-impl Default for XyServoPlant {
+impl Default for XYServoPlant {
     fn default() -> Self {
-        XyServoPlant {
+        XYServoPlant {
             table: XyTable::new(XyTableParams::PAPER, [0.0, 0.0].into()),
         }
     }
@@ -74,14 +74,14 @@ fn axis_params(values: &Values, index: usize) -> Result<AxisParams, String> {
     )
 }
 
-impl XyServoPlant {
+impl XYServoPlant {
     fn write_outputs(&self, values: &mut Values) {
         POS.set(values, &self.table.position());
         VEL.set(values, &self.table.velocity());
     }
 }
 
-impl Model for XyServoPlant {
+impl Model for XYServoPlant {
     fn initialize(&mut self, values: &mut Values, _start_time: f64) -> ModelResult {
         let params = XyTableParams {
             axes: [axis_params(values, 0)?, axis_params(values, 1)?],

@@ -16,7 +16,8 @@ use contour_fmu::fmi2::bindings::{
     fmi2ComponentEnvironment, fmi2FMUstate, fmi2Real, fmi2Status, fmi2String, fmi2Type,
     fmi2Type_fmi2CoSimulation, fmi2ValueReference,
 };
-use contour_fmu::models::{self, ModelInfo};
+use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::models;
 
 extern "C" {
     pub fn fmi2Instantiate(

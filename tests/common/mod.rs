@@ -6,7 +6,8 @@ use std::ffi::{c_char, c_void, CStr, CString};
 use std::path::PathBuf;
 use std::sync::{Mutex, OnceLock};
 
-use contour_fmu::models::{ModelInfo, Values};
+use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::framework::variables::Values;
 // Generated from third_party/fmi2/ by `cargo run -p xtask -- bindings` (kept as bindgen
 // wrote it): `Fmi2Binding`, the dlopen'ed library's functions; the FMI 2.0 types are the
 // library's own.

@@ -6,7 +6,7 @@ one axis in the normal direction, regulated by the axis P loop (Kpp) plus the CC
 (Kp, Ki, Kd). The axis is the test plant of §4.5: a PI velocity loop on the motor
 (states: velocity-error integral, motor speed, motor angle), driven by a velocity command
 held over each sample (zero-order hold, exact matrix exponential). The controller is the
-discrete PID of src/control/pid.rs: u = (Kpp + Kp)·e + Ki·Σe·Ts + Kd·(e − e_prev)/Ts, with
+discrete PID of contour-core/src/control/pid.rs: u = (Kpp + Kp)·e + Ki·Σe·Ts + Kd·(e − e_prev)/Ts, with
 the current sample in the sum. The loop is stable when every eigenvalue of the sampled
 closed loop lies inside the unit circle.
 """

@@ -1,4 +1,4 @@
-"""The Rust closed loop (src/sim/) against an independent scipy model of the same loop.
+"""The Rust closed loop (contour-core/src/sim/) against an independent scipy model of the same loop.
 
 Python side, written from docs/design.md §4.2/4.5 and not from the Rust code: each axis in motor
 coordinates (angle theta, speed omega, drive integrator z),

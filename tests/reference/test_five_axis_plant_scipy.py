@@ -1,7 +1,7 @@
-"""The Rust five-axis test plant (src/plant/, `ServoAxesParams::<5>::TRUNNION`) against
+"""The Rust five-axis test plant (contour-core/src/plant/, `ServoAxesParams::<5>::TRUNNION`) against
 independent scipy models of its five servo axes.
 
-Python side, written from the physics in the docs of src/plant/servo_axis.rs (§4.5 of
+Python side, written from the physics in the docs of contour-core/src/plant/servo_axis.rs (§4.5 of
 docs/design.md), not from the Rust matrices: each axis in motor coordinates — motor angle
 theta, motor speed omega, drive integrator zeta of the speed error —
 

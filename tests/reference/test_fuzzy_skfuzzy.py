@@ -1,9 +1,9 @@
-"""The Rust Mamdani engine (src/control/fuzzy.rs) against scikit-fuzzy (docs/design.md §4.3).
+"""The Rust Mamdani engine (contour-core/src/control/fuzzy.rs) against scikit-fuzzy (docs/design.md §4.3).
 
 scikit-fuzzy builds the same system from its own parts: triangular sets sampled on a
 20001-point universe, `min` for AND, clipping (`min`) implication, `max` accumulation
 and centroid defuzzification. The rule tables below are transcribed here from docs/design.md §4.3
-independently of `src/control/rules.rs`.
+independently of `contour-core/src/control/rules.rs`.
 
 Fairness notes (checked against the scikit-fuzzy 0.5 sources):
 - The universe is [-3, 3] and every grid input lies on it, so defining NB and PB as

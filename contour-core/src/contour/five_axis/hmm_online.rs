@@ -1,0 +1,388 @@
+//! The online form of the HMM segment mapping (docs/design.md §5.2): the reference and
+//! the measured samples arrive one at a time. Only the `band` newest segments are
+//! candidates, and a sample's mapping can be read back `lag` samples later, so the work
+//! per sample is O(band·max_skip + lag) whatever the path's length — less with a beam,
+//! which drops the states that have fallen far behind the best — and nothing is
+//! allocated after construction (every buffer is a ring of fixed size).
+//!
+//! With a band covering the whole reference and a lag covering the whole run it decodes
+//! what [`viterbi_offline`](super::hmm::viterbi_offline) decodes.
+
+use serde::{Deserialize, Serialize};
+
+use super::hmm::{segment_cost, HmmParams};
+use crate::geometry::{self, Vector};
+use crate::kinematics::Pose;
+
+/// The online decoder. It serialises whole (for FMU state save/restore); bytes from
+/// elsewhere go through [`OnlineMapper::check`] before use.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OnlineMapper {
+    params: HmmParams,
+    length: f64,
+    band: usize,
+    lag: usize,
+    /// Ring capacity − 1: the rings hold a power of two ≥ band + 1 entries, so an index
+    /// wraps with a mask instead of a division (several per segment and sample).
+    mask: usize,
+    /// The newest reference tips, unit axes and second points (index & mask).
+    tips: Vec<Vector<3>>,
+    axes: Vec<Vector<3>>,
+    seconds: Vec<Vector<3>>,
+    references: usize,
+    /// C(k, j) of the latest sample for j in `valid` (index j & mask).
+    cost: Vec<f64>,
+    next: Vec<f64>,
+    valid: (usize, usize),
+    /// Predecessors (absolute segments) of the last `lag + 1` samples: row k mod
+    /// (lag + 1), column j & mask.
+    back: Vec<usize>,
+    samples: usize,
+    previous_tip: Option<Vector<3>>,
+    /// States whose cost exceeds the best by more than this are dropped (mm of summed
+    /// cost; infinite: none, the exact decoder).
+    beam: f64,
+}
+
+impl OnlineMapper {
+    /// A decoder over the `band` (≥ 1) newest segments that can read back `lag` samples;
+    /// `length` is the tool length of the second points, mm.
+    pub fn new(params: HmmParams, length: f64, band: usize, lag: usize) -> Self {
+        let band = band.max(1);
+        let capacity = (band + 1).next_power_of_two();
+        OnlineMapper {
+            params,
+            length,
+            band,
+            lag,
+            mask: capacity - 1,
+            tips: vec![Vector::zeros(); capacity],
+            axes: vec![Vector::zeros(); capacity],
+            seconds: vec![Vector::zeros(); capacity],
+            references: 0,
+            cost: vec![f64::INFINITY; capacity],
+            next: vec![f64::INFINITY; capacity],
+            valid: (0, 0),
+            back: vec![0; (lag + 1) * capacity],
+            samples: 0,
+            previous_tip: None,
+            beam: f64::INFINITY,
+        }
+    }
+
+    /// The same decoder keeping only the states within `beam` (mm of summed cost) of the
+    /// best: a state that far behind has fallen off the measured tool for good (every
+    /// sample adds its distance), and dropping it shrinks the work from the whole band to
+    /// the few segments around the tool. A non-positive or NaN beam keeps every state.
+    pub fn with_beam(mut self, beam: f64) -> Self {
+        self.beam = if beam > 0.0 { beam } else { f64::INFINITY };
+        self
+    }
+
+    /// Appends the next reference point (tip and unit tool axis).
+    pub fn push_reference(&mut self, tip: Vector<3>, axis: Vector<3>) {
+        let slot = self.references & self.mask;
+        self.tips[slot] = tip;
+        self.axes[slot] = axis;
+        self.seconds[slot] = tip + axis * self.length;
+        self.references += 1;
+    }
+
+    /// Checks what construction and use guarantee, for a decoder restored from bytes:
+    /// ring sizes that match the band and lag, a live range inside the band, finite
+    /// points and parameters. The error names the first violation.
+    pub fn check(&self) -> Result<(), String> {
+        let capacity = (self.band.max(1) + 1).next_power_of_two();
+        let rows = self
+            .lag
+            .checked_add(1)
+            .and_then(|r| r.checked_mul(capacity));
+        if self.band == 0 || self.mask != capacity - 1 {
+            return Err(format!(
+                "ring mask {} does not fit the band {}",
+                self.mask, self.band
+            ));
+        }
+        for (name, len) in [
+            ("tips", self.tips.len()),
+            ("axes", self.axes.len()),
+            ("second points", self.seconds.len()),
+            ("costs", self.cost.len()),
+            ("next costs", self.next.len()),
+        ] {
+            if len != capacity {
+                return Err(format!("{name} ring holds {len} entries, not {capacity}"));
+            }
+        }
+        if rows != Some(self.back.len()) {
+            return Err(format!(
+                "back-pointer table holds {} entries, not (lag + 1)·{capacity}",
+                self.back.len()
+            ));
+        }
+        let (lo, hi) = self.valid;
+        if lo > hi || hi > self.references || hi - lo > self.band {
+            return Err(format!(
+                "live segments {lo}..{hi} lie outside the band of the {} reference points",
+                self.references
+            ));
+        }
+        let weight = self.params.angle_weight;
+        if self.params.max_skip == 0 || !(weight.is_finite() && weight >= 0.0) {
+            return Err(format!("mapping parameters {:?} are invalid", self.params));
+        }
+        if !(self.length.is_finite() && self.length > 0.0) || self.beam.is_nan() || self.beam <= 0.0
+        {
+            return Err(format!(
+                "tool length {} mm or beam {} mm is invalid",
+                self.length, self.beam
+            ));
+        }
+        let points = self.tips.iter().chain(&self.axes).chain(&self.seconds);
+        if !points.chain(&self.previous_tip).all(geometry::is_finite)
+            || self.cost.iter().chain(&self.next).any(|c| c.is_nan())
+        {
+            return Err("a reference point, cost or the previous tip is not finite".into());
+        }
+        Ok(())
+    }
+
+    /// The mapping's settings: parameters, tool length, band, lag, beam.
+    pub fn settings(&self) -> (HmmParams, f64, usize, usize, f64) {
+        (self.params, self.length, self.band, self.lag, self.beam)
+    }
+
+    /// Reference point `i` while it is held (it ends a held segment, or begins one).
+    pub fn point(&self, i: usize) -> Option<Pose> {
+        let held = self.references.saturating_sub(self.band + 1);
+        (i >= held && i < self.references).then(|| Pose {
+            tip: self.tips[i & self.mask],
+            axis: self.axes[i & self.mask],
+        })
+    }
+
+    /// Reference points pushed so far.
+    pub fn references(&self) -> usize {
+        self.references
+    }
+
+    /// The end poses of segment `j` while it is still held (one of the `band` newest).
+    pub fn segment(&self, j: usize) -> Option<(Pose, Pose)> {
+        Some((self.point(j)?, self.point(j.checked_add(1)?)?))
+    }
+
+    /// Samples mapped so far.
+    pub fn samples(&self) -> usize {
+        self.samples
+    }
+
+    fn cost_of(&self, j: usize, tip: &Vector<3>, second: &Vector<3>, motion: &Vector<3>) -> f64 {
+        let (a, b) = (j & self.mask, (j + 1) & self.mask);
+        segment_cost(
+            &self.params,
+            [&self.tips[a], &self.tips[b]],
+            [&self.seconds[a], &self.seconds[b]],
+            tip,
+            second,
+            motion,
+        )
+    }
+
+    /// Maps the next measured sample (tip and unit tool axis); returns the best segment
+    /// for it now, or `None` while the reference has no segment.
+    pub fn push_sample(&mut self, tip: Vector<3>, axis: Vector<3>) -> Option<usize> {
+        let hi = self.references.saturating_sub(1);
+        let lo = hi.saturating_sub(self.band);
+        if hi == lo {
+            return None;
+        }
+        let second = tip + axis * self.length;
+        let motion = self.previous_tip.map_or(Vector::zeros(), |p| tip - p);
+        let row = (self.samples % (self.lag + 1)) * (self.mask + 1);
+        let skip = self.params.max_skip;
+        // Live states of the previous sample are [vlo, vhi); they reach [vlo, vhi − 1 + K].
+        let (vlo, vhi) = self.valid;
+        let (mut from, mut to) = if self.samples > 0 && vlo < vhi {
+            (lo.max(vlo), hi.min(vhi + skip))
+        } else {
+            (lo, hi)
+        };
+        let mut reachable = false;
+        for j in from..to {
+            let c = self.cost_of(j, &tip, &second, &motion);
+            let mut best = (f64::INFINITY, j);
+            if self.samples > 0 {
+                for i in j.saturating_sub(skip).max(vlo)..=j.min(vhi.wrapping_sub(1)) {
+                    let ci = self.cost[i & self.mask];
+                    if ci < best.0 {
+                        best = (ci, i);
+                    }
+                }
+            }
+            reachable |= best.0.is_finite();
+            self.next[j & self.mask] = best.0 + c;
+            self.back[row + (j & self.mask)] = best.1;
+        }
+        if !reachable {
+            // The first sample, or the band ran past every path: start afresh (any
+            // segment, no history).
+            (from, to) = (lo, hi);
+            for j in lo..hi {
+                self.next[j & self.mask] = self.cost_of(j, &tip, &second, &motion);
+                self.back[row + (j & self.mask)] = j;
+            }
+        }
+        // The beam: states costlier than the best by more than `beam` are dropped.
+        let least = (from..to)
+            .map(|j| self.next[j & self.mask])
+            .fold(f64::INFINITY, f64::min);
+        let (mut first, mut last) = (to, from);
+        for j in from..to {
+            let slot = &mut self.next[j & self.mask];
+            if *slot > least + self.beam || slot.is_nan() {
+                *slot = f64::INFINITY;
+            } else {
+                first = first.min(j);
+                last = j + 1;
+            }
+        }
+        if first >= last {
+            // Nothing finite (a NaN observation): keep the range so the next sample
+            // restarts.
+            (first, last) = (from, to);
+        }
+        std::mem::swap(&mut self.cost, &mut self.next);
+        self.valid = (first, last);
+        self.samples += 1;
+        self.previous_tip = Some(tip);
+        Some(self.best())
+    }
+
+    /// The segment of least cost for the newest sample (ties to the lower segment).
+    fn best(&self) -> usize {
+        let (lo, hi) = self.valid;
+        (lo..hi).fold(lo, |best, j| {
+            if self.cost[j & self.mask] < self.cost[best & self.mask] {
+                j
+            } else {
+                best
+            }
+        })
+    }
+
+    /// The mapping of the sample `steps` before the newest (0 = the newest), along the
+    /// best path to the newest: `None` beyond the lag or before the first sample.
+    pub fn mapped(&self, steps: usize) -> Option<usize> {
+        if self.samples == 0 || steps > self.lag || steps >= self.samples {
+            return None;
+        }
+        let mut j = self.best();
+        for s in 0..steps {
+            let k = self.samples - 1 - s;
+            j = self.back[(k % (self.lag + 1)) * (self.mask + 1) + (j & self.mask)];
+        }
+        Some(j)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contour::five_axis::hmm::{viterbi_offline, ReferencePolyline};
+
+    type V3 = Vector<3>;
+
+    fn spiral(n: usize) -> (Vec<V3>, Vec<V3>) {
+        let tips = (0..n)
+            .map(|j| {
+                let t = j as f64 * 0.15;
+                V3::new(30.0 * t.cos(), 30.0 * t.sin(), 0.5 * t)
+            })
+            .collect();
+        let axes = (0..n)
+            .map(|j| {
+                let lean = 0.4 * (j as f64 * 0.05).sin();
+                V3::new(lean.sin(), 0.0, lean.cos())
+            })
+            .collect();
+        (tips, axes)
+    }
+
+    #[test]
+    fn with_everything_in_view_it_decodes_as_offline() {
+        let params = HmmParams {
+            max_skip: 2,
+            angle_weight: 0.7,
+        };
+        let (tips, axes) = spiral(30);
+        let run: Vec<V3> = tips.iter().map(|p| p + V3::new(0.3, -0.2, 0.1)).collect();
+        let n = 25;
+        let reference = ReferencePolyline::new(&tips, &axes, 80.0);
+        let seconds: Vec<V3> = run.iter().zip(&axes).map(|(p, o)| p + o * 80.0).collect();
+        let offline = viterbi_offline(&reference, &params, &run[..n], &seconds[..n]);
+        let mut online = OnlineMapper::new(params, 80.0, 40, 40);
+        for (p, o) in tips.iter().zip(&axes) {
+            online.push_reference(*p, *o);
+        }
+        for k in 0..n {
+            online.push_sample(run[k], axes[k]);
+        }
+        for (k, &j) in offline.iter().enumerate() {
+            assert_eq!(online.mapped(n - 1 - k), Some(j), "sample {k}");
+        }
+    }
+
+    #[test]
+    fn streaming_with_a_band_and_a_lag_commits_what_offline_decodes() {
+        // The reference runs 12 samples ahead of the measured tool (a following error),
+        // a band of 24 segments and a lag of 8 samples: every committed decision equals
+        // the offline decoding of the same data.
+        let params = HmmParams {
+            max_skip: 1,
+            angle_weight: 1.0,
+        };
+        let (tips, axes) = spiral(400);
+        let lead = 12;
+        let run: Vec<V3> = tips.iter().map(|p| p + V3::new(0.0, 0.1, -0.05)).collect();
+        let n = tips.len() - lead;
+        let reference = ReferencePolyline::new(&tips, &axes, 80.0);
+        let seconds: Vec<V3> = run.iter().zip(&axes).map(|(p, o)| p + o * 80.0).collect();
+        let offline = viterbi_offline(&reference, &params, &run[..n], &seconds[..n]);
+        let (band, lag) = (24, 8);
+        let mut online = OnlineMapper::new(params, 80.0, band, lag);
+        // With a beam of 2 mm it commits the same decisions.
+        let mut beamed = OnlineMapper::new(params, 80.0, band, lag).with_beam(2.0);
+        for j in 0..lead {
+            online.push_reference(tips[j], axes[j]);
+            beamed.push_reference(tips[j], axes[j]);
+        }
+        let mut committed = 0;
+        for k in 0..n {
+            online.push_reference(tips[k + lead], axes[k + lead]);
+            online.push_sample(run[k], axes[k]);
+            beamed.push_reference(tips[k + lead], axes[k + lead]);
+            beamed.push_sample(run[k], axes[k]);
+            if k >= lag {
+                assert_eq!(beamed.mapped(lag), online.mapped(lag), "beam, sample {k}");
+                assert_eq!(
+                    online.mapped(lag),
+                    Some(offline[k - lag]),
+                    "sample {}",
+                    k - lag
+                );
+                committed += 1;
+            }
+        }
+        assert_eq!(committed, n - lag);
+        assert!(online.mapped(lag + 1).is_none());
+        // The band's segments are held with their poses, older ones are gone.
+        let newest = tips.len() - 2;
+        let (a, b) = online.segment(newest).unwrap();
+        assert_eq!(
+            (a.tip, b.tip, b.axis),
+            (tips[newest], tips[newest + 1], axes[newest + 1])
+        );
+        assert!(online.segment(newest + 1 - band).is_some());
+        assert!(online.segment(newest - band).is_none() && online.segment(newest + 1).is_none());
+    }
+}

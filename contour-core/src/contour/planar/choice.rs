@@ -1,0 +1,163 @@
+//! The estimator the controller runs, chosen by name (`free_curve`, `line`, `arc`), as one
+//! serialisable enum so the FMU can save and restore it with the rest of its state.
+
+use std::fmt;
+use std::str::FromStr;
+
+use serde::{Deserialize, Serialize};
+
+use super::{ArcEstimator, FreeCurveEstimator, LineEstimator};
+use crate::contour::{ContourEstimate, ContourEstimator};
+use crate::geometry::Vector2;
+use crate::path::Path;
+
+/// Which estimator to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum EstimatorKind {
+    /// Two-circle free-curve estimator (any path).
+    FreeCurve,
+    /// Exact line error (Koren).
+    Line,
+    /// Exact arc/circle error (Koren–Lo).
+    Arc,
+}
+
+impl EstimatorKind {
+    /// All kinds, in FMI enumeration order (1, 2, 3).
+    pub const ALL: [EstimatorKind; 3] = [
+        EstimatorKind::FreeCurve,
+        EstimatorKind::Line,
+        EstimatorKind::Arc,
+    ];
+
+    /// Canonical name.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            EstimatorKind::FreeCurve => "free_curve",
+            EstimatorKind::Line => "line",
+            EstimatorKind::Arc => "arc",
+        }
+    }
+}
+
+impl fmt::Display for EstimatorKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl FromStr for EstimatorKind {
+    type Err = String;
+    /// Accepts `free_curve`, `free curve`, `freecurve`, `free-curve`, `line`, `arc`
+    /// (case-insensitive).
+    fn from_str(s: &str) -> Result<Self, String> {
+        let k: String = s
+            .trim()
+            .to_ascii_lowercase()
+            .chars()
+            .filter(|c| !matches!(c, '_' | ' ' | '-'))
+            .collect();
+        match k.as_str() {
+            "freecurve" => Ok(EstimatorKind::FreeCurve),
+            "line" => Ok(EstimatorKind::Line),
+            "arc" | "circle" => Ok(EstimatorKind::Arc),
+            _ => Err(format!(
+                "unknown contour estimator '{s}': expected free_curve, line or arc"
+            )),
+        }
+    }
+}
+
+/// A contour-error estimator of any kind.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Estimator {
+    /// Two-circle free-curve estimator.
+    FreeCurve(FreeCurveEstimator),
+    /// Line estimator (fixed line or tracking direction).
+    Line(LineEstimator),
+    /// Arc estimator (fixed circle or tracking three-point circle).
+    Arc(ArcEstimator),
+}
+
+impl Estimator {
+    /// The estimator of `kind` for following `path`: the exact line/arc estimators use the
+    /// path's own geometry when it is a line/arc; on other paths they fall back to the
+    /// local line (direction of the last reference move) or the circle through the last
+    /// three reference points, which is what those classic estimators do on free curves.
+    pub fn for_path(kind: EstimatorKind, path: &Path) -> Self {
+        match (kind, path) {
+            (EstimatorKind::FreeCurve, _) => Estimator::FreeCurve(FreeCurveEstimator::default()),
+            (EstimatorKind::Line, Path::Line(l)) => Estimator::Line(LineEstimator::new(l)),
+            (EstimatorKind::Line, _) => Estimator::Line(LineEstimator::tracking()),
+            (EstimatorKind::Arc, Path::Arc(a)) => Estimator::Arc(ArcEstimator::new(a)),
+            (EstimatorKind::Arc, _) => Estimator::Arc(ArcEstimator::tracking()),
+        }
+    }
+
+    /// Which kind this is.
+    pub fn kind(&self) -> EstimatorKind {
+        match self {
+            Estimator::FreeCurve(_) => EstimatorKind::FreeCurve,
+            Estimator::Line(_) => EstimatorKind::Line,
+            Estimator::Arc(_) => EstimatorKind::Arc,
+        }
+    }
+}
+
+impl ContourEstimator for Estimator {
+    fn estimate(&mut self, reference: Vector2, actual: Vector2) -> ContourEstimate {
+        match self {
+            Estimator::FreeCurve(e) => e.estimate(reference, actual),
+            Estimator::Line(e) => e.estimate(reference, actual),
+            Estimator::Arc(e) => e.estimate(reference, actual),
+        }
+    }
+    fn reset(&mut self) {
+        match self {
+            Estimator::FreeCurve(e) => e.reset(),
+            Estimator::Line(e) => e.reset(),
+            Estimator::Arc(e) => e.reset(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::path::builtin;
+
+    #[test]
+    fn names_parse() {
+        for k in EstimatorKind::ALL {
+            assert_eq!(k.as_str().parse::<EstimatorKind>().unwrap(), k);
+        }
+        assert_eq!(
+            "Free Curve".parse::<EstimatorKind>().unwrap(),
+            EstimatorKind::FreeCurve
+        );
+        assert!("spline".parse::<EstimatorKind>().is_err());
+    }
+
+    #[test]
+    fn dispatch_uses_path_geometry() {
+        let circle = builtin::by_name("circle").unwrap();
+        let mut e = Estimator::for_path(EstimatorKind::Arc, &circle);
+        // The paper's circle: centre (−10, 0), r = 10, CCW; P 0.25 mm outside at (0.25, 0).
+        let r = e.estimate(Vector2::new(0.0, 0.0), Vector2::new(0.25, 0.0));
+        assert!((r.error - 0.25).abs() < 1e-15 && r.normal == Vector2::new(-1.0, 0.0));
+        let blob = postcard::to_stdvec(&e).unwrap();
+        assert_eq!(postcard::from_bytes::<Estimator>(&blob).unwrap(), e);
+        let line = builtin::by_name("line").unwrap();
+        let mut e = Estimator::for_path(EstimatorKind::Line, &line);
+        // Line (0,0)→(40,30): P = (3, −4) lies 5 mm right of the start, perpendicular to (4, 3).
+        let r = e.estimate(Vector2::new(0.0, 0.0), Vector2::new(3.0, -4.0));
+        assert!((r.error - 5.0).abs() < 1e-14);
+        assert_eq!(e.kind(), EstimatorKind::Line);
+        let mut f = Estimator::for_path(EstimatorKind::FreeCurve, &line);
+        assert_eq!(
+            f.estimate(Vector2::new(0.0, 0.0), Vector2::new(3.0, -4.0))
+                .error,
+            0.0
+        );
+    }
+}

@@ -1,0 +1,284 @@
+//! Free-curve contour-error estimator: the two-circle method of the paper (after Chen et
+//! al.), docs/design.md §4.1.
+//!
+//! Recent reference samples are kept in a fixed-capacity ring buffer. From the newest
+//! command point the search walks back while the distance to P decreases; the last point
+//! is Rε. Circles C1 through (Rε+1, Rε, Rε−1) and C2 through (Rε, Rε−1, Rε−2) approximate
+//! the path around it. Combination (docs/design.md §4.1): the foot lies between Rε and its
+//! neighbour on P's side, and the estimate is the mean of the two circles that span that
+//! interval: C1 and C2 when P is behind Rε, C1 and C0 through (Rε+2, Rε+1, Rε) when P is
+//! ahead ((P − Rε)·(Rε+1 − Rε) > 0). Their leading interpolation errors have opposite
+//! signs. Near the ends of the buffer the one available circle is used.
+//!
+//! Each circle is evaluated by [`local_circle::circle_error`], which reduces continuously to the
+//! signed distance to the chord line for collinear samples, so straight parts need no
+//! threshold. The walk is bounded by the capacity and nothing is allocated after
+//! construction. Walking back from the command point (not a global nearest search) keeps
+//! the estimate on the right branch where a path crosses itself.
+
+use serde::{Deserialize, Serialize};
+
+use super::local_circle;
+use crate::contour::{ContourEstimate, ContourEstimator};
+use crate::geometry::{self, Vector2};
+
+/// Default buffer capacity. The actual point lags the command by about 1/(Kpp·Ts)
+/// samples (35 for Kpp = 28.5 s⁻¹, Ts = 1 ms) whatever the feed; 256 leaves ample margin.
+pub const DEFAULT_CAPACITY: usize = 256;
+
+/// Smallest buffer that can hold C1 and C2 (Rε+1 … Rε−2).
+pub const MIN_CAPACITY: usize = 4;
+
+/// Reference points closer than this (mm) to the newest stored one are not stored:
+/// a held reference (feed 0, path end) must not create degenerate circles.
+const MIN_SPACING: f64 = 1e-9;
+
+/// Serialised form, validated on load so a corrupt state blob cannot cause out-of-range
+/// indexing.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct FreeCurveData {
+    buf: Vec<Vector2>,
+    head: usize,
+    len: usize,
+}
+
+/// Two-circle free-curve estimator over a ring buffer of reference samples.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "FreeCurveData", into = "FreeCurveData")]
+pub struct FreeCurveEstimator {
+    buf: Vec<Vector2>,
+    /// Index of the newest sample.
+    head: usize,
+    /// Number of valid samples.
+    len: usize,
+}
+
+impl TryFrom<FreeCurveData> for FreeCurveEstimator {
+    type Error = String;
+    fn try_from(d: FreeCurveData) -> Result<Self, String> {
+        if d.buf.len() < MIN_CAPACITY || d.head >= d.buf.len() || d.len > d.buf.len() {
+            return Err("corrupt free-curve estimator state".into());
+        }
+        Ok(FreeCurveEstimator {
+            buf: d.buf,
+            head: d.head,
+            len: d.len,
+        })
+    }
+}
+
+impl From<FreeCurveEstimator> for FreeCurveData {
+    fn from(e: FreeCurveEstimator) -> Self {
+        FreeCurveData {
+            buf: e.buf,
+            head: e.head,
+            len: e.len,
+        }
+    }
+}
+
+impl Default for FreeCurveEstimator {
+    fn default() -> Self {
+        Self::new(DEFAULT_CAPACITY)
+    }
+}
+
+impl FreeCurveEstimator {
+    /// Estimator remembering the last `capacity` distinct reference samples (at least
+    /// [`MIN_CAPACITY`]; smaller values are raised to it). The capacity must exceed the
+    /// lag of the actual point behind the command, in samples, plus two.
+    pub fn new(capacity: usize) -> Self {
+        let cap = capacity.max(MIN_CAPACITY);
+        FreeCurveEstimator {
+            buf: vec![Vector2::zeros(); cap],
+            head: 0,
+            len: 0,
+        }
+    }
+
+    /// Buffer capacity.
+    pub fn capacity(&self) -> usize {
+        self.buf.len()
+    }
+
+    /// Number of stored samples.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// True before the first sample.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The `k`-th newest stored sample (0 = newest); `k < len`.
+    fn get(&self, k: usize) -> Vector2 {
+        // No `%` on the hot path: k < len ≤ capacity and head < capacity.
+        let i = if k <= self.head {
+            self.head - k
+        } else {
+            (self.head + self.buf.len()).wrapping_sub(k)
+        };
+        self.buf.get(i).copied().unwrap_or_default()
+    }
+
+    fn push(&mut self, r: Vector2) {
+        if self.len > 0 && geometry::dist(&r, &self.get(0)) <= MIN_SPACING {
+            return;
+        }
+        let cap = self.buf.len();
+        self.head = (self.head + 1) % cap;
+        self.buf[self.head] = r;
+        self.len = (self.len + 1).min(cap);
+    }
+
+    /// Circle through the samples centred on `m` (m+1 older, m−1 newer), evaluated at the
+    /// sample `k` (which must be one of the three); `None` if unavailable.
+    fn triple(&self, p: Vector2, m: usize, k: usize) -> Option<ContourEstimate> {
+        if m == 0 || m + 1 >= self.len || k + 1 < m || k > m + 1 {
+            return None;
+        }
+        let pts = [self.get(m + 1), self.get(m), self.get(m - 1)];
+        Some(local_circle::triple_error(p, pts, m + 1 - k))
+    }
+}
+
+impl ContourEstimator for FreeCurveEstimator {
+    fn estimate(&mut self, reference: Vector2, actual: Vector2) -> ContourEstimate {
+        self.push(reference);
+        match self.len {
+            0 | 1 => return ContourEstimate::default(),
+            2 => {
+                let (a, b) = (self.get(1), self.get(0));
+                let d = b - a;
+                let dir = d * (1.0 / geometry::norm(&d));
+                return super::line::line_error(actual, b, dir);
+            }
+            _ => {}
+        }
+        // Walk back from the command point while the distance decreases.
+        let mut k = 0;
+        let mut d = geometry::dist2(&actual, &self.get(0));
+        while k + 1 < self.len {
+            let dn = geometry::dist2(&actual, &self.get(k + 1));
+            if dn < d {
+                d = dn;
+                k += 1;
+            } else {
+                break;
+            }
+        }
+        let re = self.get(k);
+        let ahead = k >= 1 && (actual - re).dot(&(self.get(k - 1) - re)) > 0.0;
+        // The foot lies between Rε and its neighbour on P's side. Both circles whose three
+        // samples span that interval (centred on Rε and on the neighbour) are used: their
+        // leading interpolation errors have opposite signs, so their mean cancels them.
+        let centred = self.triple(actual, k, k);
+        let beside = if ahead {
+            self.triple(actual, k - 1, k)
+        } else {
+            self.triple(actual, k + 1, k)
+        };
+        match (centred, beside) {
+            (Some(a), Some(b)) => local_circle::mean(a, b),
+            (Some(e), None) | (None, Some(e)) => e,
+            // Rε is the oldest sample: the circle (Rε, Rε+1, Rε+2); len ≥ 3 guarantees it.
+            (None, None) => self
+                .triple(actual, k.saturating_sub(1), k)
+                .unwrap_or_default(),
+        }
+    }
+
+    fn reset(&mut self) {
+        self.head = 0;
+        self.len = 0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn circle_samples_give_exact_radial_error() {
+        // On a circle the fitted circles are the circle itself: exact for any lag.
+        let c = |t: f64| Vector2::new(3.0 + 20.0 * t.cos(), 1.0 + 20.0 * t.sin());
+        let mut e = FreeCurveEstimator::new(16);
+        for i in 0..40 {
+            let t = i as f64 * 0.005;
+            let lag = t - 0.0123;
+            let p = Vector2::new(3.0 + 20.03 * lag.cos(), 1.0 + 20.03 * lag.sin());
+            let r = e.estimate(c(t), p);
+            if i >= 3 {
+                assert!((r.error - 0.03).abs() < 1e-12, "i={i}: {}", r.error);
+                let n = Vector2::new(-lag.cos(), -lag.sin());
+                assert!((r.normal[0] - n[0]).abs() < 1e-9 && (r.normal[1] - n[1]).abs() < 1e-9);
+            }
+        }
+        assert_eq!(e.len(), 16);
+    }
+
+    /// With a lag longer than the buffer the walk stops at the oldest sample, where only
+    /// the circle on the newer side exists; on a circle that circle is still the path, so
+    /// the estimate stays exact (the fallback branch of `estimate`).
+    #[test]
+    fn a_lag_beyond_the_buffer_uses_the_oldest_circle() {
+        let c = |t: f64| Vector2::new(20.0 * t.cos(), 20.0 * t.sin());
+        let mut e = FreeCurveEstimator::new(MIN_CAPACITY);
+        for i in 0..30 {
+            let t = i as f64 * 0.01;
+            let lag = t - 0.2; // 20 samples behind, the buffer holds 4
+            let p = Vector2::new(19.95 * lag.cos(), 19.95 * lag.sin());
+            let r = e.estimate(c(t), p);
+            if i >= 3 {
+                assert!((r.error + 0.05).abs() < 1e-12, "i={i}: {}", r.error);
+                let n = Vector2::new(-lag.cos(), -lag.sin()); // inward: the left normal of a CCW circle
+                assert!((r.normal[0] - n[0]).abs() < 1e-9 && (r.normal[1] - n[1]).abs() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn collinear_and_held_reference() {
+        let mut e = FreeCurveEstimator::new(8);
+        assert_eq!(
+            e.estimate(Vector2::new(0.0, 0.0), Vector2::new(0.0, 0.0))
+                .error,
+            0.0
+        );
+        for i in 1..20 {
+            let x = i as f64 * 0.1;
+            let r = e.estimate(
+                Vector2::new(x, 2.0 * x),
+                Vector2::new(x - 0.2 + 0.002, 2.0 * x - 0.4 - 0.001),
+            );
+            // Offset (0.002, −0.001) is √5·0.001 right of the direction (1, 2)/√5.
+            assert!((r.error - 5f64.sqrt() * 1e-3).abs() < 1e-14, "{}", r.error);
+        }
+        // Held reference (path end): no duplicate samples, estimate stays finite.
+        for _ in 0..20 {
+            let r = e.estimate(Vector2::new(1.9, 3.8), Vector2::new(1.9, 3.7));
+            assert!(r.error.is_finite() && r.normal[0].is_finite());
+        }
+        e.reset();
+        assert!(e.is_empty());
+    }
+
+    #[test]
+    fn state_round_trip_rejects_corruption() {
+        let mut e = FreeCurveEstimator::new(5);
+        for i in 0..7 {
+            e.estimate(Vector2::new(i as f64, 0.0), Vector2::new(0.0, 0.0));
+        }
+        let blob = postcard::to_stdvec(&e).unwrap();
+        let back: FreeCurveEstimator = postcard::from_bytes(&blob).unwrap();
+        assert_eq!(back, e);
+        let bad = FreeCurveData {
+            buf: vec![Vector2::zeros(); 5],
+            head: 9,
+            len: 2,
+        };
+        let blob = postcard::to_stdvec(&bad).unwrap();
+        assert!(postcard::from_bytes::<FreeCurveEstimator>(&blob).is_err());
+    }
+}

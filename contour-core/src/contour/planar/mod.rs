@@ -1,0 +1,17 @@
+//! The two-axis paper's contour errors (docs/design.md §4.1): exact errors of a line and
+//! of an arc, the free-curve estimator (two circles through the interpolation points
+//! nearest the actual position), the estimator chosen by name, and the true error by
+//! brute-force search that the tests and metrics take as ground truth.
+
+mod arc;
+mod choice;
+mod free_curve;
+mod line;
+mod local_circle;
+mod true_error;
+
+pub use arc::ArcEstimator;
+pub use choice::{Estimator, EstimatorKind};
+pub use free_curve::FreeCurveEstimator;
+pub use line::LineEstimator;
+pub use true_error::{true_error, TrueError, TrueErrorIndex};

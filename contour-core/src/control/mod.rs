@@ -1,0 +1,21 @@
+//! Control laws: discrete PID, the Mamdani fuzzy gain scheduler with its rule tables, the
+//! scalar contour law and the N-axis cross-coupled contour controller around it
+//! (docs/design.md §4.2, 4.3).
+
+mod ccc_law;
+mod config;
+mod cross_coupled;
+mod five_axis;
+mod fuzzy;
+mod pid;
+mod rules;
+
+pub use ccc_law::{folded_inputs, CccLaw, CccStep, VectorLaw};
+pub use config::{
+    CccConfig, CccMode, ConfigError, ControllerConfig, FuzzyFactor, FuzzyFactors, Gain, Parameter,
+};
+pub use cross_coupled::{ControlOutput, CrossCoupledController};
+pub use five_axis::{FiveAxisConfig, FiveAxisController, FiveAxisOutput, SampleError};
+pub use fuzzy::{centroid, evaluate_table, membership, FuzzyEngine, FuzzyOutput, UNIVERSE};
+pub use pid::{Pid, PidGains};
+pub use rules::{RuleTable, Term, FUZZY_PID_RULES, KD_RULES, KI_RULES, KP_RULES};

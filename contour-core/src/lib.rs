@@ -1,0 +1,20 @@
+//! Cross-coupled contour control for CNC axes, without FMI: everything the FMUs of
+//! `contour-fmu` compute, and the in-process loops and offline evaluation that the tools
+//! (`contour-eval`, `contour-tune`), tests and benchmarks run.
+//!
+//! The floors, each using only those above it: [`geometry`] and [`kinematics`]; [`path`]
+//! (reference paths and the feed-rate interpolator); [`contour`] (contour errors, split by
+//! paper into `planar` and `five_axis`); [`control`] (PID, fuzzy gain scheduling, the
+//! cross-coupled controllers); [`plant`] (the test plants); [`sim`] (the closed loops in
+//! process). Units: mm, rad, s.
+
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod contour;
+pub mod control;
+pub mod geometry;
+pub mod kinematics;
+pub mod path;
+pub mod plant;
+pub mod sim;

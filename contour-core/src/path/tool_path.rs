@@ -1,0 +1,543 @@
+//! Five-axis references: the tool tip's path with the tool axis along it, in the
+//! workpiece frame (docs/design.md §5.3a). Two shapes: a pair of curves (the tip, and the
+//! point `length` mm up the tool axis) or a sequence of poses joined by straight tip
+//! moves with the axis slerped in between (CL data, sampled built-ins).
+
+use std::sync::{Arc, OnceLock};
+
+use serde::{Deserialize, Serialize};
+
+use super::nurbs::NurbsData;
+use super::polyline::Polyline;
+use super::{Curve, Nurbs, PathError};
+use crate::geometry::slerp;
+use crate::geometry::{self, Vector};
+use crate::kinematics::Pose;
+
+/// Samples per turn of the sampled built-ins: chords of at most 3.2 µm, deviating from the
+/// curves they sample by < 0.3 nm; a nearest point on them lies within 0.1 µm of the one on
+/// the curve at 0.3 mm off the tightest bend (the truth for the five-axis tests).
+const SAMPLES_PER_TURN: usize = 40_000;
+
+/// A five-axis reference. Serialised (FMU state) through [`ToolPathData`], so bytes from
+/// elsewhere are validated like a file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "ToolPathData", into = "ToolPathData")]
+pub enum ToolPath {
+    /// The tip curve and the curve of the point `length` mm up the tool axis, on the same
+    /// parameter.
+    Curves {
+        /// The tool tip's curve, mm.
+        tip: Nurbs<3>,
+        /// The curve of the point `length` up the tool axis, mm.
+        second: Nurbs<3>,
+        /// Distance between the two curves along the tool axis, mm.
+        length: f64,
+    },
+    /// Poses in order: tips joined by straight moves, axes by slerp. Clones share the
+    /// poses.
+    Poses {
+        /// The tips, mm.
+        tips: Polyline<3>,
+        /// The unit tool axes, one per tip.
+        axes: Arc<[Vector<3>]>,
+    },
+}
+
+/// The serialised form of a [`ToolPath`]; converting it back checks it as the
+/// constructors do (unit axes kept as they are, to the last bit).
+#[derive(Serialize, Deserialize)]
+pub enum ToolPathData {
+    /// [`ToolPath::Curves`].
+    Curves {
+        /// The tip curve.
+        tip: Nurbs<3>,
+        /// The second curve.
+        second: Nurbs<3>,
+        /// Their distance along the tool axis, mm.
+        length: f64,
+    },
+    /// [`ToolPath::Poses`].
+    Poses {
+        /// The tips, mm.
+        tips: Vec<Vector<3>>,
+        /// The unit tool axes.
+        axes: Vec<Vector<3>>,
+    },
+}
+
+impl From<ToolPath> for ToolPathData {
+    fn from(path: ToolPath) -> Self {
+        match path {
+            ToolPath::Curves {
+                tip,
+                second,
+                length,
+            } => ToolPathData::Curves {
+                tip,
+                second,
+                length,
+            },
+            ToolPath::Poses { tips, axes } => ToolPathData::Poses {
+                tips: tips.points().to_vec(),
+                axes: axes.to_vec(),
+            },
+        }
+    }
+}
+
+impl TryFrom<ToolPathData> for ToolPath {
+    type Error = PathError;
+    fn try_from(data: ToolPathData) -> Result<Self, PathError> {
+        match data {
+            ToolPathData::Curves {
+                tip,
+                second,
+                length,
+            } => {
+                if tip.param_range() != second.param_range() {
+                    return Err(PathError::invalid(
+                        "tip and second curves have different parameter ranges",
+                    ));
+                }
+                if !(length.is_finite() && length > 0.0) {
+                    return Err(PathError::invalid(format!(
+                        "length must be > 0 mm, got {length}"
+                    )));
+                }
+                Ok(ToolPath::Curves {
+                    tip,
+                    second,
+                    length,
+                })
+            }
+            ToolPathData::Poses { tips, axes } => {
+                if tips.len() != axes.len() {
+                    return Err(PathError::invalid(format!(
+                        "{} tips but {} tool axes",
+                        tips.len(),
+                        axes.len()
+                    )));
+                }
+                if let Some(i) = axes.iter().position(|a| {
+                    let off = (geometry::norm(a) - 1.0).abs();
+                    off.is_nan() || off >= 1e-12
+                }) {
+                    return Err(PathError::invalid(format!(
+                        "tool axis {i} is not a unit vector"
+                    )));
+                }
+                let poses: Vec<Pose> = tips
+                    .into_iter()
+                    .zip(axes)
+                    .map(|(tip, axis)| Pose { tip, axis })
+                    .collect();
+                let checked = ToolPath::from_poses(&poses)?;
+                // Keep the axes as saved (normalising again could move the last bit).
+                match checked {
+                    ToolPath::Poses { tips, .. } => Ok(ToolPath::Poses {
+                        tips,
+                        axes: poses.iter().map(|p| p.axis).collect::<Vec<_>>().into(),
+                    }),
+                    curves => Ok(curves),
+                }
+            }
+        }
+    }
+}
+
+/// The JSON form: `{"tip": NURBS, "second": NURBS, "length": L}`, each NURBS as in a
+/// planar path file but with 3-D control points; `second` is the curve of the point `L`
+/// mm up the tool axis and must share the tip curve's parameter range.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ToolPathFile {
+    tip: NurbsData<3>,
+    second: NurbsData<3>,
+    length: f64,
+}
+
+/// Names of the built-in five-axis paths.
+pub const BUILTIN_TOOL_PATHS: [&str; 2] = ["tilted_helix", "figure_eight"];
+
+/// How a five-axis reference is named: a CL file (`.cl`, `.apt`), a two-curve JSON file
+/// (`.json`), or a built-in.
+enum Source<'a> {
+    Cl(&'a str),
+    Json(&'a str),
+    Builtin(&'a str),
+}
+
+fn source(spec: &str) -> Source<'_> {
+    let lower = spec.to_ascii_lowercase();
+    if lower.ends_with(".cl") || lower.ends_with(".apt") {
+        Source::Cl(spec)
+    } else if lower.ends_with(".json") {
+        Source::Json(spec)
+    } else {
+        Source::Builtin(spec)
+    }
+}
+
+/// The poses of the reference named `spec` (see [`ToolPath::load`]) and the CL reader's
+/// warnings: a CL file's records as written (a tool turning on the spot is kept), a
+/// curve pair sampled so that no tip chord exceeds `chord` mm.
+pub fn load_poses(spec: &str, chord: f64) -> Result<(Vec<Pose>, Vec<String>), PathError> {
+    match source(spec) {
+        Source::Cl(file) => {
+            let data = super::cl_data::load_cl(file)?;
+            Ok((data.poses, data.warnings))
+        }
+        _ => Ok((ToolPath::load(spec)?.0.poses(chord), Vec::new())),
+    }
+}
+
+impl ToolPath {
+    /// The built-in path called `name` (one of [`BUILTIN_TOOL_PATHS`]).
+    pub fn builtin(name: &str) -> Result<ToolPath, PathError> {
+        match name {
+            // Sampled once per process and shared: every instance on a built-in holds
+            // the same 80 001 poses, and instantiating one costs no sampling.
+            "tilted_helix" => {
+                static HELIX: OnceLock<ToolPath> = OnceLock::new();
+                Ok(HELIX.get_or_init(ToolPath::tilted_helix).clone())
+            }
+            "figure_eight" => {
+                static EIGHT: OnceLock<ToolPath> = OnceLock::new();
+                Ok(EIGHT.get_or_init(ToolPath::figure_eight).clone())
+            }
+            _ => Err(PathError::invalid(format!(
+                "unknown five-axis path {name:?}: expected a .cl/.apt or .json file, or a \
+                 built-in ({})",
+                BUILTIN_TOOL_PATHS.join(", ")
+            ))),
+        }
+    }
+
+    /// The reference named `spec`: a CL file (`.cl`, `.apt`: APT GOTO records), a
+    /// two-curve JSON file (`.json`), or a built-in name; with the CL reader's warnings.
+    pub fn load(spec: &str) -> Result<(ToolPath, Vec<String>), PathError> {
+        match source(spec) {
+            Source::Cl(file) => {
+                let data = super::cl_data::load_cl(file)?;
+                Ok((ToolPath::from_poses(&data.poses)?, data.warnings))
+            }
+            Source::Json(file) => {
+                let (name, text) = super::file::read_path_file(file.as_ref())?;
+                Ok((ToolPath::parse_json(&text, &name)?, Vec::new()))
+            }
+            Source::Builtin(name) => Ok((ToolPath::builtin(name)?, Vec::new())),
+        }
+    }
+
+    /// The reference as poses: the vertices of a pose path; a curve pair sampled
+    /// uniformly in its parameter, doubling the count until no tip chord exceeds `chord`
+    /// mm (> 0).
+    pub fn poses(&self, chord: f64) -> Vec<Pose> {
+        match self {
+            ToolPath::Poses { tips, axes } => tips
+                .points()
+                .iter()
+                .zip(axes.iter())
+                .map(|(&tip, &axis)| Pose { tip, axis })
+                .collect(),
+            ToolPath::Curves { tip, .. } => {
+                let (u0, u1) = tip.param_range();
+                let mut n = ((tip.length() / chord).ceil() as usize).max(1);
+                loop {
+                    let poses: Vec<Pose> = (0..=n)
+                        .map(|i| self.pose_at(u0 + (u1 - u0) * i as f64 / n as f64))
+                        .collect();
+                    let longest = poses
+                        .windows(2)
+                        .map(|w| geometry::dist(&w[0].tip, &w[1].tip))
+                        .fold(0.0, f64::max);
+                    if longest <= chord || n > 1 << 26 {
+                        return poses;
+                    }
+                    n *= 2;
+                }
+            }
+        }
+    }
+
+    /// Parses the JSON form; `name` is used in messages.
+    pub fn parse_json(text: &str, name: &str) -> Result<Self, PathError> {
+        let fail = |line: usize, column: usize, message: String| PathError::File {
+            file: name.to_string(),
+            line,
+            column,
+            message,
+        };
+        let file: ToolPathFile = serde_json::from_str(text).map_err(|e| {
+            fail(
+                e.line(),
+                e.column(),
+                format!("wrong five-axis path file: {e}"),
+            )
+        })?;
+        let curve = |data: NurbsData<3>, which: &str| {
+            Nurbs::try_from(data).map_err(|e| fail(0, 0, format!("{which}: {e}")))
+        };
+        let (tip, second) = (curve(file.tip, "tip")?, curve(file.second, "second")?);
+        if tip.param_range() != second.param_range() {
+            return Err(fail(
+                0,
+                0,
+                format!(
+                    "tip and second curves have different parameter ranges {:?} and {:?}",
+                    tip.param_range(),
+                    second.param_range()
+                ),
+            ));
+        }
+        if !(file.length.is_finite() && file.length > 0.0) {
+            return Err(fail(
+                0,
+                0,
+                format!("length must be > 0 mm, got {}", file.length),
+            ));
+        }
+        Ok(ToolPath::Curves {
+            tip,
+            second,
+            length: file.length,
+        })
+    }
+
+    /// From poses (at least two, consecutive tips distinct, axes nonzero; normalised).
+    pub fn from_poses(poses: &[Pose]) -> Result<Self, PathError> {
+        let tips = Polyline::new(poses.iter().map(|p| p.tip).collect())?;
+        let axes = poses
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                geometry::unit(&p.axis).ok_or_else(|| {
+                    PathError::invalid(format!("tool axis {i} is zero or not finite"))
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        if let Some(i) = axes
+            .windows(2)
+            .position(|w| slerp(&w[0], &w[1], 0.5).is_none())
+        {
+            return Err(PathError::invalid(format!(
+                "tool axes {i} and {} are opposite: no unique turn between them",
+                i + 1
+            )));
+        }
+        Ok(ToolPath::Poses {
+            tips,
+            axes: axes.into(),
+        })
+    }
+
+    /// The pose at parameter `u` of the tip curve.
+    pub fn pose_at(&self, u: f64) -> Pose {
+        match self {
+            ToolPath::Curves { tip, second, .. } => {
+                let p = tip.point(u);
+                let axis = geometry::unit(&(second.point(u) - p)).unwrap_or_else(Vector::z);
+                Pose { tip: p, axis }
+            }
+            ToolPath::Poses { tips, axes } => {
+                let (i, t) = tips.locate(u);
+                let axis = slerp(&axes[i], &axes[i + 1], t).unwrap_or(axes[i]);
+                Pose {
+                    tip: tips.point(u),
+                    axis,
+                }
+            }
+        }
+    }
+
+    /// A helix of radius 20 mm and pitch 5 mm, two turns, with the tool tilted 20° from
+    /// the helix axis toward its centre line; the helix stands at (30, 10) on the table,
+    /// off the C axis. (Centred on the C axis the table would turn the part under a tool
+    /// that only rises: every joint moves uniformly and a lag is a pure delay along the
+    /// path, with no contour error to correct.)
+    pub fn tilted_helix() -> ToolPath {
+        let n = 2 * SAMPLES_PER_TURN;
+        let tilt = 20f64.to_radians();
+        let poses: Vec<Pose> = (0..=n)
+            .map(|i| {
+                let t = i as f64 / SAMPLES_PER_TURN as f64 * std::f64::consts::TAU;
+                let (s, c) = t.sin_cos();
+                Pose {
+                    tip: Vector::<3>::new(
+                        30.0 + 20.0 * c,
+                        10.0 + 20.0 * s,
+                        5.0 * t / std::f64::consts::TAU,
+                    ),
+                    axis: Vector::<3>::new(-tilt.sin() * c, -tilt.sin() * s, tilt.cos()),
+                }
+            })
+            .collect();
+        ToolPath::from_poses(&poses).expect("built-in helix is valid")
+    }
+
+    /// A figure eight in the plane z = 0 (40 × 20 mm, x = 20 sin t, y = 10 sin 2t) whose
+    /// two loops cross at the origin. The tool is tilted 25° toward +y and leans 15°·cos t
+    /// toward ±x, so where the tips meet (t = 0 and π) the axes differ by 2·asin(sin 15°·
+    /// cos 25°) ≈ 27.1°; the tilt keeps the tool off the C axis (A ≥ 25°), where C would
+    /// have to turn half a revolution at once.
+    pub fn figure_eight() -> ToolPath {
+        let n = 2 * SAMPLES_PER_TURN;
+        let poses: Vec<Pose> = (0..=n)
+            .map(|i| {
+                let t = i as f64 / n as f64 * std::f64::consts::TAU;
+                let lean = 15f64.to_radians() * t.cos();
+                let tilt = 25f64.to_radians();
+                Pose {
+                    tip: Vector::<3>::new(20.0 * t.sin(), 10.0 * (2.0 * t).sin(), 0.0),
+                    axis: Vector::<3>::new(
+                        lean.sin() * tilt.cos(),
+                        tilt.sin(),
+                        lean.cos() * tilt.cos(),
+                    ),
+                }
+            })
+            .collect();
+        ToolPath::from_poses(&poses).expect("built-in figure eight is valid")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::angle_between;
+
+    type V3 = Vector<3>;
+
+    #[test]
+    fn poses_are_slerped_between_vertices() {
+        let path = ToolPath::from_poses(&[
+            Pose {
+                tip: V3::zeros(),
+                axis: V3::z(),
+            },
+            Pose {
+                tip: V3::new(10.0, 0.0, 0.0),
+                axis: V3::new(2.0, 0.0, 0.0),
+            },
+        ])
+        .unwrap();
+        let pose = path.pose_at(0.5);
+        assert_eq!(pose.tip, V3::new(5.0, 0.0, 0.0));
+        let half = std::f64::consts::FRAC_PI_4;
+        assert!((pose.axis - V3::new(half.sin(), 0.0, half.cos())).amax() < 1e-15);
+        let opposite = ToolPath::from_poses(&[
+            Pose {
+                tip: V3::zeros(),
+                axis: V3::z(),
+            },
+            Pose {
+                tip: V3::x(),
+                axis: -V3::z(),
+            },
+        ]);
+        assert!(opposite.unwrap_err().to_string().contains("opposite"));
+    }
+
+    #[test]
+    fn reads_the_two_curve_json_form() {
+        // A straight tip move with the second point 100 mm up a tool tilting from +z
+        // toward +x: at the middle the axis is the normalised mean.
+        let text = r#"{
+            "tip": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0, 0], [10, 0, 0]]},
+            "second": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0, 100], [110, 0, 0]]},
+            "length": 100
+        }"#;
+        let path = ToolPath::parse_json(text, "tilt.json").unwrap();
+        let pose = path.pose_at(0.5);
+        assert_eq!(pose.tip, V3::new(5.0, 0.0, 0.0));
+        let half = std::f64::consts::FRAC_PI_4;
+        assert!((pose.axis - V3::new(half.sin(), 0.0, half.cos())).amax() < 1e-15);
+        let bad = text.replace(
+            "[0, 0, 1, 1], \"control_points\": [[0, 0, 100]",
+            "[0, 0, 2, 2], \"control_points\": [[0, 0, 100]",
+        );
+        let e = ToolPath::parse_json(&bad, "tilt.json")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("tilt.json") && e.contains("parameter ranges"),
+            "{e}"
+        );
+        let e = ToolPath::parse_json("{\"tip\": 1}", "x.json")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("x.json:1:"), "{e}");
+    }
+
+    #[test]
+    fn references_are_named_by_file_kind_or_built_in_name() {
+        let dir = std::env::temp_dir().join(format!("tool-path-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // A CL file with a tool turning on the spot: as poses it is kept, as a path to
+        // follow at a tip feed it is refused (the tip does not move).
+        let cl = dir.join("part.CL");
+        std::fs::write(
+            &cl,
+            "GOTO/0,0,0,0,0,1\nGOTO/1,0,0,0,0,2\nGOTO/1,0,0,0,0.6,0.8\nGOTO/2,0,0,0,0.6,0.8\n",
+        )
+        .unwrap();
+        let spec = cl.to_str().unwrap();
+        let (poses, warnings) = load_poses(spec, 0.01).unwrap();
+        assert_eq!(poses.len(), 4);
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(ToolPath::load(spec).is_err());
+        let json = dir.join("tilt.json");
+        std::fs::write(
+            &json,
+            r#"{"tip": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0, 0], [1, 0, 0]]},
+                "second": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[0, 0, 100], [1, 0, 100]]},
+                "length": 100}"#,
+        )
+        .unwrap();
+        // 1 mm sampled at chords ≤ 0.3 mm: 4 pieces.
+        let (poses, _) = load_poses(json.to_str().unwrap(), 0.3).unwrap();
+        assert_eq!(poses.len(), 5);
+        assert!((poses[1].tip - V3::new(0.25, 0.0, 0.0)).amax() < 1e-15);
+        let (helix, _) = ToolPath::load("tilted_helix").unwrap();
+        assert_eq!(helix, ToolPath::tilted_helix());
+        let e = ToolPath::load("spiral").unwrap_err().to_string();
+        assert!(e.contains("spiral") && e.contains("figure_eight"), "{e}");
+        let e = ToolPath::load(dir.join("missing.json").to_str().unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("missing.json") && e.contains("cannot read"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn the_built_ins_have_their_designed_shape() {
+        let helix = ToolPath::tilted_helix();
+        for u in [0.0, 12345.5, 80000.0] {
+            let p = helix.pose_at(u);
+            assert!(
+                ((p.tip[0] - 30.0).hypot(p.tip[1] - 10.0) - 20.0).abs() < 1e-5,
+                "radius at {u}"
+            );
+            assert!((angle_between(&p.axis, &V3::z()) - 20f64.to_radians()).abs() < 1e-6);
+        }
+        let end = helix.pose_at(80000.0).tip;
+        assert!((end - V3::new(50.0, 10.0, 10.0)).amax() < 1e-9);
+
+        // The figure eight passes the origin at t = 0, π (and 2π) with the tool leaning
+        // +15°, −15° (and +15°) out of its 25° tilt toward +y.
+        let eight = ToolPath::figure_eight();
+        let (start, middle) = (eight.pose_at(0.0), eight.pose_at(40000.0));
+        assert!(start.tip.amax() < 1e-12 && middle.tip.amax() < 1e-9);
+        let expected = 2.0 * (15f64.to_radians().sin() * 25f64.to_radians().cos()).asin();
+        assert!((angle_between(&start.axis, &middle.axis) - expected).abs() < 1e-9);
+        // Never along the C axis: A stays ≥ 25° (less than 1e-9 lost to the chords).
+        for i in 0..=8000 {
+            let a = angle_between(&eight.pose_at(10.0 * i as f64).axis, &V3::z());
+            assert!(a > 25f64.to_radians() - 1e-9, "A = {a} at {i}");
+        }
+    }
+}

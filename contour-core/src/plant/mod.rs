@@ -1,0 +1,8 @@
+//! Test plants: the servo axis of docs/design.md §4.5 (linear or rotary) and a machine's
+//! axes built from several of them (the XY table is two).
+
+mod servo_axes;
+mod servo_axis;
+
+pub use servo_axes::{ServoAxes, ServoAxesParams, XyTable, XyTableParams};
+pub use servo_axis::{AxisParams, ServoAxis, Transmission};

@@ -1,0 +1,420 @@
+//! `contour-eval`: the offline five-axis contour-error evaluation (docs/design.md §5.3a).
+//! Reads a reference (CL file, two-curve JSON or built-in) and a measured run (CSV of
+//! joints), maps every sample to a reference segment with the windowed Viterbi decoder,
+//! and writes the per-sample foot-point errors and, on request, the per-reference-point
+//! evaluation-function estimates and a PNG plot.
+//!
+//! Outputs are written beside their targets under a temporary name and renamed into
+//! place only when everything succeeded: a failed run leaves existing files as they were.
+
+use std::fs::File;
+use std::io::{BufRead, BufReader, BufWriter, IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use contour_core::contour::five_axis::run_evaluation::{
+    evaluate_run, suggested_max_skip, RunEvaluation, RunSettings,
+};
+use contour_core::geometry::{self, Vector};
+use contour_core::kinematics::{Joints, Pose, TableTiltingAc};
+use contour_core::path::load_poses;
+
+mod plot;
+
+const USAGE: &str = "\
+usage: contour-eval --path PART.cl|PART.apt|PART.json|tilted_helix|figure_eight
+                    --measured RUN.csv --out ERR.csv [--out-reference REF.csv]
+                    [--plot ERR.png] [--tool-length 100] [--pivot-a Y,Z] [--pivot-c X,Y]
+                    [--max-skip K] [--angle-weight 0.1] [--window W]
+
+Maps every measured sample to a segment of the reference (HMM, Viterbi) and reports the
+tool-tip and orientation contour errors of a table-tilting A-C machine.
+  RUN.csv   header row with columns time,X,Y,Z,A,C (s, mm, rad) in any order; other
+            columns are ignored
+  ERR.csv   time,segment,tip,orientation per sample (foot-point errors, mm and rad)
+  REF.csv   index,x,y,z,i,j,k,tip,orientation,t per reference point (evaluation-function
+            estimate; empty where no sample is mapped next to the point)
+  --pivot-a Y,Z  a point of the A axis (machine frame, mm; default 0,0)
+  --pivot-c X,Y  a point of the C axis at A = 0 (machine frame, mm; default 0,0)
+  --tool-length  L of the second point along the tool axis used by the mapping, mm
+  --max-skip     most segments the mapping may advance per sample (<= 255); default:
+                 1.5 x the largest measured tip step over the median reference segment
+  --angle-weight weight of the motion-direction term of the mapping, mm/rad
+  --window       candidate segments per sample of the mapping; default max(64, 8 K)
+A JSON reference is sampled into poses with tip chords of at most 0.01 mm.";
+
+/// Longest tip chord when a JSON reference's curves are sampled into poses, mm.
+const JSON_CHORD: f64 = 0.01;
+
+struct Options {
+    path: String,
+    measured: PathBuf,
+    out: PathBuf,
+    out_reference: Option<PathBuf>,
+    plot: Option<PathBuf>,
+    machine: TableTiltingAc,
+    settings: RunSettings,
+    /// --max-skip and --window as given (else chosen from the data).
+    max_skip: Option<usize>,
+    window: Option<usize>,
+}
+
+/// Exit 2: the command line or an input is wrong; exit 1: the run or a write failed.
+enum Failure {
+    Input(String),
+    Run(String),
+}
+
+fn pair(text: &str, what: &str) -> Result<(f64, f64), String> {
+    let values: Vec<&str> = text.split(',').collect();
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("{what} '{text}': '{v}' is not a finite number"))
+    };
+    match values.as_slice() {
+        [a, b] => Ok((parse(a)?, parse(b)?)),
+        _ => Err(format!(
+            "{what} needs two comma-separated numbers, got '{text}'"
+        )),
+    }
+}
+
+fn parse(args: &[String]) -> Result<Option<Options>, String> {
+    let defaults = RunSettings::default();
+    let (mut path, mut measured, mut out) = (None, None, None);
+    let mut o = Options {
+        path: String::new(),
+        measured: PathBuf::new(),
+        out: PathBuf::new(),
+        out_reference: None,
+        plot: None,
+        machine: TableTiltingAc::default(),
+        settings: defaults,
+        max_skip: None,
+        window: None,
+    };
+    let mut it = args.iter();
+    while let Some(flag) = it.next() {
+        if flag == "-h" || flag == "--help" {
+            return Ok(None);
+        }
+        let value = it.next().ok_or_else(|| format!("{flag} needs a value"))?;
+        let number = |what: &str| -> Result<f64, String> {
+            value
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && *v >= 0.0)
+                .ok_or_else(|| format!("{what} '{value}' must be a finite number >= 0"))
+        };
+        let count = |what: &str| -> Result<usize, String> {
+            value
+                .parse::<usize>()
+                .map_err(|e| format!("{what} '{value}': {e}"))
+        };
+        match flag.as_str() {
+            "--path" => path = Some(value.clone()),
+            "--measured" => measured = Some(PathBuf::from(value)),
+            "--out" => out = Some(PathBuf::from(value)),
+            "--out-reference" => o.out_reference = Some(PathBuf::from(value)),
+            "--plot" => o.plot = Some(PathBuf::from(value)),
+            "--tool-length" => o.settings.tool_length = number("--tool-length")?,
+            "--pivot-a" => {
+                let (y, z) = pair(value, "--pivot-a")?;
+                o.machine.a_pivot = Vector::<3>::new(0.0, y, z);
+            }
+            "--pivot-c" => {
+                let (x, y) = pair(value, "--pivot-c")?;
+                o.machine.c_pivot = Vector::<3>::new(x, y, 0.0);
+            }
+            "--max-skip" => {
+                let k = count("--max-skip")?;
+                if !(1..=255).contains(&k) {
+                    return Err(format!("--max-skip must be 1 ... 255, got {k}"));
+                }
+                o.max_skip = Some(k);
+            }
+            "--angle-weight" => o.settings.params.angle_weight = number("--angle-weight")?,
+            "--window" => o.window = Some(count("--window")?),
+            other => return Err(format!("unknown option '{other}'")),
+        }
+    }
+    o.path = path.ok_or("--path is required")?;
+    o.measured = measured.ok_or("--measured is required")?;
+    o.out = out.ok_or("--out is required")?;
+    if let (Some(window), Some(max_skip)) = (o.window, o.max_skip) {
+        if window <= max_skip {
+            return Err(format!(
+                "--window must exceed --max-skip ({max_skip}), got {window}"
+            ));
+        }
+    }
+    Ok(Some(o))
+}
+
+/// The reference poses named by `--path` (CL warnings to stderr).
+fn load_reference(spec: &str) -> Result<Vec<Pose>, String> {
+    let (poses, warnings) = load_poses(spec, JSON_CHORD).map_err(|e| e.to_string())?;
+    for warning in &warnings {
+        eprintln!("contour-eval: warning: {warning}");
+    }
+    Ok(poses)
+}
+
+/// The measured run: times and joints.
+struct Measured {
+    times: Vec<f64>,
+    joints: Vec<Joints>,
+}
+
+fn read_measured(file: &Path) -> Result<Measured, String> {
+    let name = file.display();
+    let reader = BufReader::new(File::open(file).map_err(|e| format!("{name}: cannot read: {e}"))?);
+    let mut lines = reader.lines();
+    let header = match lines.next() {
+        Some(line) => line.map_err(|e| format!("{name}:1: cannot read: {e}"))?,
+        None => return Err(format!("{name}: empty file, expected a header row")),
+    };
+    let columns: Vec<&str> = header.split(',').map(str::trim).collect();
+    const WANTED: [&str; 6] = ["time", "X", "Y", "Z", "A", "C"];
+    let index = WANTED
+        .iter()
+        .map(|w| {
+            columns.iter().position(|c| c == w).ok_or_else(|| {
+                format!("{name}:1: no column '{w}' in the header (need time,X,Y,Z,A,C)")
+            })
+        })
+        .collect::<Result<Vec<usize>, String>>()?;
+    let needed = index.iter().max().map_or(0, |&i| i + 1);
+    let mut run = Measured {
+        times: Vec::new(),
+        joints: Vec::new(),
+    };
+    let mut values = [0.0; 6];
+    for (number, line) in lines.enumerate() {
+        let at = number + 2;
+        let line = line.map_err(|e| format!("{name}:{at}: cannot read: {e}"))?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let fields: Vec<&str> = line.split(',').collect();
+        if fields.len() < needed {
+            return Err(format!(
+                "{name}:{at}: {} fields, the header needs at least {needed}",
+                fields.len()
+            ));
+        }
+        for (slot, (&i, w)) in values.iter_mut().zip(index.iter().zip(WANTED)) {
+            let text = fields[i].trim();
+            let v: f64 = text
+                .parse()
+                .map_err(|_| format!("{name}:{at}: column '{w}': '{text}' is not a number"))?;
+            if !v.is_finite() {
+                return Err(format!("{name}:{at}: column '{w}': '{text}' is not finite"));
+            }
+            *slot = v;
+        }
+        run.times.push(values[0]);
+        run.joints.push(Joints::new(
+            values[1], values[2], values[3], values[4], values[5],
+        ));
+    }
+    if run.joints.is_empty() {
+        return Err(format!("{name}: no measured samples after the header"));
+    }
+    Ok(run)
+}
+
+/// An output written under a temporary name beside its target.
+struct Staged {
+    temporary: PathBuf,
+    target: PathBuf,
+}
+
+impl Staged {
+    fn new(target: &Path) -> Staged {
+        let name = target
+            .file_name()
+            .map_or("output".into(), |n| n.to_string_lossy().into_owned());
+        // Same extension at the end: the PNG encoder picks its format from it.
+        let extension = target
+            .extension()
+            .map_or("tmp".into(), |e| e.to_string_lossy().into_owned());
+        let temporary = target.with_file_name(format!(
+            ".{name}.partial-{}.{extension}",
+            std::process::id()
+        ));
+        Staged {
+            temporary,
+            target: target.to_path_buf(),
+        }
+    }
+
+    fn create(&self) -> Result<BufWriter<File>, String> {
+        File::create(&self.temporary)
+            .map(|f| BufWriter::with_capacity(1 << 20, f))
+            .map_err(|e| format!("cannot write {}: {e}", self.target.display()))
+    }
+}
+
+fn write_errors(
+    staged: &Staged,
+    times: &[f64],
+    result: &RunEvaluation,
+) -> Result<(), std::io::Error> {
+    let mut w = staged.create().map_err(std::io::Error::other)?;
+    writeln!(w, "time,segment,tip,orientation")?;
+    for (t, s) in times.iter().zip(&result.samples) {
+        writeln!(w, "{t},{},{},{}", s.segment, s.tip, s.orientation)?;
+    }
+    w.into_inner().map_err(|e| e.into_error())?.sync_all()
+}
+
+fn write_reference(
+    staged: &Staged,
+    reference: &[Pose],
+    result: &RunEvaluation,
+) -> Result<(), std::io::Error> {
+    let mut w = staged.create().map_err(std::io::Error::other)?;
+    writeln!(w, "index,x,y,z,i,j,k,tip,orientation,t")?;
+    for (index, (pose, e)) in reference.iter().zip(&result.references).enumerate() {
+        let (p, o) = (pose.tip, geometry::unit(&pose.axis).unwrap_or(pose.axis));
+        write!(
+            w,
+            "{index},{},{},{},{},{},{},",
+            p[0], p[1], p[2], o[0], o[1], o[2]
+        )?;
+        match e {
+            Some(e) => writeln!(w, "{},{},{}", e.tip, e.orientation, e.t)?,
+            None => writeln!(w, ",,")?,
+        }
+    }
+    w.into_inner().map_err(|e| e.into_error())?.sync_all()
+}
+
+fn run(mut o: Options) -> Result<(), Failure> {
+    let started = Instant::now();
+    let reference = load_reference(&o.path).map_err(Failure::Input)?;
+    let measured = read_measured(&o.measured).map_err(Failure::Input)?;
+    let max_skip = o
+        .max_skip
+        .unwrap_or_else(|| suggested_max_skip(&o.machine, &reference, &measured.joints));
+    o.settings.params.max_skip = max_skip;
+    // Room for a few moves of K either side of the best segment.
+    o.settings.window = o.window.unwrap_or(o.settings.window.max(8 * max_skip));
+
+    let terminal = std::io::stderr().is_terminal();
+    let bar = indicatif::ProgressBar::new(1);
+    if terminal {
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:30} {percent:>3}%  elapsed {elapsed}  ETA {eta}",
+            )
+            .expect("valid template"),
+        );
+    } else {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    let result = evaluate_run(
+        &o.machine,
+        &reference,
+        &measured.joints,
+        &o.settings,
+        |done, total| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        },
+    )
+    .map_err(|e| Failure::Input(e.to_string()))?;
+    bar.finish_and_clear();
+
+    let mut staged = vec![Staged::new(&o.out)];
+    let mut written = write_errors(&staged[0], &measured.times, &result)
+        .map_err(|e| format!("cannot write {}: {e}", o.out.display()));
+    if let (Ok(()), Some(target)) = (&written, &o.out_reference) {
+        staged.push(Staged::new(target));
+        written = write_reference(&staged[staged.len() - 1], &reference, &result)
+            .map_err(|e| format!("cannot write {}: {e}", target.display()));
+    }
+    if let (Ok(()), Some(target)) = (&written, &o.plot) {
+        staged.push(Staged::new(target));
+        written = plot::errors_against_time(
+            &staged[staged.len() - 1].temporary,
+            &measured.times,
+            &result.samples,
+        )
+        .map_err(|e| format!("cannot plot {}: {e}", target.display()));
+    }
+    // All or nothing: rename only when every output is complete.
+    let renamed = written.and_then(|()| {
+        staged.iter().try_for_each(|s| {
+            std::fs::rename(&s.temporary, &s.target)
+                .map_err(|e| format!("cannot write {}: {e}", s.target.display()))
+        })
+    });
+    if let Err(message) = renamed {
+        for s in &staged {
+            let _ = std::fs::remove_file(&s.temporary);
+        }
+        return Err(Failure::Run(message));
+    }
+
+    let n = result.samples.len() as f64;
+    let (mut tip_max, mut tip_sum, mut rot_max, mut rot_sum) = (0.0f64, 0.0, 0.0f64, 0.0);
+    for s in &result.samples {
+        tip_max = tip_max.max(s.tip);
+        tip_sum += s.tip;
+        rot_max = rot_max.max(s.orientation);
+        rot_sum += s.orientation;
+    }
+    let estimated = result.references.iter().filter(|e| e.is_some()).count();
+    println!("samples: {}", result.samples.len());
+    println!(
+        "tip error: max {:.3} um, mean {:.3} um",
+        tip_max * 1e3,
+        tip_sum / n * 1e3
+    );
+    println!(
+        "orientation error: max {:.3} urad, mean {:.3} urad",
+        rot_max * 1e6,
+        rot_sum / n * 1e6
+    );
+    println!(
+        "reference points: {} ({estimated} with an evaluation-function estimate)",
+        reference.len()
+    );
+    println!(
+        "mapping: max skip {}, window {} segments",
+        o.settings.params.max_skip, o.settings.window
+    );
+    println!("time: {:.2} s", started.elapsed().as_secs_f64());
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match parse(&args) {
+        Ok(None) => {
+            println!("{USAGE}");
+            ExitCode::SUCCESS
+        }
+        Ok(Some(options)) => match run(options) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(Failure::Input(message)) => {
+                eprintln!("contour-eval: {message}");
+                ExitCode::from(2)
+            }
+            Err(Failure::Run(message)) => {
+                eprintln!("contour-eval: {message}");
+                ExitCode::FAILURE
+            }
+        },
+        Err(message) => {
+            eprintln!("contour-eval: {message}\n{USAGE}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,407 @@
+//! Runs the `contour-eval` binary on measured runs made here from a known displacement
+//! of the tilted helix, so the expected errors are analytic, and on bad inputs.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use contour_core::geometry::{self, Vector};
+use contour_core::kinematics::{Pose, TableTiltingAc};
+use contour_core::path::JointReference;
+use contour_core::path::ToolPath;
+
+type V3 = Vector<3>;
+
+/// Radial tip offset, mm, and tool tilt, rad, of the measured run.
+const OFFSET: f64 = 0.020;
+const TILT: f64 = 50e-6;
+
+/// The machine of the tests, as given on the command line.
+fn machine() -> TableTiltingAc {
+    TableTiltingAc {
+        a_pivot: V3::new(0.0, 0.0, -50.0),
+        c_pivot: V3::new(5.0, -3.0, 0.0),
+    }
+}
+
+const PIVOTS: [&str; 4] = ["--pivot-a", "0,-50", "--pivot-c", "5,-3"];
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("contour-eval-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Samples of the measured run: 0.4 s, 8 mm of the helix (a debug build evaluates it
+/// in seconds).
+const SAMPLES: usize = 400;
+
+/// The first SAMPLES of the helix followed at 20 mm/s, 1 kHz, with the tip moved OFFSET outward (normal to
+/// the helix) and the tool turned TILT in its vertical plane (normal to the way the axis
+/// turns along the path): columns shuffled, plus one the tool must ignore. Returns the
+/// CSV text and the helix parameter u (segment + fraction) of each row.
+fn displaced_helix_csv() -> (String, Vec<f64>) {
+    let machine = machine();
+    let mut reference = JointReference::new(ToolPath::tilted_helix(), machine, 20.0, 1e-3).unwrap();
+    let mut text = String::from("C,time,note,X,Y,Z,A\n");
+    let mut us = Vec::new();
+    let mut c = 0.0;
+    let mut k = 0;
+    loop {
+        let s = reference.current();
+        let Pose { tip, axis } = s.pose;
+        // The tool leans toward the helix's centre line: outward is the other way.
+        let outward = geometry::unit(&V3::new(-axis[0], -axis[1], 0.0)).unwrap();
+        let about = geometry::unit(&V3::z().cross(&axis)).unwrap();
+        let turned = axis * TILT.cos() + about.cross(&axis) * TILT.sin();
+        let moved = Pose {
+            tip: tip + outward * OFFSET,
+            axis: turned,
+        };
+        let q = machine.inverse(&moved, c).unwrap();
+        c = q[4];
+        writeln!(
+            text,
+            "{},{},x,{},{},{},{}",
+            q[4],
+            k as f64 * 1e-3,
+            q[0],
+            q[1],
+            q[2],
+            q[3]
+        )
+        .unwrap();
+        us.push(s.u);
+        if us.len() == SAMPLES {
+            break;
+        }
+        reference.step().unwrap();
+        k += 1;
+    }
+    (text, us)
+}
+
+fn contour_eval(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_contour-eval"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn rows(file: &Path) -> Vec<Vec<String>> {
+    std::fs::read_to_string(file)
+        .unwrap()
+        .lines()
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect()
+}
+
+/// ERR.csv holds the displacement at every sample, each mapped where it is.
+fn check_errors(file: &Path, us: &[f64]) {
+    let rows = rows(file);
+    assert_eq!(rows[0], ["time", "segment", "tip", "orientation"]);
+    assert_eq!(rows.len() - 1, us.len());
+    for (k, (row, u)) in rows[1..].iter().zip(us).enumerate() {
+        let time: f64 = row[0].parse().unwrap();
+        let segment: f64 = row[1].parse().unwrap();
+        let tip: f64 = row[2].parse().unwrap();
+        let orientation: f64 = row[3].parse().unwrap();
+        assert_eq!(time, k as f64 * 1e-3);
+        // Its own segment or a neighbour: on 3 µm segments those differ by nm in cost.
+        assert!(
+            segment <= u + 1.0 && u - segment <= 2.0,
+            "row {k}: segment {segment}, u {u}"
+        );
+        assert!((tip - OFFSET).abs() < 0.05e-3, "row {k}: tip {tip}");
+        assert!(
+            (orientation - TILT).abs() < 5e-6,
+            "row {k}: orientation {orientation}"
+        );
+    }
+}
+
+/// REF.csv: the same displacement at every reference point the run passes, none near the
+/// first sample (no sample before it to fit) nor after the run's end; the run's samples
+/// are at helix parameters `us`.
+fn check_reference(file: &Path, points: usize, us: &[f64]) {
+    // Points past the last but one sample may be nearest the last (no sample after it).
+    let last_u = us[us.len() - 2];
+    let rows = rows(file);
+    assert_eq!(
+        rows[0],
+        [
+            "index",
+            "x",
+            "y",
+            "z",
+            "i",
+            "j",
+            "k",
+            "tip",
+            "orientation",
+            "t"
+        ]
+    );
+    assert_eq!(rows.len() - 1, points);
+    let passed = last_u.floor() as usize;
+    let mut estimated = 0;
+    for (i, row) in rows[1..].iter().enumerate() {
+        assert_eq!(row[0], i.to_string());
+        if row[7].is_empty() {
+            assert!(row[8].is_empty() && row[9].is_empty());
+            assert!(
+                i < us[1].ceil() as usize || i >= passed,
+                "point {i} has no estimate"
+            );
+            continue;
+        }
+        assert!(
+            i <= us[us.len() - 1].ceil() as usize,
+            "point {i} beyond the run has an estimate"
+        );
+        let tip: f64 = row[7].parse().unwrap();
+        let orientation: f64 = row[8].parse().unwrap();
+        let t: f64 = row[9].parse().unwrap();
+        assert!((tip - OFFSET).abs() < 0.05e-3, "point {i}: tip {tip}");
+        assert!(
+            (orientation - TILT).abs() < 5e-6,
+            "point {i}: {orientation}"
+        );
+        assert!((-1.0..=1.0).contains(&t));
+        estimated += 1;
+    }
+    assert!(estimated + 10 >= passed, "{estimated} of {passed}");
+}
+
+#[test]
+fn a_displaced_helix_gives_its_displacement() {
+    let dir = scratch("helix");
+    let (csv, us) = displaced_helix_csv();
+    let (run, err, reference, plot) = (
+        dir.join("run.csv"),
+        dir.join("err.csv"),
+        dir.join("ref.csv"),
+        dir.join("err.png"),
+    );
+    std::fs::write(&run, csv).unwrap();
+    let mut args = vec![
+        "--path",
+        "tilted_helix",
+        "--measured",
+        s(&run),
+        "--out",
+        s(&err),
+        "--out-reference",
+        s(&reference),
+        "--plot",
+        s(&plot),
+    ];
+    args.extend(PIVOTS);
+    let out = contour_eval(&args);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains(&format!("samples: {}", us.len())),
+        "{stdout}"
+    );
+    assert!(stdout.contains("tip error: max 20.0"), "{stdout}");
+    check_errors(&err, &us);
+    let ToolPath::Poses { tips, .. } = ToolPath::tilted_helix() else {
+        unreachable!("the helix is sampled")
+    };
+    check_reference(&reference, tips.points().len(), &us);
+    // A PNG of the designed size: signature, then IHDR width and height.
+    let png = std::fs::read(&plot).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    assert_eq!(&png[16..24], &[0, 0, 4, 176, 0, 0, 3, 32]);
+    // Nothing else left in the folder.
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["err.csv", "err.png", "ref.csv", "run.csv"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_same_helix_as_cl_data_gives_the_same_errors() {
+    let dir = scratch("cl");
+    let ToolPath::Poses { tips, axes } = ToolPath::tilted_helix() else {
+        unreachable!("the helix is sampled")
+    };
+    let mut cl = String::from("PARTNO/HELIX\n$$ the tilted helix\nMULTAX\nFEDRAT/MMPM,1200\n");
+    let (csv, us) = displaced_helix_csv();
+    let needed = us[us.len() - 1] as usize + 50;
+    for (p, o) in tips.points().iter().zip(axes.iter()).take(needed) {
+        writeln!(
+            cl,
+            "GOTO/{:.7},{:.7},{:.7},{:.12},{:.12},{:.12}",
+            p[0], p[1], p[2], o[0], o[1], o[2]
+        )
+        .unwrap();
+    }
+    cl.push_str("FINI\n");
+    let (part, run, err) = (dir.join("helix.cl"), dir.join("run.csv"), dir.join("e.csv"));
+    std::fs::write(&part, cl).unwrap();
+    std::fs::write(&run, csv).unwrap();
+    let mut args = vec!["--path", s(&part), "--measured", s(&run), "--out", s(&err)];
+    args.extend(PIVOTS);
+    let out = contour_eval(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    check_errors(&err, &us);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_inputs_fail_naming_the_cause_and_write_nothing() {
+    let dir = scratch("bad");
+    let good = "time,X,Y,Z,A,C\n0,20,0,0,0.35,0\n0.001,20,0.01,0,0.35,0\n";
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let good_run = write("good.csv", good);
+    let no_a = write("no_a.csv", "time,X,Y,Z,C\n0,1,2,3,4\n");
+    let nan = write(
+        "nan.csv",
+        "time,X,Y,Z,A,C\n0,20,0,0,0.35,0\n0.001,20,NaN,0,0.35,0\n",
+    );
+    let word = write(
+        "word.csv",
+        "time,X,Y,Z,A,C\n0,20,0,0,0.35,0\n0.001,20,0,0,abc,0\n",
+    );
+    let no_goto = write("empty.cl", "PARTNO/NOTHING\nMULTAX\n$$ no motion\nFINI\n");
+    let missing = dir.join("missing.csv");
+    let missing_cl = dir.join("missing.cl");
+    let cases: Vec<(String, &Path, Vec<&str>)> = vec![
+        (
+            s(&no_a).to_string(),
+            &no_a,
+            vec!["no_a.csv:1", "no column 'A'"],
+        ),
+        (
+            s(&nan).to_string(),
+            &nan,
+            vec!["nan.csv:3", "column 'Y'", "not finite"],
+        ),
+        (
+            s(&word).to_string(),
+            &word,
+            vec!["word.csv:3", "'abc' is not a number"],
+        ),
+        ("".to_string(), &missing, vec!["missing.csv", "cannot read"]),
+    ];
+    let out_file = dir.join("out.csv");
+    let ref_file = dir.join("ref.csv");
+    std::fs::write(&out_file, "keep me\n").unwrap();
+    let check = |args: &[&str], expected: &[&str]| {
+        let out = contour_eval(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        for e in expected {
+            assert!(stderr.contains(e), "{args:?}: expected '{e}' in {stderr}");
+        }
+        assert_eq!(std::fs::read_to_string(&out_file).unwrap(), "keep me\n");
+        assert!(!ref_file.exists());
+    };
+    for (_, measured, expected) in &cases {
+        check(
+            &[
+                "--path",
+                "tilted_helix",
+                "--measured",
+                s(measured),
+                "--out",
+                s(&out_file),
+                "--out-reference",
+                s(&ref_file),
+            ],
+            expected,
+        );
+    }
+    let with_path = |path: &str| {
+        vec![
+            "--path".to_string(),
+            path.to_string(),
+            "--measured".into(),
+            s(&good_run).into(),
+            "--out".into(),
+            s(&out_file).into(),
+            "--out-reference".into(),
+            s(&ref_file).into(),
+        ]
+    };
+    for (path, expected) in [
+        (s(&no_goto), vec!["empty.cl", "at least two GOTO points"]),
+        (
+            "spiral",
+            vec![
+                "unknown five-axis path \"spiral\"",
+                "tilted_helix",
+                "figure_eight",
+            ],
+        ),
+        (s(&missing_cl), vec!["missing.cl", "cannot read"]),
+    ] {
+        let args = with_path(path);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        check(&args, &expected);
+    }
+    // Command-line mistakes: exit 2 too.
+    check(
+        &["--path", "tilted_helix", "--out", s(&out_file)],
+        &["--measured is required"],
+    );
+    check(
+        &[
+            "--path",
+            "tilted_helix",
+            "--measured",
+            s(&good_run),
+            "--out",
+            s(&out_file),
+            "--pivot-a",
+            "1",
+        ],
+        &["--pivot-a needs two"],
+    );
+    // Only the inputs and the untouched output remain: no temporary files.
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["empty.cl", "good.csv", "nan.csv", "no_a.csv", "out.csv", "word.csv"]
+    );
+    // And the good run then replaces the output.
+    let args = with_path("tilted_helix");
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = contour_eval(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(std::fs::read_to_string(&out_file)
+        .unwrap()
+        .starts_with("time,segment,tip,orientation\n"));
+    assert!(ref_file.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

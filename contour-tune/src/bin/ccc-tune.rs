@@ -1,0 +1,232 @@
+//! `ccc-tune`: tunes the fuzzy CCC's five scaling factors (kε, kΔε, kpf, kif, kdf) with
+//! the standard or improved PSO on an in-process closed loop (docs/design.md §4.4), and writes
+//! the result as JSON that the ContourCCC2D FMU takes as start values. The JSON holds
+//! only what the run determines (no timing), so the same seed gives the same file on any
+//! number of threads.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use contour_core::path::Path;
+use contour_core::sim::preset_feed;
+use contour_tune::objective::{ContourObjective, Fitness, FACTOR_NAMES, LOWER, UPPER};
+use contour_tune::{minimize, Algorithm, PsoSettings};
+use serde_json::json;
+
+const USAGE: &str = "\
+usage: ccc-tune [--path circle|infinity|trident|FILE] [--feed MM_PER_S] [--swarm 50]
+                [--iters 100] [--algorithm improved|standard] [--seed 1] [--out tuned.json]
+                [--lower a,b,c,d,e] [--upper a,b,c,d,e] [--plant paper|mismatched]
+                [--fitness mean|max] [--threads N]
+
+Minimises the mean (or max) |true contour error| of the closed loop interpolator -> fuzzy-PID CCC
+-> XYServoPlant over the factors (ke, kde, kp, ki, kd) of ContourCCC2D. The feed defaults
+to 10*pi mm/s on the circle (the paper's) and 50 mm/s elsewhere.";
+
+struct Options {
+    path: String,
+    feed: Option<f64>,
+    swarm: usize,
+    iterations: usize,
+    algorithm: Algorithm,
+    seed: u64,
+    out: PathBuf,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    plant: String,
+    fitness: Fitness,
+    threads: Option<usize>,
+}
+
+fn parse_list(text: &str, what: &str) -> Result<Vec<f64>, String> {
+    let values: Result<Vec<f64>, _> = text.split(',').map(|v| v.trim().parse::<f64>()).collect();
+    let values = values.map_err(|e| format!("{what}: {e} in '{text}'"))?;
+    if values.len() != FACTOR_NAMES.len() {
+        return Err(format!(
+            "{what} needs {} comma-separated values ({}), got {}",
+            FACTOR_NAMES.len(),
+            FACTOR_NAMES.join(", "),
+            values.len()
+        ));
+    }
+    Ok(values)
+}
+
+fn parse(args: &[String]) -> Result<Option<Options>, String> {
+    let mut o = Options {
+        path: "circle".into(),
+        feed: None,
+        swarm: 50,
+        iterations: 100,
+        algorithm: Algorithm::Improved,
+        seed: 1,
+        out: PathBuf::from("tuned.json"),
+        lower: LOWER.to_vec(),
+        upper: UPPER.to_vec(),
+        plant: "paper".into(),
+        fitness: Fitness::Mean,
+        threads: None,
+    };
+    let mut it = args.iter();
+    while let Some(flag) = it.next() {
+        if flag == "-h" || flag == "--help" {
+            return Ok(None);
+        }
+        let value = it.next().ok_or_else(|| format!("{flag} needs a value"))?;
+        let number = |what: &str| -> Result<f64, String> {
+            value
+                .parse::<f64>()
+                .map_err(|e| format!("{what} '{value}': {e}"))
+        };
+        let count = |what: &str| -> Result<usize, String> {
+            value
+                .parse::<usize>()
+                .map_err(|e| format!("{what} '{value}': {e}"))
+        };
+        match flag.as_str() {
+            "--path" => o.path = value.clone(),
+            "--feed" => o.feed = Some(number("--feed")?),
+            "--swarm" => o.swarm = count("--swarm")?,
+            "--iters" => o.iterations = count("--iters")?,
+            "--algorithm" => o.algorithm = value.parse()?,
+            "--seed" => {
+                o.seed = value
+                    .parse()
+                    .map_err(|e| format!("--seed '{value}': {e}"))?
+            }
+            "--out" => o.out = PathBuf::from(value),
+            "--lower" => o.lower = parse_list(value, "--lower")?,
+            "--upper" => o.upper = parse_list(value, "--upper")?,
+            "--plant" => o.plant = value.clone(),
+            "--fitness" => o.fitness = value.parse()?,
+            "--threads" => o.threads = Some(count("--threads")?),
+            other => return Err(format!("unknown option '{other}'")),
+        }
+    }
+    Ok(Some(o))
+}
+
+fn run(o: Options) -> Result<(), String> {
+    if let Some(threads) = o.threads {
+        if threads == 0 {
+            return Err("--threads must be at least 1".into());
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build_global()
+            .map_err(|e| e.to_string())?;
+    }
+    if o.lower.iter().any(|&v| v < 0.0) {
+        return Err("--lower: the fuzzy factors cannot be negative".into());
+    }
+    let path = Path::from_spec(&o.path, None).map_err(|e| format!("--path: {e}"))?;
+    let feed = o.feed.unwrap_or_else(|| preset_feed(&path));
+    let objective = ContourObjective::new(path, feed, &o.plant, o.fitness)?;
+    let settings = PsoSettings {
+        algorithm: o.algorithm,
+        swarm: o.swarm,
+        iterations: o.iterations,
+        lower: o.lower.clone(),
+        upper: o.upper.clone(),
+        velocity_fraction: 0.2,
+        seed: o.seed,
+    };
+    settings.validate()?;
+
+    let started = Instant::now();
+    let terminal = std::io::stderr().is_terminal();
+    let bar = indicatif::ProgressBar::new(o.iterations as u64);
+    if terminal {
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:30} iteration {pos}/{len}  best {msg}  elapsed {elapsed}  ETA {eta}",
+            )
+            .expect("valid template"),
+        );
+    } else {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    let result = minimize(
+        settings.clone(),
+        |x| objective.evaluate(x),
+        |iteration, best| {
+            bar.set_position(iteration as u64);
+            bar.set_message(format!("{:.4} um", best * 1e3));
+            if !terminal {
+                eprintln!(
+                    "iteration {iteration}/{}: best fitness {:.4} um",
+                    o.iterations,
+                    best * 1e3
+                );
+            }
+        },
+    )?;
+    bar.finish_and_clear();
+    let elapsed = started.elapsed().as_secs_f64();
+
+    let factors: serde_json::Map<String, serde_json::Value> = FACTOR_NAMES
+        .iter()
+        .zip(&result.best)
+        .map(|(name, value)| (name.to_string(), json!(value)))
+        .collect();
+    let document = json!({
+        "factors": factors,
+        "fitness_mm": result.fitness,
+        "history_mm": result.history,
+        "settings": {
+            "path": o.path,
+            "feed_mm_per_s": feed,
+            "plant": o.plant,
+            "fitness": o.fitness,
+            "ts_s": objective.ts(),
+            "algorithm": settings.algorithm,
+            "swarm": settings.swarm,
+            "iterations": settings.iterations,
+            "lower": settings.lower,
+            "upper": settings.upper,
+            "velocity_fraction": settings.velocity_fraction,
+            "seed": settings.seed,
+        },
+    });
+    let text = serde_json::to_string_pretty(&document).map_err(|e| e.to_string())? + "\n";
+    // Written beside the target and renamed into place: a failed write leaves nothing.
+    let partial = o.out.with_extension("json.partial");
+    std::fs::write(&partial, text)
+        .map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
+    std::fs::rename(&partial, &o.out).map_err(|e| {
+        let _ = std::fs::remove_file(&partial);
+        format!("cannot write {}: {e}", o.out.display())
+    })?;
+    eprintln!(
+        "best {:?} |true contour error| {:.4} um after {} x {} evaluations in {elapsed:.2} s; wrote {}",
+        o.fitness,
+        result.fitness * 1e3,
+        o.iterations,
+        o.swarm,
+        o.out.display()
+    );
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match parse(&args) {
+        Ok(None) => {
+            println!("{USAGE}");
+            ExitCode::SUCCESS
+        }
+        Ok(Some(options)) => match run(options) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(message) => {
+                eprintln!("ccc-tune: {message}");
+                ExitCode::FAILURE
+            }
+        },
+        Err(message) => {
+            eprintln!("ccc-tune: {message}\n{USAGE}");
+            ExitCode::from(2)
+        }
+    }
+}

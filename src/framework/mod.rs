@@ -1,0 +1,14 @@
+//! The FMU framework: what every model is built from and what the FMI layer drives,
+//! knowing no FMU and no control law. A model declares its variables ([`variables`],
+//! assembled per axis by [`variable_table`], with [`units`] and fixed [`text`]), steps on
+//! a [`sample_clock`], implements [`model::Model`], and saves its state through
+//! [`state_codec`], checked on restore by [`state_check`].
+
+pub mod model;
+pub mod sample_clock;
+pub mod state_check;
+pub mod state_codec;
+pub mod text;
+pub mod units;
+pub mod variable_table;
+pub mod variables;
