@@ -105,9 +105,7 @@ fuzz-long: cargo-fuzz
 # uninstrumented; the test executables export the ASan runtime for the cdylib to find.
 HOST       := $(shell rustc -vV 2>/dev/null | sed -n 's/^host: //p')
 ASAN_FLAGS := -Zsanitizer=address -Clink-arg=-Wl,--export-dynamic
-ASAN_TESTS := --lib --test fmi_abi --test abi_handles --test abi_state_validation \
-              --test abi_two_axis_models --test bad_inputs --test exported_symbols \
-              --test no_alloc --test threads
+ASAN_TESTS := --lib --test abi
 asan:
 	RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=target/asan RUSTFLAGS="$(ASAN_FLAGS)" \
 		$(CARGO) test -p contour-fmu --target $(HOST) --features test-hooks $(ASAN_TESTS)

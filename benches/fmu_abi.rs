@@ -1,12 +1,12 @@
 //! One controller sample as an importer pays for it, through the exported C functions
-//! (linked statically, as tests/no_alloc.rs calls them; an importer adds only the
+//! (linked statically, as tests/abi/no_alloc.rs calls them; an importer adds only the
 //! dlopen'ed call's indirection): `fmi2SetReal` of the inputs, `fmi2DoStep` of 1 ms (one
 //! control period), `fmi2GetReal` of the outputs an importer reads. Each is set against
 //! the same calls with the same number of values on `PassThrough` (a test-only model that
 //! copies inputs to outputs, hence the `test-hooks` feature): the ratio is the
 //! controller's own cost over the ABI and instance bookkeeping. The target for
 //! ContourCCC5X: at most 5 µs median per sample, flat in the path length, no allocation
-//! (the last is tests/no_alloc.rs).
+//! (the last is tests/abi/no_alloc.rs).
 //!
 //! `fmu_abi/contour_ccc_2d_sample`: the reference and measured points of the recorded
 //! two-axis closed loop on the paper's circle (4 inputs, u.x, u.y and contourError read);
@@ -43,7 +43,7 @@ use contour_fmu::framework::model::ModelInfo;
 use contour_fmu::models;
 use criterion::{BenchmarkGroup, Criterion, SamplingMode, Throughput};
 
-#[path = "../tests/common/linked.rs"]
+#[path = "../tests/abi/common/linked.rs"]
 mod linked;
 
 use linked::{

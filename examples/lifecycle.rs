@@ -4,7 +4,7 @@
 //! watch (`valgrind --leak-check=full --error-exitcode=1`, tests/fmpy/test_leaks.py).
 //! Exits non-zero if any call fails.
 
-#[path = "../tests/common/linked.rs"]
+#[path = "../tests/abi/common/linked.rs"]
 mod linked;
 
 use std::ffi::CString;

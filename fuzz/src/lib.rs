@@ -1,5 +1,5 @@
 //! What the fuzz targets share: the exported `fmi2*` functions linked statically (those
-//! of tests/common/linked.rs plus the rest), a logger that reads every message it is
+//! of tests/abi/common/linked.rs plus the rest), a logger that reads every message it is
 //! sent, the panic policy, and the small path files under `fuzz/resources/`.
 //!
 //! Built only by `cargo fuzz` (with `RUSTC_BOOTSTRAP=1`): the logger is a real C variadic
@@ -16,12 +16,12 @@ use contour_fmu::fmi2::bindings::{
     fmi2Real, fmi2Status, fmi2StatusKind, fmi2String, fmi2ValueReference,
 };
 
-#[path = "../../tests/common/linked.rs"]
+#[path = "../../tests/abi/common/linked.rs"]
 pub mod linked;
 
 pub use linked::*;
 
-// The exported functions tests/common/linked.rs does not declare.
+// The exported functions tests/abi/common/linked.rs does not declare.
 extern "C" {
     pub fn fmi2GetTypesPlatform() -> *const c_char;
     pub fn fmi2GetVersion() -> *const c_char;

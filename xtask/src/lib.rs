@@ -143,7 +143,7 @@ pub fn generate() -> Result<Vec<Output>, Error> {
 
     Ok(vec![
         generate_one(library, "src/fmi2/bindings.rs")?,
-        generate_one(test_library, "tests/common/fmi2_library.rs")?,
+        generate_one(test_library, "tests/abi/common/fmi2_library.rs")?,
     ])
 }
 

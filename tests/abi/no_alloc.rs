@@ -56,15 +56,13 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-mod common;
-
 // Linked statically from the rlib (not dlopened), so the counting allocator sees what
 // they allocate.
-use common::linked::{
+use crate::common::linked::{
     fmi2DoStep, fmi2EnterInitializationMode, fmi2ExitInitializationMode, fmi2FreeInstance,
     fmi2GetReal, fmi2Instantiate, fmi2SetReal, fmi2SetupExperiment,
 };
-use common::{callbacks, cstr, fmi2ValueReference, Log};
+use crate::common::{callbacks, cstr, fmi2ValueReference, Log};
 use contour_fmu::models;
 
 #[test]
@@ -144,15 +142,15 @@ fn a_contour_ccc_5x_round_on_a_moving_path_allocates_nothing() {
     // joints run along a helix and the measured ones trail 35 samples behind: the online
     // mapping, the foot-point errors, both laws and the evaluation estimate all run, the
     // mapping's rings wrap, through the ABI, every sample.
-    let model = common::linked::model("ContourCCC5X");
-    let inputs = common::linked::vrs(
+    let model = crate::common::linked::model("ContourCCC5X");
+    let inputs = crate::common::linked::vrs(
         model,
         &[
             "ref.X", "ref.Y", "ref.Z", "ref.A", "ref.C", "pos.X", "pos.Y", "pos.Z", "pos.A",
             "pos.C",
         ],
     );
-    let outputs = common::linked::vrs(
+    let outputs = crate::common::linked::vrs(
         model,
         &[
             "u.X",
@@ -186,7 +184,7 @@ fn a_contour_ccc_5x_round_on_a_moving_path_allocates_nothing() {
     let functions = callbacks(&log);
     let name = cstr("no-alloc-5x");
     // SAFETY: the callbacks (and the log they point to) outlive the instance.
-    let c = unsafe { common::linked::instantiate_started(model, &name, &*functions) };
+    let c = unsafe { crate::common::linked::instantiate_started(model, &name, &*functions) };
     let mut read = [0.0; 9];
     let (mut max_tip, mut max_u) = (0.0f64, 0.0f64);
     let mut round = |k: usize| {

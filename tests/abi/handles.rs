@@ -4,11 +4,8 @@
 //! 0.0.39's `fmi2FreeFMUstate(c, state)` and freeing stored states after a fatal error.
 //!
 //! Needs the `test-hooks` feature (the `FaultProbe` model, for the fatal state).
-#![cfg(feature = "test-hooks")]
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use contour_fmu::models::{fault_probe as probe, xy_servo_plant as plant};
 
 const POS_X: u32 = plant::POS.at(0).vr() as u32;

@@ -3,13 +3,11 @@
 //! memory, …) or come from another state layout are refused by fmi2DeSerializeFMUstate
 //! with fmi2Error and a message naming the cause, and the instance is left as it was.
 //!
-//! The bytes are opened and resealed by hand (tests/common: magic, format version, payload,
+//! The bytes are opened and resealed by hand (tests/abi/common: magic, format version, payload,
 //! CRC-32); values are found in the model's part by their exact bit patterns, computed
 //! independently (parameters we set, the in-process controller's PID integral).
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use contour_core::contour::planar::{Estimator, FreeCurveEstimator};
 use contour_core::control::{ControllerConfig, CrossCoupledController};
 use contour_core::geometry::Vector2;

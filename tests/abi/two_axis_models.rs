@@ -3,11 +3,9 @@
 //! state save/restore (in place, serialized into a fresh instance, and fmusim's
 //! `--initial-fmu-state-file` sequence), and bad parameters.
 
-mod common;
-
 use std::collections::BTreeMap;
 
-use common::*;
+use crate::common::*;
 use contour_core::contour::planar::{Estimator, FreeCurveEstimator};
 use contour_core::control::{ControllerConfig, CrossCoupledController};
 use contour_core::geometry::Vector2;
@@ -465,5 +463,37 @@ fn inconsistent_parameters_are_refused_at_the_end_of_initialization() {
         assert_eq!(set_good(&i), OK);
         assert_eq!(i.exit_init(), OK, "{}", i.last_error());
         assert_eq!(i.step(0.0, 1e-3), OK);
+    }
+}
+
+// XYServoPlant through the ABI.
+
+mod xy_servo_plant {
+    use crate::common::plant_vr::{POS_X, POS_Y, U_X, U_Y, VEL_X};
+    use crate::common::*;
+    use contour_fmu::models::xy_servo_plant as plant;
+
+    #[test]
+    fn one_long_step_equals_many_short_ones() {
+        let coarse = Instance::new(&plant::INFO);
+        let fine = Instance::new(&plant::INFO);
+        coarse.start();
+        fine.start();
+        let mut t = 0.0;
+        for k in 0..20 {
+            let u = [50.0 * (k as f64 * 0.7).sin(), -30.0 + k as f64];
+            assert_eq!(coarse.set_reals(&[U_X, U_Y], &u), OK);
+            assert_eq!(fine.set_reals(&[U_X, U_Y], &u), OK);
+            assert_eq!(coarse.step(t, 0.01), OK);
+            for j in 0..10 {
+                assert_eq!(fine.step(t + j as f64 * 0.001, 0.001), OK);
+            }
+            t += 0.01;
+            let (_, a) = coarse.get_reals(&[POS_X, POS_Y, VEL_X]);
+            let (_, b) = fine.get_reals(&[POS_X, POS_Y, VEL_X]);
+            for (x, y) in a.iter().zip(&b) {
+                assert!((x - y).abs() <= 1e-12 * x.abs().max(1.0), "{a:?} vs {b:?}");
+            }
+        }
     }
 }

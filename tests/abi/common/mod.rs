@@ -15,8 +15,38 @@ pub use contour_fmu::fmi2::bindings::*;
 #[rustfmt::skip]
 mod fmi2_library;
 pub use fmi2_library::*;
-// The same functions linked statically instead (tests/no_alloc.rs, benches/fmu_abi.rs).
+// The same functions linked statically instead (tests/abi/no_alloc.rs, benches/fmu_abi.rs).
 pub mod linked;
+
+/// Steps a started XYServoPlant from sample `from` to `to` (1 ms) under sinusoidal
+/// commands; the positions and the x velocity after each step.
+pub fn run_plant(i: &Instance, from: usize, to: usize) -> Vec<[f64; 3]> {
+    let h = 0.001;
+    (from..to)
+        .map(|k| {
+            let t = k as f64 * h;
+            let u = [20.0 * (5.0 * t).sin(), 15.0 * (3.0 * t).cos()];
+            assert_eq!(i.set_reals(&[plant_vr::U_X, plant_vr::U_Y], &u), OK);
+            assert_eq!(i.step(t, h), OK);
+            let (_, v) = i.get_reals(&[plant_vr::POS_X, plant_vr::POS_Y, plant_vr::VEL_X]);
+            [v[0], v[1], v[2]]
+        })
+        .collect()
+}
+
+/// XYServoPlant's value references that the ABI tests set and read.
+pub mod plant_vr {
+    use contour_fmu::models::xy_servo_plant as plant;
+
+    pub const U_X: u32 = plant::U.at(0).vr() as u32;
+    pub const U_Y: u32 = plant::U.at(1).vr() as u32;
+    pub const POS_X: u32 = plant::POS.at(0).vr() as u32;
+    pub const POS_Y: u32 = plant::POS.at(1).vr() as u32;
+    pub const VEL_X: u32 = plant::VEL.at(0).vr() as u32;
+    /// The first axis's inertia parameter `x.J`.
+    pub const X_J: u32 = 6;
+    pub const POS0_X: u32 = plant::POS0.at(0).vr() as u32;
+}
 use serde::{Deserialize, Serialize};
 
 pub const OK: fmi2Status = fmi2Status_fmi2OK;

@@ -3,7 +3,6 @@
 //! else: no Model Exchange functions (the model descriptions declare Co-Simulation only),
 //! no helper of a dependency, no Rust symbol. Read from the ELF dynamic symbol table, the
 //! table an importer's dlsym looks in.
-#![cfg(target_os = "linux")]
 
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -103,4 +102,57 @@ fn the_library_exports_exactly_the_fmi2_co_simulation_functions() {
          unexpected exported non-functions {others:?}",
         path.display()
     );
+}
+
+/// Through the dlopened library: every function is found and answers.
+#[cfg(feature = "test-hooks")]
+mod through_dlopen {
+    use crate::common::*;
+
+    #[test]
+    fn all_34_functions_are_exported_and_report_the_platform() {
+        let lib = lib();
+        let present = [
+            lib.fmi2GetTypesPlatform.is_ok(),
+            lib.fmi2GetVersion.is_ok(),
+            lib.fmi2SetDebugLogging.is_ok(),
+            lib.fmi2Instantiate.is_ok(),
+            lib.fmi2FreeInstance.is_ok(),
+            lib.fmi2SetupExperiment.is_ok(),
+            lib.fmi2EnterInitializationMode.is_ok(),
+            lib.fmi2ExitInitializationMode.is_ok(),
+            lib.fmi2Terminate.is_ok(),
+            lib.fmi2Reset.is_ok(),
+            lib.fmi2GetReal.is_ok(),
+            lib.fmi2GetInteger.is_ok(),
+            lib.fmi2GetBoolean.is_ok(),
+            lib.fmi2GetString.is_ok(),
+            lib.fmi2SetReal.is_ok(),
+            lib.fmi2SetInteger.is_ok(),
+            lib.fmi2SetBoolean.is_ok(),
+            lib.fmi2SetString.is_ok(),
+            lib.fmi2GetFMUstate.is_ok(),
+            lib.fmi2SetFMUstate.is_ok(),
+            lib.fmi2FreeFMUstate.is_ok(),
+            lib.fmi2SerializedFMUstateSize.is_ok(),
+            lib.fmi2SerializeFMUstate.is_ok(),
+            lib.fmi2DeSerializeFMUstate.is_ok(),
+            lib.fmi2GetDirectionalDerivative.is_ok(),
+            lib.fmi2SetRealInputDerivatives.is_ok(),
+            lib.fmi2GetRealOutputDerivatives.is_ok(),
+            lib.fmi2DoStep.is_ok(),
+            lib.fmi2CancelStep.is_ok(),
+            lib.fmi2GetStatus.is_ok(),
+            lib.fmi2GetRealStatus.is_ok(),
+            lib.fmi2GetIntegerStatus.is_ok(),
+            lib.fmi2GetBooleanStatus.is_ok(),
+            lib.fmi2GetStringStatus.is_ok(),
+        ];
+        assert_eq!(present.len(), 34);
+        assert!(present.iter().all(|&p| p));
+        let platform = unsafe { std::ffi::CStr::from_ptr(lib.fmi2GetTypesPlatform()) };
+        let version = unsafe { std::ffi::CStr::from_ptr(lib.fmi2GetVersion()) };
+        assert_eq!(platform.to_str().unwrap(), "default");
+        assert_eq!(version.to_str().unwrap(), "2.0");
+    }
 }

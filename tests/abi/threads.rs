@@ -3,11 +3,9 @@
 //! nothing but the handle registry, and nothing in a step depends on which thread runs it
 //! or on what the other instances do meanwhile.
 
-mod common;
-
 use std::ffi::CString;
 
-use common::linked::{
+use crate::common::linked::{
     fmi2DoStep, fmi2EnterInitializationMode, fmi2ExitInitializationMode, fmi2FreeInstance,
     fmi2GetReal, fmi2Instantiate, fmi2SetReal, fmi2SetupExperiment, quiet_callbacks,
 };
@@ -184,6 +182,71 @@ fn instances_stepped_on_eight_threads_match_the_same_instances_stepped_serially(
             serial[0] != serial[1],
             "{}: instances alike",
             model.identifier
+        );
+    }
+}
+
+// Instances through the dlopened library, interleaved and across threads.
+
+mod interleaved {
+    use crate::common::plant_vr::{POS0_X, POS_X, U_X};
+    use crate::common::*;
+    use contour_fmu::models::xy_servo_plant as plant;
+
+    #[test]
+    fn instances_are_independent_when_interleaved_and_across_threads() {
+        let alone = Instance::new(&plant::INFO);
+        alone.start();
+        let reference = run_plant(&alone, 0, 200);
+
+        let a = Instance::named(&plant::INFO, "a");
+        let b = Instance::named(&plant::INFO, "b");
+        a.start();
+        assert_eq!(b.setup(0.0, None), OK);
+        assert_eq!(b.enter_init(), OK);
+        assert_eq!(b.set_reals(&[POS0_X], &[5.0]), OK);
+        assert_eq!(b.exit_init(), OK);
+        let mut from_a = Vec::new();
+        for k in 0..200 {
+            from_a.extend(run_plant(&a, k, k + 1));
+            assert_eq!(b.set_reals(&[U_X], &[-100.0]), OK);
+            assert_eq!(b.step(k as f64 * 0.001, 0.001), OK);
+        }
+        assert_eq!(from_a, reference);
+        assert!(b.get_real(POS_X) < 5.0 - 10.0);
+
+        // Each instance stepped on its own thread, concurrently.
+        let results: Vec<Vec<[f64; 3]>> = std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..2)
+                .map(|_| {
+                    scope.spawn(|| {
+                        let i = Instance::new(&plant::INFO);
+                        i.start();
+                        run_plant(&i, 0, 200)
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        assert_eq!(results[0], reference);
+        assert_eq!(results[1], reference);
+    }
+
+    #[test]
+    fn reset_restores_start_values() {
+        let i = Instance::new(&plant::INFO);
+        assert_eq!(i.setup(0.0, None), OK);
+        assert_eq!(i.enter_init(), OK);
+        assert_eq!(i.set_reals(&[POS0_X], &[7.0]), OK);
+        assert_eq!(i.exit_init(), OK);
+        assert_eq!(i.get_real(POS_X), 7.0);
+        run_plant(&i, 0, 20);
+        assert_eq!(i.reset(), OK);
+        assert_eq!(i.setup(0.0, None), OK);
+        assert_eq!(i.enter_init(), OK);
+        assert_eq!(
+            i.get_reals(&[POS0_X, POS_X, U_X]),
+            (OK, vec![0.0, 0.0, 0.0])
         );
     }
 }

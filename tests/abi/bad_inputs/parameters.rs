@@ -1,0 +1,231 @@
+//! Absurd parameters: refused when set, when initialization ends (within their bounds but
+//! not physical), or when the first step overflows.
+
+use super::*;
+
+pub(super) static CASES: &[Case] = &[
+    case(
+        "Ts = 0 (controller)",
+        C2,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("Ts", 0.0)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter 'Ts' must be at least 1e-6 s (got 0)"),
+        Corrected,
+    ),
+    case(
+        "Ts < 0 (five-axis controller)",
+        C5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("Ts", -1e-3)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter 'Ts' must be at least 1e-6 s (got -0.001)"),
+        Corrected,
+    ),
+    case(
+        "Ts of 1 ns (five-axis interpolator)",
+        P5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("Ts", 1e-9)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter 'Ts' must be at least 1e-6 s"),
+        Corrected,
+    ),
+    case(
+        "a negative feed",
+        P2,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("feed", -5.0)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter 'feed' must be > 0 (got -5)"),
+        Corrected,
+    ),
+    case(
+        "a zero feed (five-axis)",
+        P5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("feed", 0.0)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter 'feed' must be > 0 (got 0)"),
+        Corrected,
+    ),
+    case(
+        "a line of zero length",
+        P2,
+        Initialization,
+        |s| {
+            s.exit_with(|s| {
+                let status = s.set_string("path", "line");
+                s.ok(status);
+                s.i().set_reals(&[s.vr("line.x1"), s.vr("line.y1")], &[0.0, 0.0])
+            })
+        },
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameters 'line.*'"),
+        Corrected,
+    ),
+    case(
+        "an arc of negative radius",
+        P2,
+        Initialization,
+        |s| {
+            s.exit_with(|s| {
+                let status = s.set_string("path", "arc");
+                s.ok(status);
+                s.set_real("arc.r", -3.0)
+            })
+        },
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameters 'arc.*': invalid path: arc radius"),
+        Corrected,
+    ),
+    case(
+        "an arc estimator of zero radius",
+        C2,
+        Initialization,
+        |s| {
+            s.exit_with(|s| {
+                let status = s.set_integer("estimator", 3);
+                s.ok(status);
+                s.set_real("arc.r", 0.0)
+            })
+        },
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameters 'arc.*': invalid path: arc radius"),
+        Corrected,
+    ),
+    case(
+        "a zero contour correction limit",
+        C2,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("ccc.limit", 0.0)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter ccc.limit = 0 is invalid"),
+        Corrected,
+    ),
+    case(
+        "a negative position-loop gain",
+        C2,
+        Initialization,
+        |s| s.set_real("axis.y.Ki", -1.0),
+        ERROR,
+        Some("fmi2SetReal: variable 'axis.y.Ki' = -1 is below its minimum 0"),
+        Usable,
+    ),
+    case(
+        "a negative damping of the Jacobian inverse",
+        C5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("damping", -1.0)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter damping = -1 is invalid"),
+        Corrected,
+    ),
+    case(
+        "a zero tool length",
+        C5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("toolLength", 0.0)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter toolLength = 0 is invalid"),
+        Corrected,
+    ),
+    case(
+        "a negative tool length",
+        C5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("toolLength", -150.0)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter toolLength = -150 is invalid"),
+        Corrected,
+    ),
+    case(
+        "a zero mapping beam",
+        C5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("hmm.beam", 0.0)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter hmm.beam = 0 is invalid"),
+        Corrected,
+    ),
+    case(
+        "a zero inertia",
+        XY,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("x.J", 0.0)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter 'x.J' must be > 0 (got 0)"),
+        Corrected,
+    ),
+    case(
+        "a negative viscous friction (damping)",
+        XY,
+        Initialization,
+        |s| s.set_real("y.B", -1.0),
+        ERROR,
+        Some("fmi2SetReal: variable 'y.B' = -1 is below its minimum 0"),
+        Usable,
+    ),
+    case(
+        "a zero gear ratio",
+        F5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("A.ratio", 0.0)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter 'A.ratio' must be > 0 (got 0)"),
+        Corrected,
+    ),
+    case(
+        "a zero ball-screw lead",
+        F5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("Z.lead", 0.0)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter 'Z.lead' must be > 0 (got 0)"),
+        Corrected,
+    ),
+    case(
+        "an inertia of 1e-300 (the plant overflows in its first step)",
+        XY,
+        Initialization,
+        |s| {
+            let status = s.exit_with(|s| s.set_real("x.J", 1e-300));
+            s.ok(status);
+            s.i().step(0.0, H)
+        },
+        ERROR,
+        Some("fmi2DoStep: step at t = 0 failed: output 'pos.x' = NaN is not finite"),
+        ResetRequired,
+    ),
+    case(
+        "a velocity-loop gain of 1e300 (the plant overflows in its first step)",
+        F5,
+        Initialization,
+        |s| {
+            let status = s.exit_with(|s| s.set_real("X.Kvp", 1e300));
+            s.ok(status);
+            s.i().step(0.0, H)
+        },
+        ERROR,
+        Some("fmi2DoStep: step at t = 0 failed: output 'pos.X' = NaN is not finite"),
+        ResetRequired,
+    ),
+    case(
+        "an unknown built-in path",
+        P2,
+        Initialization,
+        |s| s.exit_with(|s| s.set_string("path", "spiral")),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter 'path': unknown path 'spiral'"),
+        Corrected,
+    ),
+    case(
+        "an unknown five-axis built-in path",
+        P5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_string("path", "spiral")),
+        ERROR,
+        Some("fmi2ExitInitializationMode: parameter 'path': invalid path: unknown five-axis path \"spiral\""),
+        Corrected,
+    ),
+];
