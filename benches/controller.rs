@@ -1,5 +1,5 @@
 //! One sample of the two-axis cross-coupled controller (axis loops + free-curve contour
-//! estimate + CCC law), per CCC mode, on the paper's circle (docs/design.md §4.2), and one whole
+//! estimate + CCC law), per CCC mode, on the paper's circle (docs/design/two-axis.md §4.2), and one whole
 //! metrics-only closed-loop run (the PSO's unit of work).
 //!
 //! The controller is fed realistic samples: the reference and actual points of a recorded

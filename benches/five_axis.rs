@@ -1,5 +1,5 @@
 //! One sample of the five-axis controller (axis loops + online HMM mapping + foot-point
-//! errors + tip and orientation laws + damped least squares), docs/design.md §5.
+//! errors + tip and orientation laws + damped least squares), docs/design/five-axis.md §5.
 //!
 //! `five_axis/sample_*`: replays the reference and measured joints of the recorded
 //! closed loop on the figure-eight (2 540 samples, through its crossing) in each CCC mode;

@@ -11,7 +11,7 @@
 //! 2 s); `infinity` and `trident` at 50 mm/s (`sim::FREE_CURVE_FEED`): a 1.75 mm
 //! following error, and with the paper's large viscous friction (B = 1.2 N·m·s) about
 //! 65 A of drive current, against 42 A on the circle (the plant has no current limit by
-//! default, docs/design.md §4.5). Every run is from rest at the path start to the sample where the
+//! default, docs/design/two-axis.md §4.5). Every run is from rest at the path start to the sample where the
 //! interpolator reaches the path end (no settle time); Ts = 1 ms, free-curve estimator.
 
 use contour_core::control::CccMode;

@@ -1,5 +1,5 @@
 //! Wall-clock cost of one metrics-only closed-loop run, the unit of work of the PSO tuner
-//! (docs/design.md §4.4: 50 particles × 100 iterations ≈ 5000 runs):
+//! (docs/design/two-axis.md §4.4: 50 particles × 100 iterations ≈ 5000 runs):
 //! `cargo run --release --example closed_loop_timing [RUNS]`.
 //!
 //! The paper's circle (2 s at Ts = 1 ms, 2001 samples) per CCC mode, plus the trident at

@@ -1,4 +1,4 @@
-//! Runs the in-process five-axis closed loop (docs/design.md §5.4) on a reference and
+//! Runs the in-process five-axis closed loop (docs/design/five-axis.md §5.4) on a reference and
 //! writes the measured joints as contour-eval reads them (`time,X,Y,Z,A,C`), with the
 //! true errors of the run on stderr.
 //!

@@ -1,4 +1,4 @@
-//! Table-tilting A–C five-axis machine (docs/design.md §5.1): the linear axes X, Y, Z move
+//! Table-tilting A–C five-axis machine (docs/design/five-axis.md §5.1): the linear axes X, Y, Z move
 //! the tool; the workpiece sits on a C table (about the Z direction) carried by an A
 //! cradle (about the X direction). Joints q = (X, Y, Z, A, C) in mm and rad; the tool tip
 //! p and the unit tool axis o are expressed in the workpiece frame.
@@ -151,7 +151,7 @@ impl TableTiltingAc {
 }
 
 /// Joint increments for a workpiece-frame correction `e` (tip mm, orientation rad) by
-/// damped least squares, Δq = Jᵀ·(J·Jᵀ + μ²·I)⁻¹·e (docs/design.md §5.4): the
+/// damped least squares, Δq = Jᵀ·(J·Jᵀ + μ²·I)⁻¹·e (docs/design/five-axis.md §5.4): the
 /// least-squares solution for μ = 0 where J has full rank, kept bounded near the A = 0
 /// singularity by μ > 0. Computed in the equal form (JᵀJ + μ²·I)⁻¹·Jᵀ·e: J is 6 × 5, so
 /// J·Jᵀ is always singular and the 6 × 6 system loses digits as μ → 0, while the 5 × 5
@@ -184,7 +184,7 @@ mod tests {
 
     #[test]
     fn forward_is_the_written_out_trunnion_formula_without_pivots() {
-        // docs/design.md §5.1, term by term.
+        // docs/design/five-axis.md §5.1, term by term.
         let m = TableTiltingAc::default();
         for q in joints() {
             let (x, y, z) = (q[0], q[1], q[2]);

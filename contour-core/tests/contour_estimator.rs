@@ -26,7 +26,7 @@
 //! of a built-in path. Near the crossings the points are still evaluated, with the smaller
 //! displacements only.
 //!
-//! Bounds. The two-axis paper (docs/design.md, source [A], *Measurement and Control* 2022;
+//! Bounds. The two-axis paper (docs/design/overview.md, source [A], *Measurement and Control* 2022;
 //! its estimator after Chen et al.) reports the estimation deviation as below 0.0184 mm on
 //! the "∞" curve (its Fig. 14) and within 0.00221 mm on the trident (Fig. 19), without
 //! stating the interpolation chord. It gives no number for the circle or line. The

@@ -1,5 +1,5 @@
 //! Two-axis cross-coupled controller (contour-core/src/control/cross_coupled.rs, ccc_law.rs and
-//! config.rs): the correction is n·U_c with U_c recomputed here from the docs/design.md
+//! config.rs): the correction is n·U_c with U_c recomputed here from the docs/design/two-axis.md
 //! §4.2 formula, Off mode is the bare axis loops, fuzzy gains follow Kp0 + kpf·ΔKp′ from the
 //! engine, configuration errors name the parameter, state survives serde, and on a closed
 //! loop the CCC actually removes contour error.
@@ -12,7 +12,7 @@ use contour_core::control::{
 use contour_core::geometry::Vector2;
 use serde::{Deserialize, Serialize};
 
-/// Exact contour error of a circle (docs/design.md §4.1), computed here independently.
+/// Exact contour error of a circle (docs/design/two-axis.md §4.1), computed here independently.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 struct CircleEstimator {
     centre: [f64; 2],

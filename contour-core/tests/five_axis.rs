@@ -1,4 +1,4 @@
-//! Five-axis closed loop (docs/design.md §5): the controller's per-sample estimates
+//! Five-axis closed loop (docs/design/five-axis.md §5): the controller's per-sample estimates
 //! against the truth (nearest point on the exact reference, on the branch being traced),
 //! the CCC's effect, the HMM against the nearest-segment mapping on the self-crossing
 //! figure-eight, and bad input.
@@ -58,7 +58,7 @@ fn per_sample_estimates_match_the_truth_and_the_ccc_cuts_both_errors() {
         }
         // Without CCC the lagging axes leave tens of µm (helix, blade) to hundreds
         // (figure eight); the CCC takes ≥ 90 % off the maximal tip error and ≥ 80 % off
-        // the maximal orientation error (docs/design.md §5.5 reports the table).
+        // the maximal orientation error (docs/design/five-axis.md §5.5 reports the table).
         assert!(off.max_tip > 0.02, "{name}: {off:?}");
         assert!(on.max_tip < 0.1 * off.max_tip, "{name}: {on:?} vs {off:?}");
         assert!(

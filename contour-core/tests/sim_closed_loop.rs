@@ -25,7 +25,7 @@ fn three_modes(config: &SimConfig) -> [Metrics; 3] {
 fn ccc_reduces_contour_error_on_the_paper_circle() {
     for plant in [XyTableParams::PAPER, XyTableParams::mismatched()] {
         let [off, fixed, fuzzy] = three_modes(&SimConfig::paper_circle().with_plant(plant));
-        // docs/design.md §4.2: 47.7 µm without CCC (the paper: 0.049 mm).
+        // docs/design/two-axis.md §4.2: 47.7 µm without CCC (the paper: 0.049 mm).
         assert!(
             (0.045..0.050).contains(&off.max_abs_error),
             "no CCC: {off:?}"
@@ -37,7 +37,7 @@ fn ccc_reduces_contour_error_on_the_paper_circle() {
             );
             assert!(m.mean_abs_error < 0.1 * off.mean_abs_error, "{name}: {m:?}");
             // After the start-up transient the PI CCC holds the circle within a µm
-            // (docs/design.md §4.2 measured 0.08 µm for the fixed gains).
+            // (docs/design/two-axis.md §4.2 measured 0.08 µm for the fixed gains).
             assert!(m.settled_max_abs_error < 1e-3, "{name}: {m:?}");
         }
     }

@@ -1,4 +1,4 @@
-//! `contour-eval`: the offline five-axis contour-error evaluation (docs/design.md §5.3a).
+//! `contour-eval`: the offline five-axis contour-error evaluation (docs/design/five-axis.md §5.3a).
 //! Reads a reference (CL file, two-curve JSON or built-in) and a measured run (CSV of
 //! joints), maps every sample to a reference segment with the windowed Viterbi decoder,
 //! and writes the per-sample foot-point errors and, on request, the per-reference-point

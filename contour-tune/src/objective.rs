@@ -1,4 +1,4 @@
-//! The tuner's objective (docs/design.md §4.4): a closed-loop run of the in-process simulator
+//! The tuner's objective (docs/design/two-axis.md §4.4): a closed-loop run of the in-process simulator
 //! with candidate fuzzy factors, scored by the true contour error (against the exact
 //! path, not the controller's estimate). Diverging runs get a large finite penalty, so
 //! the swarm is steered away from them instead of crashing on NaN.
@@ -14,7 +14,7 @@ use contour_core::sim::{Metrics, SimConfig, Simulator};
 /// (`fuzzy.<name>`).
 pub const FACTOR_NAMES: [&str; 5] = ["ke", "kde", "kp", "ki", "kd"];
 
-/// Default search box (docs/design.md §4.4), from the physics of the contour loop
+/// Default search box (docs/design/two-axis.md §4.4), from the physics of the contour loop
 /// rather than from where earlier optima fell:
 /// - kε, kΔε ≤ 10 per µm (per µm and sample): the fuzzy inputs saturate no finer than
 ///   0.3 µm, three counts of a 0.1 µm linear scale; finer would schedule on encoder noise.
@@ -34,7 +34,7 @@ const PENALTY_MM: f64 = 1000.0;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Fitness {
-    /// Mean |true contour error| over the run (docs/design.md §4.4, the paper's).
+    /// Mean |true contour error| over the run (docs/design/two-axis.md §4.4, the paper's).
     Mean,
     /// Maximum |true contour error| over the run.
     Max,

@@ -1,4 +1,4 @@
-//! Particle swarm optimisation, standard and improved (docs/design.md §4.4), behind one ask/tell
+//! Particle swarm optimisation, standard and improved (docs/design/two-axis.md §4.4), behind one ask/tell
 //! interface: the caller asks for the positions to evaluate, evaluates them however it
 //! likes (in parallel), and tells the fitness back. All randomness comes from one seeded
 //! ChaCha8 stream consumed in a fixed order, so the same seed gives the same run
@@ -51,7 +51,7 @@ pub fn coefficients(algorithm: Algorithm, t: usize, iterations: usize) -> (f64, 
             (W_START - (W_START - W_END) * fraction, 2.0, 2.0)
         }
         Algorithm::Improved => {
-            // The paper's formula was lost; docs/design.md §4.4 reconstructs it as this sigmoid.
+            // The paper's formula was lost; docs/design/two-axis.md §4.4 reconstructs it as this sigmoid.
             let w = W_END + (W_START - W_END) / (1.0 + (BETA * t as f64 - ALPHA).exp());
             let lambda = (w - W_END) / (W_START - W_END);
             let c1 = C_START + (C_END - C_START) * lambda * lambda;

@@ -1,5 +1,5 @@
 """True five-axis contour errors of an FMU run, computed in Python independently of the
-Rust code: the machine's forward kinematics (docs/design.md §5.1) written out again with
+Rust code: the machine's forward kinematics (docs/design/five-axis.md §5.1) written out again with
 numpy, and the nearest point on the reference found by brute force.
 
 The reference is the interpolator's own output, one pose per sample (0.05 mm apart at

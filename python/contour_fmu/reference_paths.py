@@ -1,7 +1,7 @@
 """The built-in paths rebuilt in Python, and the true contour error computed from them,
 independently of the Rust code.
 
-The NURBS `infinity` and `trident` come from the control points listed in docs/design.md
+The NURBS `infinity` and `trident` come from the control points listed in docs/design/two-axis.md
 §4.6 (cubic, clamped uniform knots; evaluated with geomdl), the circle, line and arc from
 their closed forms. For the true contour error each path is sampled densely and every
 point is projected onto the segments next to its nearest sample (about 1e-9 mm from the
@@ -14,7 +14,7 @@ import numpy as np
 from geomdl import NURBS
 from scipy.spatial import cKDTree
 
-# Control points (mm) of the built-in NURBS paths, docs/design.md §4.6.
+# Control points (mm) of the built-in NURBS paths, docs/design/two-axis.md §4.6.
 INFINITY = [
     (0, 0), (4.5, 4.5), (18.1, 21.5), (41.5, 19.0), (42.1, -19.4), (17.2, -20.1), (0, 0),
     (-17.2, 20.1), (-42.1, 19.4), (-41.5, -19.0), (-18.1, -21.5), (-4.5, -4.5), (0, 0),

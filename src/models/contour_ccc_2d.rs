@@ -1,6 +1,6 @@
 //! `ContourCCC2D`: the two-axis controller. Per axis a position loop on the following
 //! error, plus the cross-coupled correction along the contour normal with fixed or
-//! fuzzy-adapted PID gains (docs/design.md §4.2, 4.3). The control law runs every `Ts` inside
+//! fuzzy-adapted PID gains (docs/design/two-axis.md §4.2, 4.3). The control law runs every `Ts` inside
 //! `fmi2DoStep` on the inputs held over the step, whatever the communication step.
 
 use super::axis_variables::{COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_IN};

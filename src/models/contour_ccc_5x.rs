@@ -1,4 +1,4 @@
-//! `ContourCCC5X`: the five-axis controller (docs/design.md §5.4). Per joint a position
+//! `ContourCCC5X`: the five-axis controller (docs/design/five-axis.md §5.4). Per joint a position
 //! loop on the following error; the reference joints it receives, through the forward
 //! kinematics, are its expected path (no path file), which the online HMM maps the
 //! measured pose onto; tip and orientation contour errors there drive two fuzzy-PID laws

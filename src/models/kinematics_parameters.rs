@@ -1,7 +1,7 @@
 //! The machine's kinematics parameters shared by `PathInterpolator5X` (joints from the
 //! path's poses) and `ContourCCC5X` (poses from the joints): the same names and
 //! defaults in both, so one set of values describes one machine. Default: both pivots
-//! at the machine origin, LinuxCNC's A–C trunnion convention (docs/design.md §5.1).
+//! at the machine origin, LinuxCNC's A–C trunnion convention (docs/design/five-axis.md §5.1).
 
 use crate::framework::variable_table::Reals;
 use crate::framework::variables::{Start, Values, Variable};

@@ -1,7 +1,7 @@
 //! `PathInterpolator5X`: the five-axis reference. The tool tip follows a built-in path, a
 //! two-curve JSON file or APT CL data at a constant feed, one sample every `Ts`, the tool
 //! axis the path's at that point; the machine's inverse kinematics give the joints
-//! (docs/design.md §5.3a, §5.1). `ref.X` … `ref.C` hold the latest sample between
+//! (docs/design/five-axis.md §5.3a, §5.1). `ref.X` … `ref.C` hold the latest sample between
 //! samples.
 
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! `XYServoPlant`: the two-axis test plant of docs/design.md §4.5 as an FMU model. Velocity
+//! `XYServoPlant`: the two-axis test plant of docs/design/two-axis.md §4.5 as an FMU model. Velocity
 //! commands in, positions and velocities out; integrated exactly, so the trajectory does
 //! not depend on the communication step.
 

@@ -216,7 +216,7 @@ fn allocations_during(f: impl FnOnce()) -> u64 {
     ALLOCATIONS.with(Cell::get) - before
 }
 
-/// Exact circle error, like the estimators of docs/design.md §4.1 (no history needed).
+/// Exact circle error, like the estimators of docs/design/two-axis.md §4.1 (no history needed).
 struct Circle;
 
 impl ContourEstimator for Circle {

@@ -1,4 +1,4 @@
-"""An independent model of the XYServoPlant axis (docs/design.md §4.5) for scipy.
+"""An independent model of the XYServoPlant axis (docs/design/two-axis.md §4.5) for scipy.
 
 Written in the motor's own coordinates (angle, speed, PI integral of the speed error),
 not in the screw coordinates the Rust code uses, and integrated by solve_ivp at tight

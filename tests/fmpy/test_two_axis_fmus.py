@@ -309,7 +309,7 @@ def test_fuzzy_ccc_beats_no_ccc_through_the_fmus(fmu_dir, path, feed):
     assert fixed.max() < 0.5 * without.max()
     assert fuzzy.mean() < 0.1 * without.mean()
     if path == "circle":
-        # docs/design.md §4.2: 47.7 um without CCC on the paper's circle and plant.
+        # docs/design/two-axis.md §4.2: 47.7 um without CCC on the paper's circle and plant.
         assert 0.0476 < without.max() < 0.0478
 
 

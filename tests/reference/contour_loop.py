@@ -1,5 +1,5 @@
 """Stability of the contour loop with frozen CCC gains, computed from the plant's physics
-with scipy, independently of the Rust code (docs/design.md §4.4, the PSO search box).
+with scipy, independently of the Rust code (docs/design/two-axis.md §4.4, the PSO search box).
 
 Along a straight contour with identical axes the contour error is the position error of
 one axis in the normal direction, regulated by the axis P loop (Kpp) plus the CCC PID

@@ -1,6 +1,6 @@
 """The Rust closed loop (contour-core/src/sim/) against an independent scipy model of the same loop.
 
-Python side, written from docs/design.md §4.2/4.5 and not from the Rust code: each axis in motor
+Python side, written from docs/design/two-axis.md §4.2/4.5 and not from the Rust code: each axis in motor
 coordinates (angle theta, speed omega, drive integrator z),
 
     omega_cmd = v * 2 pi / lead
@@ -139,7 +139,7 @@ def test_fixed_gain_ccc_matches_scipy(rust_json):
     deviation = np.abs(np.array(trace["actual"]) - actual).max()
     assert deviation < 1e-6, f"max position deviation {deviation} mm"
     err = np.abs(contour_error(actual))
-    # docs/design.md §4.2: the PI CCC leaves ~0.08 um once the start-up transient is over.
+    # docs/design/two-axis.md §4.2: the PI CCC leaves ~0.08 um once the start-up transient is over.
     assert err[200:].max() < 0.5e-3
     assert err.max() < 0.2 * 0.03
     assert run["metrics"]["max_abs_error"] == pytest.approx(err.max(), abs=1e-6)

@@ -2,7 +2,7 @@
 independent scipy models of its five servo axes.
 
 Python side, written from the physics in the docs of contour-core/src/plant/servo_axis.rs (§4.5 of
-docs/design.md), not from the Rust matrices: each axis in motor coordinates — motor angle
+docs/design/README.md), not from the Rust matrices: each axis in motor coordinates — motor angle
 theta, motor speed omega, drive integrator zeta of the speed error —
 
     omega_cmd = k v                                  (k = 2 pi / lead mm, or the gear ratio)

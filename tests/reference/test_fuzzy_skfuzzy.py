@@ -1,8 +1,8 @@
-"""The Rust Mamdani engine (contour-core/src/control/fuzzy.rs) against scikit-fuzzy (docs/design.md §4.3).
+"""The Rust Mamdani engine (contour-core/src/control/fuzzy.rs) against scikit-fuzzy (docs/design/two-axis.md §4.3).
 
 scikit-fuzzy builds the same system from its own parts: triangular sets sampled on a
 20001-point universe, `min` for AND, clipping (`min`) implication, `max` accumulation
-and centroid defuzzification. The rule tables below are transcribed here from docs/design.md §4.3
+and centroid defuzzification. The rule tables below are transcribed here from docs/design/two-axis.md §4.3
 independently of `contour-core/src/control/rules.rs`.
 
 Fairness notes (checked against the scikit-fuzzy 0.5 sources):
@@ -37,7 +37,7 @@ UNIVERSE_POINTS = 20001
 GRID = 61
 TOLERANCE = 2e-3
 
-# Rows E = NB..PB, columns EC = NB..PB (docs/design.md §4.3).
+# Rows E = NB..PB, columns EC = NB..PB (docs/design/two-axis.md §4.3).
 TABLES = {
     "dkp": """
         PB PB PM PM PS ZO ZO
@@ -85,7 +85,7 @@ def _variable(kind, label, universe):
 
 
 def build_simulation(points=UNIVERSE_POINTS):
-    """The docs/design.md §4.3 system in scikit-fuzzy: 49 rules, each firing all three outputs."""
+    """The docs/design/two-axis.md §4.3 system in scikit-fuzzy: 49 rules, each firing all three outputs."""
     universe = np.linspace(-3.0, 3.0, points)
     e = _variable(ctrl.Antecedent, "E", universe)
     ec = _variable(ctrl.Antecedent, "EC", universe)

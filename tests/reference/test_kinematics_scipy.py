@@ -1,7 +1,7 @@
 """The Rust five-axis kinematics (contour-core/src/kinematics.rs) against scipy's rotations.
 
 Python side, written from the machine description in the docs of contour-core/src/kinematics.rs and
-docs/design.md §5.1, not from the Rust formulas: the workpiece sits on a C platter that
+docs/design/five-axis.md §5.1, not from the Rust formulas: the workpiece sits on a C platter that
 turns about the z direction through the C pivot c; the platter rides on an A cradle that
 tilts about the x direction through the A pivot a. A rotation by R about an axis through
 the point p moves x to R·(x − p) + p, so the table carries a workpiece point w to

@@ -1,6 +1,6 @@
 """The Rust NURBS evaluator (point, first and second derivative) against geomdl.
 
-The built-in curves are rebuilt from the control points listed in docs/design.md §4.6
+The built-in curves are rebuilt from the control points listed in docs/design/two-axis.md §4.6
 (contour_fmu.reference_paths, not from the Rust output), so the test also checks the Rust
 data entry. Rational evaluation is checked on the exact 9-point unit circle and on a random
 degree-4 NURBS with random weights and a non-uniform knot vector, written to a JSON file and

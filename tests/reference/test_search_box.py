@@ -1,5 +1,5 @@
 """The PSO search box of ccc-tune keeps every fuzzy-scheduled gain inside the contour
-loop's 6 dB gain margin (docs/design.md §4.4), computed from the plant's physics by
+loop's 6 dB gain margin (docs/design/two-axis.md §4.4), computed from the plant's physics by
 contour_loop.py (scipy), and is not needlessly tighter than that."""
 
 import json

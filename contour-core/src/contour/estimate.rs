@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::geometry::Vector;
 
-/// A contour error and the direction to correct along (docs/design.md §4.1).
+/// A contour error and the direction to correct along (docs/design/two-axis.md §4.1).
 ///
 /// `error · normal` is the error vector from the actual point to its foot point on the
 /// path. In the plane `error` is signed (positive when the actual point lies right of the

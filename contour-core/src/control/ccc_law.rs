@@ -1,5 +1,5 @@
 //! The scalar contour law ε → U_c = Kp·ε + Ki·Σε·Ts + Kd·Δε/Ts, with the gains fixed or
-//! scheduled every sample by the fuzzy system from ε and Δε (docs/design.md §4.3). It
+//! scheduled every sample by the fuzzy system from ε and Δε (docs/design/two-axis.md §4.3). It
 //! knows nothing of axes: the two-axis and N-axis controllers (and a five-axis one, one
 //! law per contour error) apply its output along their own directions.
 
@@ -20,7 +20,7 @@ use crate::geometry::{self, Vector};
 /// and its mirror image different gains. Folded, the gains depend only on |ε| and on
 /// whether |ε| grows (EC′ < 0) or shrinks (EC′ > 0), read from the half of the tables
 /// where Kp grows and Ki shrinks as |ε| grows. The increments stay unsigned: the PID's
-/// product with ε carries the sign of the correction (docs/design.md §4.3).
+/// product with ε carries the sign of the correction (docs/design/two-axis.md §4.3).
 pub fn folded_inputs(factors: &FuzzyFactors, error: f64, delta: f64) -> (f64, f64) {
     // Compare with 0 rather than use `signum`, which gives ±1 for ±0.
     let s = if error > 0.0 || (error == 0.0 && delta > 0.0) {
@@ -89,7 +89,7 @@ impl CccLaw {
     /// Fixed mode returns `gains0`; fuzzy mode `gains0 + k·ΔK′` with the rule tables read
     /// at the folded inputs of [`folded_inputs`], each gain clamped at ≥ 0. The gains are
     /// the same for (ε, Δε) and (−ε, −Δε), so a path and its mirror image get the same
-    /// control (docs/design.md §4.3, direction symmetry).
+    /// control (docs/design/two-axis.md §4.3, direction symmetry).
     pub fn schedule(&self, error: f64, delta: f64) -> (PidGains, FuzzyOutput) {
         let g0 = self.config.gains0;
         match self.config.mode {

@@ -61,7 +61,7 @@ impl Default for FuzzyFactors {
 pub struct CccConfig {
     /// Off / fixed gains / fuzzy-adapted gains. Default: `Fuzzy`.
     pub mode: CccMode,
-    /// Kp0 (1/s), Ki0 (1/s²), Kd0 (–). Default (100, 5000, 0): the PI CCC that docs/design.md §4.2
+    /// Kp0 (1/s), Ki0 (1/s²), Kd0 (–). Default (100, 5000, 0): the PI CCC that docs/design/two-axis.md §4.2
     /// measured at 0.08 µm on the paper's circle; near ε = 0 the fuzzy adjustments of Kp
     /// and Ki are zero, so the fuzzy mode keeps that accuracy in steady state.
     pub gains0: PidGains,
@@ -100,7 +100,7 @@ pub struct ControllerConfig<const D: usize = 2> {
     /// Sample period, s. Default 1 ms.
     pub ts: f64,
     /// Position controllers G, one per axis in axis order (output mm/s per mm, or rad/s
-    /// per rad). Default P with Kpp = 28.5 1/s (docs/design.md §4.2).
+    /// per rad). Default P with Kpp = 28.5 1/s (docs/design/two-axis.md §4.2).
     #[serde(with = "BigArray")]
     pub axis: [PidGains; D],
     /// |G| bound in mm/s (enables the axis anti-windup). Default `None`: the plant has no

@@ -1,5 +1,5 @@
-//! N-axis cross-coupled contour controller (docs/design.md §4.2) with optional fuzzy gain
-//! adaptation (docs/design.md §4.3).
+//! N-axis cross-coupled contour controller (docs/design/two-axis.md §4.2) with optional fuzzy gain
+//! adaptation (docs/design/two-axis.md §4.3).
 //!
 //! Per sample: following errors `e = R − P`; per-axis position controllers give velocity
 //! commands `G(e)` (mm/s); the contour estimator gives the contour error ε and the unit

@@ -1,10 +1,10 @@
-//! Five-axis cross-coupled contour controller (docs/design.md §5.4).
+//! Five-axis cross-coupled contour controller (docs/design/five-axis.md §5.4).
 //!
 //! Per sample, with joint reference q_r and measured joints q (X, Y, Z mm; A, C rad):
 //! 1. the axis position loops give u = G(q_r − q), per joint;
 //! 2. the forward kinematics turn q_r into the next reference pose, appended to the
 //!    online HMM mapper's reference, and q into the actual pose, which the mapper assigns
-//!    to a reference segment (docs/design.md §5.2);
+//!    to a reference segment (docs/design/five-axis.md §5.2);
 //! 3. on that segment the foot point gives the tip error vector ε_t (to the foot, mm) and
 //!    the orientation error as a rotation vector ε_o (axis × angle turning the actual tool
 //!    axis onto the slerped reference axis, rad);
@@ -50,7 +50,7 @@ pub struct FiveAxisConfig {
     /// The law on the orientation error (rad → rad/s); the fuzzy inputs read the error in
     /// mrad where the tip law reads µm. Default: the same gains as the tip law.
     pub orientation: CccConfig,
-    /// μ of the damped least squares (docs/design.md §5.4). Default 0.01: below 1e-4
+    /// μ of the damped least squares (docs/design/five-axis.md §5.4). Default 0.01: below 1e-4
     /// relative change of the correction wherever the Jacobian's singular values exceed 1
     /// (mm per mm, or per rad), and |Δq| ≤ |e|/(2μ) at A = 0.
     pub damping: f64,
@@ -70,7 +70,7 @@ pub struct FiveAxisConfig {
     /// tool — are kept; the work per sample drops from the band to those (a third of the
     /// instructions of the full band, the same mapping on both built-ins).
     pub beam: f64,
-    /// Compute the evaluation-function estimate online (docs/design.md §5.6). Default on;
+    /// Compute the evaluation-function estimate online (docs/design/five-axis.md §5.6). Default on;
     /// it is a diagnostic the control law does not use, and about 40 % of a sample's cost.
     pub evaluate: bool,
     /// The machine.
@@ -193,7 +193,7 @@ pub struct FiveAxisOutput {
     pub tip_step: CccStep,
     /// The orientation law's step.
     pub orientation_step: CccStep,
-    /// The newest evaluation-function estimate (docs/design.md §5.3), for a reference
+    /// The newest evaluation-function estimate (docs/design/five-axis.md §5.3), for a reference
     /// point the settled mapping has passed: it describes the tool `lag` or more samples
     /// ago ([`PointEvaluation::sample`]).
     pub evaluation: Option<PointEvaluation>,

@@ -1,4 +1,4 @@
-//! Mamdani fuzzy inference for the gain adaptation of docs/design.md §4.3, with exact centroid
+//! Mamdani fuzzy inference for the gain adaptation of docs/design/two-axis.md §4.3, with exact centroid
 //! defuzzification.
 //!
 //! Sets: seven triangles NB … PB centred at −3 … 3 with half-width 1; NB and PB are flat
@@ -80,7 +80,7 @@ pub struct FuzzyEngine {
 }
 
 impl Default for FuzzyEngine {
-    /// The classical fuzzy-PID tables of docs/design.md §4.3.
+    /// The classical fuzzy-PID tables of docs/design/two-axis.md §4.3.
     fn default() -> Self {
         Self::new(FUZZY_PID_RULES)
     }

@@ -1,6 +1,6 @@
 //! Control laws: discrete PID, the Mamdani fuzzy gain scheduler with its rule tables, the
 //! scalar contour law and the N-axis cross-coupled contour controller around it
-//! (docs/design.md §4.2, 4.3).
+//! (docs/design/two-axis.md §4.2, 4.3).
 
 mod ccc_law;
 mod config;

@@ -1,7 +1,7 @@
 //! Discrete PID with conditional-integration anti-windup and gains that may change every
 //! sample (the fuzzy CCC adapts them).
 //!
-//! Law at sample k (docs/design.md §4.2): `u = Kp·e + Ki·I + Kd·(e − e_prev)/Ts` with
+//! Law at sample k (docs/design/two-axis.md §4.2): `u = Kp·e + Ki·I + Kd·(e − e_prev)/Ts` with
 //! `I = Σ e·Ts` including the current sample. The state keeps `I` itself rather than
 //! `Ki·I`, exactly as the formula reads, so a gain change rescales the accumulated
 //! integral action at once; that is the behaviour of the paper's fuzzy PID.

@@ -1,4 +1,4 @@
-//! Linguistic terms and the three classical fuzzy-PID rule tables of docs/design.md §4.3.
+//! Linguistic terms and the three classical fuzzy-PID rule tables of docs/design/two-axis.md §4.3.
 //!
 //! The tables are plain data so the engine, the scikit-fuzzy cross-check and any future
 //! tuning code all read the same source; rows are indexed by the contour-error input E
@@ -49,7 +49,7 @@ impl Term {
         self as u8 as f64 - 3.0
     }
 
-    /// The two-letter name used in docs/design.md §4.3 (and by the scikit-fuzzy reference).
+    /// The two-letter name used in docs/design/two-axis.md §4.3 (and by the scikit-fuzzy reference).
     pub const fn name(self) -> &'static str {
         match self {
             Term::NB => "NB",
@@ -68,7 +68,7 @@ pub type RuleTable = [[Term; 7]; 7];
 
 use Term::{NB, NM, NS, PB, PM, PS, ZO};
 
-/// ΔKp′ rules: a large error of one sign calls for more proportional action (docs/design.md §4.3).
+/// ΔKp′ rules: a large error of one sign calls for more proportional action (docs/design/two-axis.md §4.3).
 pub const KP_RULES: RuleTable = [
     [PB, PB, PM, PM, PS, ZO, ZO],
     [PB, PB, PM, PS, PS, ZO, NS],
@@ -79,7 +79,7 @@ pub const KP_RULES: RuleTable = [
     [ZO, ZO, NM, NM, NM, NB, NB],
 ];
 
-/// ΔKi′ rules (docs/design.md §4.3).
+/// ΔKi′ rules (docs/design/two-axis.md §4.3).
 pub const KI_RULES: RuleTable = [
     [NB, NB, NM, NM, NS, ZO, ZO],
     [NB, NB, NM, NS, NS, ZO, ZO],
@@ -90,7 +90,7 @@ pub const KI_RULES: RuleTable = [
     [ZO, ZO, PS, PM, PM, PB, PB],
 ];
 
-/// ΔKd′ rules (docs/design.md §4.3).
+/// ΔKd′ rules (docs/design/two-axis.md §4.3).
 pub const KD_RULES: RuleTable = [
     [PS, NS, NB, NB, NB, NM, PS],
     [PS, NS, NB, NM, NM, NS, ZO],
@@ -108,7 +108,7 @@ pub const FUZZY_PID_RULES: [RuleTable; 3] = [KP_RULES, KI_RULES, KD_RULES];
 mod tests {
     use super::*;
 
-    /// Spot checks against docs/design.md §4.3 written out independently of the tables' layout.
+    /// Spot checks against docs/design/two-axis.md §4.3 written out independently of the tables' layout.
     #[test]
     fn tables_match_design_spot_checks() {
         // (table, E, EC, expected)

@@ -1,4 +1,4 @@
-//! The built-in test paths, chosen by name by the path-interpolator FMU (docs/design.md §4.6).
+//! The built-in test paths, chosen by name by the path-interpolator FMU (docs/design/two-axis.md §4.6).
 //!
 //! - `circle`: the paper's x = 10 cos πt − 10, y = 10 sin πt, t ∈ [0, 2], as an analytic
 //!   [`Arc`] (centre (−10, 0), r = 10, start angle 0, CCW full turn). Analytic rather than
@@ -7,7 +7,7 @@
 //! - `line`: (0, 0) → (40, 30), 50 mm.
 //! - `arc`: clockwise half circle from (0, 0) about (−20, 0), r = 20, ending at (−40, 0).
 //! - `infinity`, `trident`: the cubic NURBS fitted for this project, weights 1, clamped
-//!   uniform knots, control points exactly as listed in docs/design.md §4.6.
+//!   uniform knots, control points exactly as listed in docs/design/two-axis.md §4.6.
 
 use std::f64::consts::{FRAC_1_SQRT_2, PI};
 
@@ -95,7 +95,7 @@ pub fn trident() -> Nurbs {
     cubic_uniform(&P)
 }
 
-/// The exact unit circle of docs/design.md §4.6 (degree 2, 9 control points on a square's corners
+/// The exact unit circle of docs/design/two-axis.md §4.6 (degree 2, 9 control points on a square's corners
 /// and edge midpoints, weights 1, √2/2, …; knots 0,0,0,¼,¼,½,½,¾,¾,1,1,1): the reference
 /// case for the rational evaluator.
 pub fn rational_unit_circle() -> Nurbs {
@@ -147,7 +147,7 @@ mod tests {
 
     #[test]
     fn shapes_have_designed_size() {
-        // docs/design.md §4.6: infinity length ≈ 241 mm, crosses itself at the origin.
+        // docs/design/two-axis.md §4.6: infinity length ≈ 241 mm, crosses itself at the origin.
         let inf = infinity();
         let l = inf.length();
         assert!((l - 241.0).abs() < 2.0, "infinity length {l}");

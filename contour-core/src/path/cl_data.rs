@@ -1,6 +1,6 @@
 //! APT cutter-location (CL) data, the format five-axis CAM post-processors write: each
 //! `GOTO/x,y,z,i,j,k` record gives the tool tip (mm) and the tool-axis vector, both in
-//! the workpiece frame (docs/design.md §5.3a).
+//! the workpiece frame (docs/design/five-axis.md §5.3a).
 //!
 //! Read: `GOTO` with six numbers, or three (the tool axis then stays as it was, +Z at the
 //! start). Skipped: `$$` comments (to the end of the line), `PARTNO`, `MULTAX`, `FEDRAT`

@@ -1,4 +1,4 @@
-//! Feed-rate interpolator: one reference sample every `Ts` at feed `F` (docs/design.md §4.6).
+//! Feed-rate interpolator: one reference sample every `Ts` at feed `F` (docs/design/two-axis.md §4.6).
 //!
 //! The curve parameter advances by the second-order Taylor inverse of the arc length,
 //!   Δu = L/|C'| − L²·(C'·C'')/(2|C'|⁴),  L = F·Ts,

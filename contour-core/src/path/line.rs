@@ -50,7 +50,7 @@ impl<const D: usize> Line<D> {
 }
 
 impl Line<2> {
-    /// Direction angle θ of travel, rad (docs/design.md §4.1).
+    /// Direction angle θ of travel, rad (docs/design/two-axis.md §4.1).
     pub fn angle(&self) -> f64 {
         let d = self.b - self.a;
         d[1].atan2(d[0])

@@ -1,5 +1,5 @@
 //! Reference paths (lines and NURBS in any dimension, planar arcs), the built-in shapes
-//! and the feed-rate interpolator that samples them every `Ts` (docs/design.md §4.6).
+//! and the feed-rate interpolator that samples them every `Ts` (docs/design/two-axis.md §4.6).
 //! Units: mm, s.
 //!
 //! Every geometric type implements [`Curve`] in its dimension, and [`Path`] is the closed

@@ -1,5 +1,5 @@
 //! NURBS curve in any dimension, of any degree 1..=[`MAX_DEGREE`] with positive rational weights and a
-//! clamped knot vector, with first and second derivatives (docs/design.md §4.6).
+//! clamped knot vector, with first and second derivatives (docs/design/two-axis.md §4.6).
 //!
 //! Evaluation builds the triangle of B-spline basis values of degrees 0..p on the knot
 //! span of u by the Cox–de Boor recurrence, then differentiates the degree-p functions
@@ -379,7 +379,7 @@ mod tests {
     use super::*;
     use crate::geometry::Vector2;
 
-    /// docs/design.md §4.6: exact unit circle, degree 2, 9 control points on a square.
+    /// docs/design/two-axis.md §4.6: exact unit circle, degree 2, 9 control points on a square.
     fn unit_circle() -> Nurbs {
         crate::path::builtin::rational_unit_circle()
     }

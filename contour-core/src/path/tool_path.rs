@@ -1,5 +1,5 @@
 //! Five-axis references: the tool tip's path with the tool axis along it, in the
-//! workpiece frame (docs/design.md §5.3a). Two shapes: a pair of curves (the tip, and the
+//! workpiece frame (docs/design/five-axis.md §5.3a). Two shapes: a pair of curves (the tip, and the
 //! point `length` mm up the tool axis) or a sequence of poses joined by straight tip
 //! moves with the axis slerped in between (CL data, sampled built-ins).
 

@@ -1,4 +1,4 @@
-//! Test plants: the servo axis of docs/design.md §4.5 (linear or rotary) and a machine's
+//! Test plants: the servo axis of docs/design/two-axis.md §4.5 (linear or rotary) and a machine's
 //! axes built from several of them (the XY table is two).
 
 mod servo_axes;

@@ -1,4 +1,4 @@
-//! One axis of a test plant (docs/design.md §4.5): a servo drive whose PI loop closes on
+//! One axis of a test plant (docs/design/two-axis.md §4.5): a servo drive whose PI loop closes on
 //! motor speed, a motor with inertia and viscous friction, and a transmission — a ball
 //! screw for a linear axis (position in mm) or a gearbox for a rotary one (rad).
 //!
@@ -75,7 +75,7 @@ pub struct AxisParams {
 
 impl AxisParams {
     /// The paper's motor (CT = 0.57 N·m/A, B = 1.2 N·m·s, J = 0.015 kg·m², 10 mm lead)
-    /// with the drive of docs/design.md §4.5: the PI zero cancels the B/J pole, 50 Hz velocity bandwidth.
+    /// with the drive of docs/design/two-axis.md §4.5: the PI zero cancels the B/J pole, 50 Hz velocity bandwidth.
     pub const PAPER: AxisParams = AxisParams {
         inertia: 0.015,
         friction: 1.2,

@@ -1,5 +1,5 @@
 //! In-process five-axis closed loop: joint reference (tip feed, inverse kinematics) →
-//! five-axis controller → five servo axes, sampled every `Ts` (docs/design.md §5.5), with
+//! five-axis controller → five servo axes, sampled every `Ts` (docs/design/five-axis.md §5.5), with
 //! the true contour errors for the metrics.
 //!
 //! The sample sequence is the two-axis one (module docs of `sim`): for k = 0, 1, …

@@ -32,7 +32,7 @@ pub struct Metrics {
     pub samples: usize,
     /// Maximum over all samples.
     pub max_abs_error: f64,
-    /// Mean over all samples (the PSO fitness of docs/design.md §4.4).
+    /// Mean over all samples (the PSO fitness of docs/design/two-axis.md §4.4).
     pub mean_abs_error: f64,
     /// Samples with t ≥ `transient`.
     pub settled_samples: usize,

@@ -1,5 +1,5 @@
 //! In-process closed loop: interpolator → cross-coupled controller → servo axes, sampled
-//! every `Ts` (docs/design.md §4.2, 4.5, 4.6). The reference for everything the FMUs must match in
+//! every `Ts` (docs/design/two-axis.md §4.2, 4.5, 4.6). The reference for everything the FMUs must match in
 //! co-simulation, and the fitness evaluator of the PSO tuner.
 //!
 //! # The sample sequence (the FMU co-simulation reproduces it, keep it exactly so)

@@ -1,5 +1,5 @@
 //! `ccc-tune`: tunes the fuzzy CCC's five scaling factors (kε, kΔε, kpf, kif, kdf) with
-//! the standard or improved PSO on an in-process closed loop (docs/design.md §4.4), and writes
+//! the standard or improved PSO on an in-process closed loop (docs/design/two-axis.md §4.4), and writes
 //! the result as JSON that the ContourCCC2D FMU takes as start values. The JSON holds
 //! only what the run determines (no timing), so the same seed gives the same file on any
 //! number of threads.

@@ -1,5 +1,5 @@
 //! The paper's evaluation-function estimate of the five-axis contour errors at one
-//! reference point (docs/design.md §5.3): the actual joints near the point are fitted by
+//! reference point (docs/design/five-axis.md §5.3): the actual joints near the point are fitted by
 //! parabolas, the fit is mapped through the forward kinematics, and the point of the fit
 //! that minimises
 //!   F(t) = λ1·‖p(t) − R_i‖ + λ2·R·∠(o(t), O_i)

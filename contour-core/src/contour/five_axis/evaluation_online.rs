@@ -1,4 +1,4 @@
-//! The evaluation-function estimate (docs/design.md §5.3) computed while the run goes on,
+//! The evaluation-function estimate (docs/design/five-axis.md §5.3) computed while the run goes on,
 //! for the controller's outputs: the offline form (`run_evaluation`) with what a sample
 //! stream allows.
 //!

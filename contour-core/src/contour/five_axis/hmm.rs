@@ -1,5 +1,5 @@
 //! Mapping measured five-axis samples to reference segments with a hidden Markov model
-//! solved by Viterbi (docs/design.md §5.2) — the offline form over a whole run, and the
+//! solved by Viterbi (docs/design/five-axis.md §5.2) — the offline form over a whole run, and the
 //! nearest-segment mapping it is compared with (the online form: `hmm_online`; the
 //! windowed offline form: `run_evaluation`).
 //!

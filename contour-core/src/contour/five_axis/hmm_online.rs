@@ -1,4 +1,4 @@
-//! The online form of the HMM segment mapping (docs/design.md §5.2): the reference and
+//! The online form of the HMM segment mapping (docs/design/five-axis.md §5.2): the reference and
 //! the measured samples arrive one at a time. Only the `band` newest segments are
 //! candidates, and a sample's mapping can be read back `lag` samples later, so the work
 //! per sample is O(band·max_skip + lag) whatever the path's length — less with a beam,

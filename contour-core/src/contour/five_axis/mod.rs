@@ -1,4 +1,4 @@
-//! The five-axis paper's contour errors (docs/design.md §5.2–5.3a): measured samples mapped
+//! The five-axis paper's contour errors (docs/design/five-axis.md §5.2–5.3a): measured samples mapped
 //! to reference segments by a hidden Markov model solved by Viterbi (offline over a run,
 //! windowed, or online as samples arrive), the tip and orientation errors at the foot
 //! point, and the evaluation-function estimate; [`run_evaluation`] puts them together for

@@ -1,4 +1,4 @@
-//! The per-sample five-axis contour errors used for control (docs/design.md §5.3): the
+//! The per-sample five-axis contour errors used for control (docs/design/five-axis.md §5.3): the
 //! actual tool tip against its mapped reference segment — the error vector to the foot
 //! point — and the actual tool axis against the reference axis at that foot point,
 //! slerped between the segment's end axes.

@@ -1,4 +1,4 @@
-//! Whole-run evaluation of a measured five-axis run against its reference (docs/design.md
+//! Whole-run evaluation of a measured five-axis run against its reference (docs/design/five-axis.md
 //! §5.2–5.3a): the Viterbi segment mapping of every measured sample, the foot-point tip
 //! and orientation errors of each sample, and the evaluation-function estimate at each
 //! reference point.
@@ -342,7 +342,7 @@ const PROGRESS_EVERY: usize = 8192;
 /// poses on `machine`: maps every sample (windowed Viterbi), gives each its foot-point
 /// errors, and estimates the evaluation function at every reference point from the
 /// sample nearest it among those mapped to the `max_skip` segments either side of it,
-/// with the samples before and after it (docs/design.md §5.3). `progress(done, total)` is called now and then and at
+/// with the samples before and after it (docs/design/five-axis.md §5.3). `progress(done, total)` is called now and then and at
 /// the end. Memory: O(samples + reference points), never samples × segments.
 pub fn evaluate_run(
     machine: &TableTiltingAc,
@@ -408,7 +408,7 @@ pub fn evaluate_run(
     for (k, (q, &j)) in measured.iter().zip(&mapping).enumerate() {
         let pose = machine.forward(q);
         // The mapping picks the branch; the foot is on the segment under the tip next to
-        // it, placed by the swept normal plane (docs/design.md §5.3).
+        // it, placed by the swept normal plane (docs/design/five-axis.md §5.3).
         let segment = |i: usize| (i + 1 < points).then(|| (reference[i], reference[i + 1]));
         let f = nearest_segment_near(segment, j, &pose.tip);
         let before = f.checked_sub(1).map(|i| &reference[i]);
@@ -823,7 +823,7 @@ mod tests {
         )
         .unwrap();
 
-        // R and the weights from their definitions (docs/design.md §5.3).
+        // R and the weights from their definitions (docs/design/five-axis.md §5.3).
         let (mut travel, mut turned) = (0.0, 0.0);
         for w in reference.windows(2) {
             travel += geometry::dist(&w[0].tip, &w[1].tip);

@@ -1,4 +1,4 @@
-//! Exact contour error of a circular arc (docs/design.md §4.1): counter-clockwise
+//! Exact contour error of a circular arc (docs/design/two-axis.md §4.1): counter-clockwise
 //! ε = ‖P − O‖ − r, n = −(P − O)/‖P − O‖; clockwise both signs flip. Positive right of
 //! travel. Koren–Lo's variable gains are the second-order expansion of this.
 //!

@@ -1,10 +1,10 @@
 //! Free-curve contour-error estimator: the two-circle method of the paper (after Chen et
-//! al.), docs/design.md §4.1.
+//! al.), docs/design/two-axis.md §4.1.
 //!
 //! Recent reference samples are kept in a fixed-capacity ring buffer. From the newest
 //! command point the search walks back while the distance to P decreases; the last point
 //! is Rε. Circles C1 through (Rε+1, Rε, Rε−1) and C2 through (Rε, Rε−1, Rε−2) approximate
-//! the path around it. Combination (docs/design.md §4.1): the foot lies between Rε and its
+//! the path around it. Combination (docs/design/two-axis.md §4.1): the foot lies between Rε and its
 //! neighbour on P's side, and the estimate is the mean of the two circles that span that
 //! interval: C1 and C2 when P is behind Rε, C1 and C0 through (Rε+2, Rε+1, Rε) when P is
 //! ahead ((P − Rε)·(Rε+1 − Rε) > 0). Their leading interpolation errors have opposite

@@ -1,4 +1,4 @@
-//! Exact contour error of a straight line (docs/design.md §4.1, Koren's coupling gains):
+//! Exact contour error of a straight line (docs/design/two-axis.md §4.1, Koren's coupling gains):
 //! ε = −ex·sin θ + ey·cos θ, n = (−sin θ, cos θ), with ex, ey the following errors
 //! against a point of the line and θ the direction of travel. Positive right of travel.
 //!
@@ -121,7 +121,7 @@ mod tests {
         // Left of travel, beyond the end of the segment: still the perpendicular distance.
         let r = e.estimate(Vector2::new(4.0, 5.0), Vector2::new(7.0 - 0.8, 9.0 + 0.6));
         assert!((r.error + 1.0).abs() < 1e-14);
-        // The formula of docs/design.md §4.1 with following errors ex = xr − xp, ey = yr − yp.
+        // The formula of docs/design/two-axis.md §4.1 with following errors ex = xr − xp, ey = yr − yp.
         let (th, rr, p) = (0.3f64, Vector2::new(2.0, 1.0), Vector2::new(2.5, 0.2));
         let mut f =
             LineEstimator::from_angle(Vector2::new(2.0 - 3.0 * th.cos(), 1.0 - 3.0 * th.sin()), th);

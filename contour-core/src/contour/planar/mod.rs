@@ -1,4 +1,4 @@
-//! The two-axis paper's contour errors (docs/design.md §4.1): exact errors of a line and
+//! The two-axis paper's contour errors (docs/design/two-axis.md §4.1): exact errors of a line and
 //! of an arc, the free-curve estimator (two circles through the interpolation points
 //! nearest the actual position), the estimator chosen by name, and the true error by
 //! brute-force search that the tests and metrics take as ground truth.

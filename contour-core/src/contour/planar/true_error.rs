@@ -1,4 +1,4 @@
-//! True contour error: the signed distance from P to the exact path (docs/design.md §4.1 ground
+//! True contour error: the signed distance from P to the exact path (docs/design/two-axis.md §4.1 ground
 //! truth), with the estimators' sign convention (positive right of travel, normal = left
 //! unit normal at the foot point).
 //!
