@@ -60,14 +60,16 @@ class Unit:
 class Master:
     """Use as a context manager: instantiated and initialized on entry, freed on exit."""
 
-    def __init__(self, units, connections, step, stop, scheme="gauss-seidel", initial=()):
+    def __init__(self, units, connections, step, stop, scheme="gauss-seidel", initial=(), log=None):
         """units: list of Unit in stepping order; connections: list of (source unit,
         output name, destination unit, input name); initial: connections applied once in
-        initialization mode, in order (e.g. an output onto a parameter)."""
+        initialization mode, in order (e.g. an output onto a parameter); log: a
+        contour_fmu.fmu_log.FmuLog that collects the FMUs' messages (default: fmpy's
+        logger, which prints them)."""
         if scheme not in SCHEMES:
             raise ValueError(f"unknown coupling scheme {scheme!r}; expected one of {SCHEMES}")
         self.units, self.connections, self.initial = units, connections, initial
-        self.step, self.stop, self.scheme = step, stop, scheme
+        self.step, self.stop, self.scheme, self.log = step, stop, scheme, log
         self.slaves, self.variables, self._dirs = {}, {}, []
 
     def __enter__(self):
@@ -79,7 +81,7 @@ class Master:
                               modelIdentifier=md.coSimulation.modelIdentifier, instanceName=u.name)
             self.slaves[u.name] = slave
             self.variables[u.name] = {v.name: v for v in md.modelVariables}
-            slave.instantiate()
+            slave.instantiate(callbacks=None if self.log is None else self.log.callbacks)
             slave.setupExperiment(startTime=0.0, stopTime=self.stop)
             slave.enterInitializationMode()
             for name, value in u.start_values.items():

@@ -72,7 +72,7 @@ def command_replay(args):
     try:
         values, trace = run_one(job, instances, run.start_values)
     except Exception as e:  # noqa: BLE001  a failed run's reason, as its row gives it
-        for line in instances.log.errors:
+        for line in instances.log.failures():
             print(line, file=sys.stderr)
         print(f"run {run.id} failed: {type(e).__name__}: {e}", file=sys.stderr)
         return 1

@@ -26,12 +26,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..fmu_log import ERROR, FmuLog
 from ..loops import LOOPS
 from ..master import free_all, set_value
 from . import metrics as campaign_metrics
 
 ORDER = ("controller", "plant", "interpolator")
-FMI_ERROR = 3  # fmi2Error; the logger's status of a refused call
 
 
 @dataclass(frozen=True)
@@ -74,29 +74,6 @@ def extracted(sha256, archive, within=None):
     return _extracted[sha256]
 
 
-class _Log:
-    """The FMUs' log messages of the current run (fmpy's logger callback)."""
-
-    def __init__(self):
-        from ctypes import byref
-
-        from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
-                               fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, calloc, free)
-        from fmpy.logging import addLoggerProxy
-
-        self.errors = []
-
-        def log(_env, name, status, _category, message):
-            if status >= FMI_ERROR:
-                self.errors.append(f"{name.decode(errors='replace')}: {message.decode(errors='replace')}")
-
-        self.callbacks = fmi2CallbackFunctions()
-        self.callbacks.logger = fmi2CallbackLoggerTYPE(log)
-        self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        addLoggerProxy(byref(self.callbacks))
-
-
 class LoopInstances:
     """The loop's three FMUs, instantiated once; `run` resets them between runs."""
 
@@ -106,7 +83,7 @@ class LoopInstances:
         from fmpy.fmi2 import FMU2Slave
 
         self.loop = LOOPS[loop]
-        self.log = _Log()
+        self.log = FmuLog(least=ERROR)  # the reasons a run failed
         self.slaves, self.variables = {}, {}
         try:
             for unit in ORDER:
@@ -153,7 +130,7 @@ class LoopInstances:
     def run(self, job, start_values):
         """One run from t = 0: returns its trace, {"time": ..., "unit.variable": ...} of
         the loop's recorded outputs, one value per step."""
-        self.log.errors.clear()
+        self.log.clear()
         if not self.fresh:
             for slave in self.slaves.values():
                 slave.reset()
@@ -252,7 +229,7 @@ def run_batch(job, runs, archives=None):
                 values, _ = run_one(job, instances, start_values)
                 row.update(values)
             except Exception as e:  # noqa: BLE001  every failure of a run is its row's message
-                logged = instances.log.errors
+                logged = instances.log.failures()
                 row.update({m: float("nan") for m in job.metrics})
                 row["status"] = "error"
                 row["message"] = "; ".join([*logged[-3:], f"{type(e).__name__}: {e}"])
