@@ -6,6 +6,7 @@ without fmpy):
 
 - wiring: the paper's loop as a list of connections, shared by every master;
 - master: a fixed-step Gauss-Seidel or Jacobi master on fmpy's FMU2Slave, closed_loop();
+- stepping: the fixed-step loop of the master and the campaigns;
 - fmu_log: fmpy logger callbacks that collect the FMUs' messages (FmuLog);
 - tuned: a ccc-tune result as ContourCCC2D start values;
 - reference_paths: the built-in paths rebuilt in Python and the true contour error;
