@@ -14,7 +14,7 @@ import pytest
 
 import contour_fmu
 from contour_fmu import repo
-from conftest import REPO
+from helpers.checkout import REPO
 
 PIN = re.compile(r"^([A-Za-z0-9._-]+)==([^\s#;]+)")
 

@@ -17,7 +17,7 @@ from contour_fmu import demo
 from contour_fmu.fmu_log import FmuLog
 from contour_fmu.master import Master, Unit, closed_loop
 from contour_fmu.reference_paths import ContourReference
-from fmu_slave import Slave
+from helpers.fmu_slave import Slave
 
 CONTROLLER_OUTPUTS = ["u.x", "u.y", "contourError", "err.x", "err.y", "ccc.Kp", "ccc.Ki", "ccc.Kd"]
 
