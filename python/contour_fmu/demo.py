@@ -22,6 +22,8 @@ usage: python -m contour_fmu.demo [--fmu-dir DIR] [--out DIR]
 The defaults are in the checkout <repo> (contour_fmu.repo: $CONTOUR_FMU_REPO, else the
 working directory or a parent of it, else the checkout the package is installed from in
 editable mode): <repo>/target/fmu, <repo>/out, <repo>/target/release/ccc-tune.
+
+Needs the plots and reference extras (matplotlib; geomdl, scipy).
 """
 
 import argparse
@@ -33,11 +35,15 @@ from pathlib import Path
 import numpy as np
 
 from . import five_axis_demo, repo
+from .extras import needs
 from .master import closed_loop
 from .output_files import write_csv
 from .output_files import write_cross_check as write_cross_check_files
-from .reference_paths import INFINITY, TRIDENT, ContourReference, clamped_uniform
 from .tuned import start_values
+
+with needs("plots", "reference"):
+    import matplotlib  # noqa: F401  the plots, here so that a missing one stops us before any run
+    from .reference_paths import INFINITY, TRIDENT, ContourReference, clamped_uniform
 
 STEP = 1e-3
 

@@ -1,16 +1,12 @@
-"""The command line: python -m contour_fmu.campaign run | replay (see --help)."""
+"""The command line: python -m contour_fmu.campaign run | replay (see --help). Needs the
+campaign extra (--help does not)."""
 
 import argparse
 import sys
 import time
 from pathlib import Path
 
-from . import report
-from .execute import SchedulerUnreachable, archives_of, execute, job_of
-from .metrics import errors
-from .runner import LoopInstances, run_one, unpacked
-from .spec import CampaignError, load
-from .store import OutputInUse
+from ..extras import MissingExtra, require
 
 
 def parse_args(argv):
@@ -48,6 +44,10 @@ def parse_args(argv):
 
 
 def command_run(args):
+    from . import report
+    from .execute import execute
+    from .spec import load
+
     campaign = load(args.file, args.fmu_dir)
     began = time.perf_counter()
     store = execute(campaign, args.out, scheduler=args.scheduler, workers=args.workers,
@@ -64,6 +64,10 @@ def command_run(args):
 
 def command_replay(args):
     from ..output_files import write_csv
+    from .execute import archives_of, job_of
+    from .metrics import errors
+    from .runner import LoopInstances, run_one, unpacked
+    from .spec import load
 
     campaign = load(args.file, args.fmu_dir)
     run = campaign.run(args.run)
@@ -95,6 +99,15 @@ def command_replay(args):
 
 def main(argv=None):
     args = parse_args(argv)
+    try:
+        require("campaign")  # before any run, not when the plots are drawn at the end
+    except MissingExtra as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    from .execute import SchedulerUnreachable
+    from .spec import CampaignError
+    from .store import OutputInUse
+
     try:
         return command_run(args) if args.command == "run" else command_replay(args)
     except (CampaignError, OutputInUse, SchedulerUnreachable) as e:
