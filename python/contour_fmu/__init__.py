@@ -21,6 +21,7 @@ python/pyproject.toml (contour_fmu.extras) and says so when it is missing:
 - campaign [campaign]: many closed-loop runs (swept plant parameters, feeds, paths,
   variants) on Dask, one Parquet row each, with a summary and plots
   (python -m contour_fmu.campaign run FILE --out DIR);
+- cli: the console script `contour-fmu` (demo, campaign run|replay, libcosim, ecos);
 - extras: which module needs which extra;
 - repo: where the checkout, its FMUs and ccc-tune are.
 """

@@ -55,8 +55,8 @@ def set_initial(execution, index, variable, text):
         check(execution.string_initial_value(index, ref, text), f"initial value {text}")
 
 
-def main(argv):
-    args = engine_arguments(argv, "A closed loop in libcosim", (int, "communication step (ns)"))
+def main(argv, prog=None):
+    args = engine_arguments(argv, "A closed loop in libcosim", (int, "communication step (ns)"), prog)
     loop, steps = args.loop, args.steps
     log_output_level(CosimLogLevel.WARNING)
 

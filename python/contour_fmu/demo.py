@@ -155,11 +155,11 @@ def build_ccc_tune():
     return f"cargo build --release -p {repo.TUNER_PACKAGE} --bin ccc-tune"
 
 
-def parse_args(argv=None):
+def parse_args(argv=None, prog="python -m contour_fmu.demo"):
     """The options, with the defaults resolved in the checkout (only those needed: with
     --fmu-dir and --out given, no checkout is needed unless --tune runs ccc-tune)."""
     parser = argparse.ArgumentParser(
-        prog="python -m contour_fmu.demo", description=__doc__.splitlines()[0],
+        prog=prog, description=__doc__.splitlines()[0],
         epilog=f"<repo> is the checkout: ${repo.ENV}, else the working directory or a parent of "
                "it, else the checkout the package is installed from in editable mode; "
                "$CARGO_TARGET_DIR replaces <repo>/target.")
@@ -190,8 +190,8 @@ def parse_args(argv=None):
     return args
 
 
-def main(argv=None):
-    args = parse_args(argv)
+def main(argv=None, prog="python -m contour_fmu.demo"):
+    args = parse_args(argv, prog)
     args.out.mkdir(parents=True, exist_ok=True)
 
     rows = []

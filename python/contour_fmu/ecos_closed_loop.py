@@ -62,8 +62,8 @@ class Recorder(SimulationListener):
             self.series[f"{unit}.{name}"].append(self.sim.get_real(ident(unit, name)))
 
 
-def main(argv):
-    args = engine_arguments(argv, "A closed loop in ecos", (float, "communication step (s)"))
+def main(argv, prog=None):
+    args = engine_arguments(argv, "A closed loop in ecos", (float, "communication step (s)"), prog)
     loop = args.loop
     parameters = {ident(unit, name): parse_value(text) for unit, name, text in args.assignments}
     EcosLib.set_log_level("warn")

@@ -2,8 +2,8 @@
 each one brings, and the error that names the extra to install when one is missing.
 
 The core (fmpy, numpy, attrs) runs wiring, loops, master, stepping, fmu_log, tuned, repo,
-output_files, five_axis_truth, container_build, and the campaign file (campaign.spec) and
-runner. The extras:
+output_files, five_axis_truth, container_build, the campaign file (campaign.spec) and
+runner, and the command line `contour-fmu` up to its commands. The extras:
 
 - reference (geomdl, scipy): reference_paths, the built-in paths and the true contour error;
 - plots (matplotlib): the plots of the demo and the campaigns; the demo needs plots and

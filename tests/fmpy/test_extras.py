@@ -47,7 +47,7 @@ def test_the_core_runs_the_closed_loop_without_any_extra(fmu_dir):
     result = without_extras("""
         import contour_fmu, contour_fmu.wiring, contour_fmu.loops, contour_fmu.stepping
         import contour_fmu.fmu_log, contour_fmu.tuned, contour_fmu.repo, contour_fmu.output_files
-        import contour_fmu.five_axis_truth, contour_fmu.container_build
+        import contour_fmu.five_axis_truth, contour_fmu.container_build, contour_fmu.cli
         import contour_fmu.campaign, contour_fmu.campaign.spec, contour_fmu.campaign.runner
         from pathlib import Path
         from contour_fmu.master import closed_loop
@@ -92,34 +92,43 @@ def test_a_module_of_a_missing_extra_names_the_extra():
     assert result["contour_fmu.campaign.store"].startswith("no module named 'pyarrow'")
 
 
-@pytest.mark.parametrize("argv", [["run", "campaign.toml", "--out", "out"],
-                                  ["replay", "campaign.toml", "--run", "0"]])
-def test_the_campaign_command_line_names_the_missing_extra(argv):
+@pytest.mark.parametrize("argv, extra", [
+    (["campaign", "run", "campaign.toml", "--out", "out"], "campaign"),
+    (["campaign", "replay", "campaign.toml", "--run", "0"], "campaign"),
+    (["demo"], "plots,reference"),
+    (["libcosim", "fmus", "1000000", "10"], "engines"),
+    (["ecos", "fmus", "0.001", "10"], "engines"),
+])
+def test_the_command_line_names_the_missing_extra(argv, extra):
     result = without_extras("""
         import contextlib, io
-        from contour_fmu.campaign.__main__ import main
+        from contour_fmu import cli
         err = io.StringIO()
         with contextlib.redirect_stderr(err):
-            status = main(json.loads(sys.argv[2]))
+            status = cli.main(json.loads(sys.argv[2]))
         print(json.dumps({"status": status, "stderr": err.getvalue()}))
     """, json.dumps(argv))
     assert result["status"] == 2
     assert result["stderr"].count("\n") == 1, result["stderr"]
-    assert "pip install 'contour-fmu[campaign]'" in result["stderr"]
+    assert f"pip install 'contour-fmu[{extra}]'" in result["stderr"]
 
 
-def test_the_campaign_command_line_helps_without_any_extra():
+def test_the_command_line_helps_without_any_extra():
     result = without_extras("""
         import contextlib, io
-        from contour_fmu.campaign.__main__ import main
-        out = io.StringIO()
-        with contextlib.redirect_stdout(out):
-            try:
-                main(["run", "--help"])
-            except SystemExit as e:
-                print(json.dumps([e.code, out.getvalue()]), file=sys.__stdout__)
+        from contour_fmu import cli
+        shown = {}
+        for argv in (["--help"], ["campaign", "--help"], ["campaign", "run", "--help"]):
+            out = io.StringIO()
+            with contextlib.redirect_stdout(out):
+                try:
+                    cli.main(argv)
+                except SystemExit as e:
+                    shown[" ".join(argv)] = (e.code, out.getvalue())
+        print(json.dumps(shown))
     """)
-    assert result[0] == 0 and "--scheduler" in result[1]
+    assert [code for code, _ in result.values()] == [0, 0, 0]
+    assert "campaign" in result["--help"][1] and "--scheduler" in result["campaign run --help"][1]
 
 
 def test_needs_passes_other_import_errors_through():

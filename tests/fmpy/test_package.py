@@ -108,6 +108,7 @@ def test_the_extras_of_contour_fmu_extras_are_pyprojects():
         pinned, included = own(optional[extra])
         assert sorted(pinned) == sorted(modules), extra  # distributions named as their modules
         assert included == list(INCLUDES.get(extra, ())), extra
+    assert pyproject()["scripts"] == {"contour-fmu": "contour_fmu.cli:main"}
 
 
 def test_the_venv_holds_the_pinned_versions():

@@ -1,5 +1,5 @@
-"""The command line: python -m contour_fmu.campaign run | replay (see --help). Needs the
-campaign extra (--help does not)."""
+"""The command line: python -m contour_fmu.campaign run | replay (see --help), also
+`contour-fmu campaign`. Needs the campaign extra (--help does not)."""
 
 import argparse
 import sys
@@ -8,9 +8,11 @@ from pathlib import Path
 
 from ..extras import MissingExtra, require
 
+PROG = "python -m contour_fmu.campaign"
 
-def parse_args(argv):
-    parser = argparse.ArgumentParser(prog="python -m contour_fmu.campaign",
+
+def parse_args(argv, prog=PROG):
+    parser = argparse.ArgumentParser(prog=prog,
                                      description="Closed-loop co-simulation campaigns of the "
                                                  "contour-fmu FMUs on Dask (docs/campaigns.md).")
     commands = parser.add_subparsers(dest="command", required=True)
@@ -97,8 +99,8 @@ def command_replay(args):
     return 0
 
 
-def main(argv=None):
-    args = parse_args(argv)
+def main(argv=None, prog=PROG):
+    args = parse_args(argv, prog)
     try:
         require("campaign")  # before any run, not when the plots are drawn at the end
     except MissingExtra as e:
