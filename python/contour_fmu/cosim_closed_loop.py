@@ -17,18 +17,22 @@ The printed object holds
 - "series": {"unit.variable": [values at steps 1..STEPS]} for the loop's recorded outputs;
 - "last": {"unit.variable": value} of the same outputs and interpolator.done, from a
   last-value observer after the run.
+
+Needs the engines extra (libcosimpy).
 """
 
 import json
 import sys
 
-from libcosimpy.CosimEnums import CosimVariableType
-from libcosimpy.CosimExecution import CosimExecution
-from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-from libcosimpy.CosimObserver import CosimObserver
-from libcosimpy.CosimSlave import CosimLocalSlave
-
+from .extras import needs
 from .loops import engine_arguments
+
+with needs("engines"):
+    from libcosimpy.CosimEnums import CosimVariableType
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimObserver import CosimObserver
+    from libcosimpy.CosimSlave import CosimLocalSlave
 
 DONE = ("interpolator", "done")
 
@@ -51,8 +55,8 @@ def set_initial(execution, index, variable, text):
         check(execution.string_initial_value(index, ref, text), f"initial value {text}")
 
 
-def main(argv):
-    args = engine_arguments(argv, "A closed loop in libcosim", (int, "communication step (ns)"))
+def main(argv, prog=None):
+    args = engine_arguments(argv, "A closed loop in libcosim", (int, "communication step (ns)"), prog)
     loop, steps = args.loop, args.steps
     log_output_level(CosimLogLevel.WARNING)
 

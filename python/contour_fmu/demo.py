@@ -22,6 +22,8 @@ usage: python -m contour_fmu.demo [--fmu-dir DIR] [--out DIR]
 The defaults are in the checkout <repo> (contour_fmu.repo: $CONTOUR_FMU_REPO, else the
 working directory or a parent of it, else the checkout the package is installed from in
 editable mode): <repo>/target/fmu, <repo>/out, <repo>/target/release/ccc-tune.
+
+Needs the plots and reference extras (matplotlib; geomdl, scipy).
 """
 
 import argparse
@@ -33,11 +35,15 @@ from pathlib import Path
 import numpy as np
 
 from . import five_axis_demo, repo
+from .extras import needs
 from .master import closed_loop
 from .output_files import write_csv
 from .output_files import write_cross_check as write_cross_check_files
-from .reference_paths import INFINITY, TRIDENT, ContourReference, clamped_uniform
 from .tuned import start_values
+
+with needs("plots", "reference"):
+    import matplotlib  # noqa: F401  the plots, here so that a missing one stops us before any run
+    from .reference_paths import INFINITY, TRIDENT, ContourReference, clamped_uniform
 
 STEP = 1e-3
 
@@ -149,11 +155,11 @@ def build_ccc_tune():
     return f"cargo build --release -p {repo.TUNER_PACKAGE} --bin ccc-tune"
 
 
-def parse_args(argv=None):
+def parse_args(argv=None, prog="python -m contour_fmu.demo"):
     """The options, with the defaults resolved in the checkout (only those needed: with
     --fmu-dir and --out given, no checkout is needed unless --tune runs ccc-tune)."""
     parser = argparse.ArgumentParser(
-        prog="python -m contour_fmu.demo", description=__doc__.splitlines()[0],
+        prog=prog, description=__doc__.splitlines()[0],
         epilog=f"<repo> is the checkout: ${repo.ENV}, else the working directory or a parent of "
                "it, else the checkout the package is installed from in editable mode; "
                "$CARGO_TARGET_DIR replaces <repo>/target.")
@@ -184,8 +190,8 @@ def parse_args(argv=None):
     return args
 
 
-def main(argv=None):
-    args = parse_args(argv)
+def main(argv=None, prog="python -m contour_fmu.demo"):
+    args = parse_args(argv, prog)
     args.out.mkdir(parents=True, exist_ok=True)
 
     rows = []

@@ -20,14 +20,18 @@ The printed object holds
 - "series": {"unit.variable": [values after steps 1..STEPS]} for the loop's recorded
   outputs, read by a post-step listener once ecos has transferred the connections of that
   step.
+
+Needs the engines extra (ecospy, whose engine needs Debian's libtbb12).
 """
 
 import json
 import sys
 
-from ecospy import EcosLib, EcosSimulation, EcosSimulationStructure, SimulationListener
-
+from .extras import needs
 from .loops import engine_arguments
+
+with needs("engines"):
+    from ecospy import EcosLib, EcosSimulation, EcosSimulationStructure, SimulationListener
 
 
 def ident(unit, name):
@@ -58,8 +62,8 @@ class Recorder(SimulationListener):
             self.series[f"{unit}.{name}"].append(self.sim.get_real(ident(unit, name)))
 
 
-def main(argv):
-    args = engine_arguments(argv, "A closed loop in ecos", (float, "communication step (s)"))
+def main(argv, prog=None):
+    args = engine_arguments(argv, "A closed loop in ecos", (float, "communication step (s)"), prog)
     loop = args.loop
     parameters = {ident(unit, name): parse_value(text) for unit, name, text in args.assignments}
     EcosLib.set_log_level("warn")

@@ -7,11 +7,13 @@ Python (contour_fmu.five_axis_truth).
 Writes to OUT: one CSV per run (joints, commands, estimates, true errors), one PNG per
 path (the tool-tip path with tool-axis glyphs, tip and orientation error against time)
 and the FMI cross-check files of ContourCCC5X (OUT/cross-check/ContourCCC5X/) from the
-fuzzy-CCC run on the helix. Returns the table rows; `print_table` prints them.
+fuzzy-CCC run on the helix. Returns the table rows; `print_table` prints them. The plots
+need the plots extra (matplotlib).
 """
 
 import numpy as np
 
+from .extras import needs
 from .five_axis_truth import contour_errors, forward
 from .master import Master, Unit, five_axis_closed_loop
 from .output_files import write_cross_check, write_csv
@@ -70,7 +72,8 @@ def write_run_csv(filename, before, after, tip, orientation):
 
 
 def plot(out, label, runs):
-    import matplotlib
+    with needs("plots"):
+        import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

@@ -73,11 +73,12 @@ LOOPS = {
 }
 
 
-def engine_arguments(argv, description, step):
+def engine_arguments(argv, description, step, prog=None):
     """Parses an engine's command line: [--loop NAME] FMU_DIR STEP STEPS
-    [UNIT.VARIABLE=VALUE ...]. `step` is (its type, its help). Returns the namespace with
-    `loop` as a Loop and `assignments` as (unit, variable, text) triples."""
-    parser = argparse.ArgumentParser(description=description)
+    [UNIT.VARIABLE=VALUE ...]. `step` is (its type, its help); `prog` the program's name
+    in the usage (default: argparse's). Returns the namespace with `loop` as a Loop and
+    `assignments` as (unit, variable, text) triples."""
+    parser = argparse.ArgumentParser(prog=prog, description=description)
     parser.add_argument("--loop", choices=list(LOOPS), default="two_axis",
                         help="which closed loop to run (default: two_axis)")
     parser.add_argument("fmu_dir", type=Path, help="folder holding the loop's FMUs")

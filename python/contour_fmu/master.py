@@ -20,10 +20,9 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
 from .loops import LOOPS
+from .stepping import SCHEMES, Stepping
 from .wiring import (CLOSED_LOOP_CONNECTIONS, FIVE_AXIS_CONNECTIONS, FIVE_AXIS_PATH_START,
                      PATH_START)
-
-SCHEMES = ("gauss-seidel", "jacobi")
 
 
 def set_value(slave, variable, value):
@@ -60,14 +59,16 @@ class Unit:
 class Master:
     """Use as a context manager: instantiated and initialized on entry, freed on exit."""
 
-    def __init__(self, units, connections, step, stop, scheme="gauss-seidel", initial=()):
+    def __init__(self, units, connections, step, stop, scheme="gauss-seidel", initial=(), log=None):
         """units: list of Unit in stepping order; connections: list of (source unit,
         output name, destination unit, input name); initial: connections applied once in
-        initialization mode, in order (e.g. an output onto a parameter)."""
+        initialization mode, in order (e.g. an output onto a parameter); log: a
+        contour_fmu.fmu_log.FmuLog that collects the FMUs' messages (default: fmpy's
+        logger, which prints them)."""
         if scheme not in SCHEMES:
             raise ValueError(f"unknown coupling scheme {scheme!r}; expected one of {SCHEMES}")
         self.units, self.connections, self.initial = units, connections, initial
-        self.step, self.stop, self.scheme = step, stop, scheme
+        self.step, self.stop, self.scheme, self.log = step, stop, scheme, log
         self.slaves, self.variables, self._dirs = {}, {}, []
 
     def __enter__(self):
@@ -79,7 +80,7 @@ class Master:
                               modelIdentifier=md.coSimulation.modelIdentifier, instanceName=u.name)
             self.slaves[u.name] = slave
             self.variables[u.name] = {v.name: v for v in md.modelVariables}
-            slave.instantiate()
+            slave.instantiate(callbacks=None if self.log is None else self.log.callbacks)
             slave.setupExperiment(startTime=0.0, stopTime=self.stop)
             slave.enterInitializationMode()
             for name, value in u.start_values.items():
@@ -109,31 +110,19 @@ class Master:
             return slave.getBoolean(vr)[0]
         return slave.getString(vr)[0]
 
-    def _transfer(self, into=None):
-        for src, out, dst, inp in self.connections:
-            if into is None or dst == into:
-                self.set(dst, inp, self.get(src, out))
-
     def run(self, record):
-        """Steps from 0 to the stop time. Returns two structured arrays with a 'time'
-        column and one column "unit.variable" per (unit, variable) in `record`:
-        `before[k]` holds the outputs at t_k before the step from t_k, `after[k]` the
-        outputs once every FMU has stepped to t_k+1 (for a sampled controller: the
+        """Steps from 0 to the stop time (contour_fmu.stepping). Returns two structured
+        arrays with a 'time' column and one column "unit.variable" per (unit, variable) in
+        `record`: `before[k]` holds the outputs at t_k before the step from t_k, `after[k]`
+        the outputs once every FMU has stepped to t_k+1 (for a sampled controller: the
         command it computed at t_k)."""
         steps = int(round(self.stop / self.step))
-        names = [f"{u}.{v}" for u, v in record]
-        before, after = [], []
-        for k in range(steps):
-            t = k * self.step
-            before.append((t, *[self.get(u, v) for u, v in record]))
-            if self.scheme == "jacobi":
-                self._transfer()
-            for unit in self.units:
-                if self.scheme == "gauss-seidel":
-                    self._transfer(into=unit.name)
-                self.slaves[unit.name].doStep(currentCommunicationPoint=t, communicationStepSize=self.step)
-            after.append((t + self.step, *[self.get(u, v) for u, v in record]))
-        dtype = [("time", float)] + [(n, float) for n in names]
+        stepping = Stepping({u.name: self.slaves[u.name] for u in self.units}, self.variables,
+                            self.connections, self.scheme)
+        _, before, after = stepping.run(self.step, steps, before=record, after=record)
+        dtype = [("time", float)] + [(f"{u}.{v}", float) for u, v in record]
+        before = [(k * self.step, *row) for k, row in enumerate(before)]
+        after = [(k * self.step + self.step, *row) for k, row in enumerate(after)]
         return np.array(before, dtype=dtype), np.array(after, dtype=dtype)
 
 

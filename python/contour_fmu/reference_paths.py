@@ -6,13 +6,19 @@ The NURBS `infinity` and `trident` come from the control points listed in docs/d
 their closed forms. For the true contour error each path is sampled densely and every
 point is projected onto the segments next to its nearest sample (about 1e-9 mm from the
 exact distance at 200 001 samples).
+
+Needs the reference extra (geomdl, scipy).
 """
 
 import math
 
 import numpy as np
-from geomdl import NURBS
-from scipy.spatial import cKDTree
+
+from .extras import needs
+
+with needs("reference"):
+    from geomdl import NURBS
+    from scipy.spatial import cKDTree
 
 # Control points (mm) of the built-in NURBS paths, docs/design/two-axis.md §4.6.
 INFINITY = [

@@ -1,19 +1,12 @@
 """Fixtures for the FMU tests: the packaged FMUs, built once per session by fmu-build."""
 
-import os
 import shutil
 import subprocess
-from pathlib import Path
 
 import pytest
 
 from contour_fmu.loops import LOOPS
-
-REPO = Path(__file__).resolve().parents[2]
-
-
-def target_dir():
-    return Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target"))
+from helpers.checkout import REPO, target_dir
 
 
 @pytest.fixture(scope="session")

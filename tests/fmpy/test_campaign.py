@@ -14,8 +14,6 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-import campaign_faults
-from conftest import REPO
 from contour_fmu.campaign import CampaignError, load
 from contour_fmu.campaign.execute import execute
 from contour_fmu.campaign.metrics import compute
@@ -23,6 +21,8 @@ from contour_fmu.campaign.store import OutputInUse
 from contour_fmu.master import closed_loop
 from contour_fmu.reference_paths import paper_circle_distance
 from contour_fmu.tuned import start_values
+from helpers import campaign_faults
+from helpers.checkout import REPO
 
 # The workers import contour_fmu (installed) but not the tests: send the faults by value.
 cloudpickle.register_pickle_by_value(campaign_faults)

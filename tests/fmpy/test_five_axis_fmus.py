@@ -16,7 +16,7 @@ from contour_fmu import five_axis_demo
 from contour_fmu.master import five_axis_closed_loop
 from contour_fmu.output_files import write_cross_check
 from contour_fmu.wiring import FIVE_AXIS_JOINTS
-from fmu_slave import Slave
+from helpers.fmu_slave import Slave
 
 REPO = Path(__file__).resolve().parents[2]
 BLADE = REPO / "examples" / "cl" / "blade.cl"

@@ -13,7 +13,7 @@ import subprocess
 
 import pytest
 
-from conftest import REPO, target_dir
+from helpers.checkout import REPO, target_dir
 
 CYCLES = 20
 

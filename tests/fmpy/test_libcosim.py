@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from plant_reference import PAPER_AXIS, simulate_axis
+from helpers.plant_reference import PAPER_AXIS, simulate_axis
 
 HERE = Path(__file__).resolve().parent
 
@@ -16,7 +16,8 @@ def test_steps_in_libcosim_and_matches_scipy(xy_plant_fmu):
     step_ns, steps = 1_000_000, 200  # 1 ms steps for 0.2 s
     u_x, u_y = 25.0, -10.0
     done = subprocess.run(
-        [sys.executable, str(HERE / "cosim_run.py"), xy_plant_fmu, str(step_ns), str(steps),
+        [sys.executable, str(HERE / "helpers" / "cosim_run.py"), xy_plant_fmu, str(step_ns),
+         str(steps),
          f"0={u_x}", f"1={u_y}", "--observe", "2", "3"],
         capture_output=True, text=True, timeout=120,
     )

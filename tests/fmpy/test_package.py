@@ -1,6 +1,6 @@
 """The contour_fmu package (python/) as installed: the tests import this checkout's code,
-its pins agree with requirements/, it finds the checkout from anywhere, and the demo's
-command line answers without a run."""
+its pins (core and extras) agree with requirements/, it finds the checkout from anywhere,
+and the demo's command line answers without a run."""
 
 import importlib.metadata
 import json
@@ -14,7 +14,8 @@ import pytest
 
 import contour_fmu
 from contour_fmu import repo
-from conftest import REPO
+from contour_fmu.extras import EXTRAS, INCLUDES
+from helpers.checkout import REPO
 
 PIN = re.compile(r"^([A-Za-z0-9._-]+)==([^\s#;]+)")
 
@@ -43,21 +44,71 @@ def pyproject():
     return tomllib.loads((REPO / "python" / "pyproject.toml").read_text())["project"]
 
 
+SELF = re.compile(r"^contour-fmu\[([a-z,]+)\]$")  # an extra that includes others
+
+
+def own(requirements):
+    """({name: version}, [included extras]) of a list of pyproject requirements."""
+    pinned, included = {}, []
+    for requirement in requirements:
+        if inner := SELF.match(requirement):
+            included += inner[1].split(",")
+            continue
+        match = PIN.match(requirement)
+        assert match, f"python/pyproject.toml: not pinned with ==: {requirement!r}"
+        pinned[canonical(match[1])] = match[2]
+    return pinned, included
+
+
+def declared(extras):
+    """{name: version} of the core and `extras` with the extras they include."""
+    project = pyproject()
+    found = own(project["dependencies"])[0]
+    for extra in extras:
+        pinned, included = own(project["optional-dependencies"][extra])
+        found.update(pinned)
+        found.update(declared(included))
+    return found
+
+
+def run_extras():
+    """The extras of the run set: all but test."""
+    return sorted(set(pyproject()["optional-dependencies"]) - {"test"})
+
+
+def direct(filename):
+    """{name: version} of a requirements file's own pins before its transitive ones."""
+    text = (REPO / "requirements" / filename).read_text().split("# Transitive dependencies.")[0]
+    return {canonical(m[1]): m[2] for m in map(PIN.match, text.splitlines()) if m}
+
+
 def test_the_tests_import_this_checkouts_package():
     assert Path(contour_fmu.__file__).resolve().parent == REPO / "python" / "contour_fmu"
     assert importlib.metadata.version("contour-fmu") == pyproject()["version"] == contour_fmu.__version__
 
 
-@pytest.mark.parametrize("filename, declared", [
-    ("run.txt", lambda p: p["dependencies"]),
-    ("test.txt", lambda p: p["dependencies"] + p["optional-dependencies"]["test"]),
-])
-def test_pyproject_pins_are_the_requirements_pins(filename, declared):
+@pytest.mark.parametrize("filename, extras", [("run.txt", run_extras()), ("test.txt", ["test"])])
+def test_pyproject_pins_are_the_requirements_pins(filename, extras):
     locked = pins(filename)
-    for requirement in declared(pyproject()):
-        match = PIN.match(requirement)
-        assert match, f"python/pyproject.toml: not pinned with ==: {requirement!r}"
-        assert locked.get(canonical(match[1])) == match[2], requirement
+    for name, version in declared(extras).items():
+        assert locked.get(name) == version, f"{name}=={version}"
+
+
+def test_the_requirements_direct_pins_are_the_core_and_the_extras():
+    assert direct("run.txt") == declared(run_extras())
+    assert direct("test.txt") == own(pyproject()["optional-dependencies"]["test"])[0]
+    # The test extra brings every other one: -e './python[test]' installs the whole package.
+    assert sorted(own(pyproject()["optional-dependencies"]["test"])[1]) == run_extras()
+
+
+def test_the_extras_of_contour_fmu_extras_are_pyprojects():
+    optional = pyproject()["optional-dependencies"]
+    assert sorted(EXTRAS) == run_extras()
+    for extra, modules in EXTRAS.items():
+        pinned, included = own(optional[extra])
+        assert sorted(pinned) == sorted(modules), extra  # distributions named as their modules
+        assert included == list(INCLUDES.get(extra, ())), extra
+    assert pyproject()["scripts"] == {"contour-fmu": "contour_fmu.cli:main"}
 
 
 def test_the_venv_holds_the_pinned_versions():

@@ -9,7 +9,7 @@ import pytest
 
 from contour_fmu import demo, repo
 from contour_fmu.tuned import start_values
-from conftest import REPO, target_dir
+from helpers.checkout import REPO, target_dir
 
 PAPER = {"fuzzy.ke": 1.0, "fuzzy.kde": 1.2, "fuzzy.kp": 87.0, "fuzzy.ki": 8.5, "fuzzy.kd": 4.0}
 

@@ -14,9 +14,10 @@ from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
 from contour_fmu import demo
-from contour_fmu.master import closed_loop
+from contour_fmu.fmu_log import FmuLog
+from contour_fmu.master import Master, Unit, closed_loop
 from contour_fmu.reference_paths import ContourReference
-from fmu_slave import Slave
+from helpers.fmu_slave import Slave
 
 CONTROLLER_OUTPUTS = ["u.x", "u.y", "contourError", "err.x", "err.y", "ccc.Kp", "ccc.Ki", "ccc.Kd"]
 
@@ -231,6 +232,17 @@ def test_nan_input_is_refused_and_outputs_stay(controller):
     assert failure.value.status == 3  # fmi2Error
     assert any("'pos.x' refuses the non-finite value NaN" in m for m in c.log.errors())
     assert np.array_equal(c.reals(CONTROLLER_OUTPUTS + ["pos.x"]), before)
+
+
+def test_the_master_gives_the_fmus_messages_to_its_log(fmu_dir):
+    log = FmuLog()
+    units = [Unit("controller", str(fmu_dir / "ContourCCC2D.fmu"))]
+    with Master(units, [], 1e-3, 0.01, log=log) as master:
+        with pytest.raises(FMICallException):
+            master.set("controller", "pos.x", float("nan"))
+    assert len(log.failures()) == 1
+    assert log.failures()[0].startswith("controller: ")
+    assert "'pos.x' refuses the non-finite value NaN" in log.failures()[0]
 
 
 @pytest.mark.parametrize("fixture, values, words", [

@@ -4,7 +4,7 @@ import numpy as np
 from fmpy import read_model_description, simulate_fmu
 from fmpy.validation import validate_fmu
 
-from plant_reference import PAPER_AXIS, simulate_axis
+from helpers.plant_reference import PAPER_AXIS, simulate_axis
 
 STEP = 1e-3
 

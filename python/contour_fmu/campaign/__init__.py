@@ -7,7 +7,9 @@ fixed and swept parameters, paths and metrics; every run becomes one Parquet row
 
 Modules: spec (the file, checked and expanded into runs), runner (what a worker does:
 extract, instantiate, reset, step, measure), metrics, store (the Parquet rows),
-execute (Dask or serial), report (summary and plots), __main__ (the command line).
+execute (Dask or serial), report (summary and plots), __main__ (the command line, also
+`contour-fmu campaign`). Running, replaying and reporting need the campaign extra; spec
+and runner need only the core.
 """
 
 from .spec import CampaignError, load  # noqa: F401

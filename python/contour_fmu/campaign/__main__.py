@@ -1,20 +1,18 @@
-"""The command line: python -m contour_fmu.campaign run | replay (see --help)."""
+"""The command line: python -m contour_fmu.campaign run | replay (see --help), also
+`contour-fmu campaign`. Needs the campaign extra (--help does not)."""
 
 import argparse
 import sys
 import time
 from pathlib import Path
 
-from . import report
-from .execute import SchedulerUnreachable, archives_of, execute, job_of
-from .metrics import errors
-from .runner import LoopInstances, run_one, unpacked
-from .spec import CampaignError, load
-from .store import OutputInUse
+from ..extras import MissingExtra, require
+
+PROG = "python -m contour_fmu.campaign"
 
 
-def parse_args(argv):
-    parser = argparse.ArgumentParser(prog="python -m contour_fmu.campaign",
+def parse_args(argv, prog=PROG):
+    parser = argparse.ArgumentParser(prog=prog,
                                      description="Closed-loop co-simulation campaigns of the "
                                                  "contour-fmu FMUs on Dask (docs/campaigns.md).")
     commands = parser.add_subparsers(dest="command", required=True)
@@ -48,6 +46,10 @@ def parse_args(argv):
 
 
 def command_run(args):
+    from . import report
+    from .execute import execute
+    from .spec import load
+
     campaign = load(args.file, args.fmu_dir)
     began = time.perf_counter()
     store = execute(campaign, args.out, scheduler=args.scheduler, workers=args.workers,
@@ -64,6 +66,10 @@ def command_run(args):
 
 def command_replay(args):
     from ..output_files import write_csv
+    from .execute import archives_of, job_of
+    from .metrics import errors
+    from .runner import LoopInstances, run_one, unpacked
+    from .spec import load
 
     campaign = load(args.file, args.fmu_dir)
     run = campaign.run(args.run)
@@ -72,7 +78,7 @@ def command_replay(args):
     try:
         values, trace = run_one(job, instances, run.start_values)
     except Exception as e:  # noqa: BLE001  a failed run's reason, as its row gives it
-        for line in instances.log.errors:
+        for line in instances.log.failures():
             print(line, file=sys.stderr)
         print(f"run {run.id} failed: {type(e).__name__}: {e}", file=sys.stderr)
         return 1
@@ -93,8 +99,17 @@ def command_replay(args):
     return 0
 
 
-def main(argv=None):
-    args = parse_args(argv)
+def main(argv=None, prog=PROG):
+    args = parse_args(argv, prog)
+    try:
+        require("campaign")  # before any run, not when the plots are drawn at the end
+    except MissingExtra as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    from .execute import SchedulerUnreachable
+    from .spec import CampaignError
+    from .store import OutputInUse
+
     try:
         return command_run(args) if args.command == "run" else command_replay(args)
     except (CampaignError, OutputInUse, SchedulerUnreachable) as e:

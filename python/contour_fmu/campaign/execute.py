@@ -15,6 +15,7 @@ import contextlib
 import hashlib
 import time
 
+from ..extras import needs
 from .runner import Job, extracted, run_batch
 from .store import ResultStore
 
@@ -66,8 +67,9 @@ class FmuArchives(WorkerPlugin):
 def dask_client(scheduler=None, workers=None):
     """A distributed Client: to `scheduler` (an address), else to a new LocalCluster of
     `workers` single-threaded worker processes (default: one per core)."""
-    import dask
-    from distributed import Client, LocalCluster
+    with needs("campaign"):
+        import dask
+        from distributed import Client, LocalCluster
 
     if scheduler is not None:
         try:
@@ -116,7 +118,8 @@ def _settle(batch, attempt, run, metrics):
     """(rows to write, whether to try again) of one attempt of a batch: `run()` gives its
     rows or raises. A first attempt that is lost or fails is tried again; a second is
     recorded as lost or failed, with the reason."""
-    from distributed.scheduler import KilledWorker
+    with needs("campaign"):
+        from distributed.scheduler import KilledWorker
 
     try:
         return [{**row, "attempts": attempt} for row in run()], False
@@ -154,7 +157,8 @@ def run_on_dask(campaign, store, client, progress=None, batch_fn=run_batch):
     No more batches are in flight than the workers have threads, so a worker's death
     loses only what it was running, on any scheduler; the next batch is submitted before
     the finished one's rows are written, so a worker does not wait for the disk."""
-    from distributed import as_completed
+    with needs("campaign"):
+        from distributed import as_completed
 
     job = job_of(campaign)
     plugin = FmuArchives(job, archives_of(campaign))
@@ -195,7 +199,8 @@ def execute(campaign, out, *, scheduler=None, workers=None, resume=False, serial
             show_progress=True, batch_fn=run_batch):
     """Runs the campaign's pending runs into OUT; returns the store. Connects to the
     scheduler (or starts the LocalCluster) before any run."""
-    from tqdm import tqdm
+    with needs("campaign"):
+        from tqdm import tqdm
 
     store = ResultStore(out, campaign, resume=resume)  # refuses a folder in use, writes nothing
     total = len(campaign.runs)

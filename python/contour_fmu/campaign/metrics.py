@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..extras import needs
 from ..wiring import FIVE_AXIS_JOINTS
 
 STATISTICS = ("max", "mean")
@@ -83,7 +84,8 @@ def check_metrics(loop, metrics, interpolator_values=None, interpolator_variable
 
 @functools.lru_cache(maxsize=None)
 def _two_axis_reference(path):
-    from ..reference_paths import ContourReference
+    with needs("campaign"):
+        from ..reference_paths import ContourReference
 
     return ContourReference(path)
 

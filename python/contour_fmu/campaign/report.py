@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..extras import needs
 from .metrics import unit_of
 
 SCALE = {"mm": (1e3, "µm"), "rad": (1e6, "µrad")}
@@ -46,7 +47,8 @@ def _groups(columns):
 def sensitivity(x, y):
     """(Spearman's rho, elasticity) of y against x; NaN when either is constant or x is
     not a number (a swept string)."""
-    from scipy.stats import spearmanr
+    with needs("campaign"):
+        from scipy.stats import spearmanr
 
     if any(isinstance(v, str) for v in x):
         return float("nan"), float("nan")
@@ -133,7 +135,8 @@ def _log_if_wide(ax, data):
 
 def plot(campaign, table, out):
     """OUT/distribution.png and, with swept parameters, OUT/sensitivity.png."""
-    import matplotlib
+    with needs("campaign"):
+        import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

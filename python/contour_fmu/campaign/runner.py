@@ -8,10 +8,10 @@ loops of simulations. A run that fails (an FMU returns fmi2Error, the path never
 becomes a row with status "error" and the FMU's own log message; the instances are then
 made anew, so the next run starts clean.
 
-The stepping is the Gauss-Seidel scheme of contour_fmu.master (controller, plant,
-interpolator; each input refreshed from its source just before its FMU steps), written
-with the value references resolved once: a campaign run gives exactly what
-master.closed_loop gives for the same start values.
+The stepping is contour_fmu.master's, the Gauss-Seidel loop of contour_fmu.stepping
+(controller, plant, interpolator; each input refreshed from its source just before its
+FMU steps): a campaign run gives exactly what master.closed_loop gives for the same start
+values.
 """
 
 import atexit
@@ -26,12 +26,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..fmu_log import ERROR, FmuLog
 from ..loops import LOOPS
 from ..master import free_all, set_value
+from ..stepping import Stepping
 from . import metrics as campaign_metrics
 
 ORDER = ("controller", "plant", "interpolator")
-FMI_ERROR = 3  # fmi2Error; the logger's status of a refused call
 
 
 @dataclass(frozen=True)
@@ -74,29 +75,6 @@ def extracted(sha256, archive, within=None):
     return _extracted[sha256]
 
 
-class _Log:
-    """The FMUs' log messages of the current run (fmpy's logger callback)."""
-
-    def __init__(self):
-        from ctypes import byref
-
-        from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
-                               fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, calloc, free)
-        from fmpy.logging import addLoggerProxy
-
-        self.errors = []
-
-        def log(_env, name, status, _category, message):
-            if status >= FMI_ERROR:
-                self.errors.append(f"{name.decode(errors='replace')}: {message.decode(errors='replace')}")
-
-        self.callbacks = fmi2CallbackFunctions()
-        self.callbacks.logger = fmi2CallbackLoggerTYPE(log)
-        self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        addLoggerProxy(byref(self.callbacks))
-
-
 class LoopInstances:
     """The loop's three FMUs, instantiated once; `run` resets them between runs."""
 
@@ -106,7 +84,7 @@ class LoopInstances:
         from fmpy.fmi2 import FMU2Slave
 
         self.loop = LOOPS[loop]
-        self.log = _Log()
+        self.log = FmuLog(least=ERROR)  # the reasons a run failed
         self.slaves, self.variables = {}, {}
         try:
             for unit in ORDER:
@@ -120,31 +98,20 @@ class LoopInstances:
             self.free()
             raise
         vr = lambda unit, name: self.variables[unit][name].valueReference  # noqa: E731
-        # Inputs of each unit, grouped by source: (source slave, its vrs, our vrs).
-        self.links = {unit: [] for unit in ORDER}
-        for src in ORDER:
-            for dst in ORDER:
-                pairs = [(vr(s, o), vr(d, i)) for s, o, d, i in self.loop.connections if s == src and d == dst]
-                if pairs:
-                    self.links[dst].append((self.slaves[src], *map(list, zip(*pairs))))
+        self.stepping = Stepping(self.slaves, self.variables, self.loop.connections)
         self.path_start = [(self.slaves[s], vr(s, o), self.slaves[d], vr(d, i))
                            for s, o, d, i in self.loop.path_start]
         # Recorded at t_k before the step: the reference and the plant's position; after
         # it, the controller's outputs (its command and estimates for the sample at t_k).
-        self.before, self.before_vrs = self._grouped([c for c in self.loop.recorded if c[0] != "controller"])
-        self.after, self.after_vrs = self._grouped([c for c in self.loop.recorded if c[0] == "controller"])
+        self.before = self._grouped([c for c in self.loop.recorded if c[0] != "controller"])
+        self.after = self._grouped([c for c in self.loop.recorded if c[0] == "controller"])
         self.done_vr = [vr("interpolator", "done")]
         self.fresh = True
 
-    def _grouped(self, columns):
-        """(columns in reading order, [(slave, its vrs)]): one getReal per unit."""
-        ordered, reads = [], []
-        for unit in ORDER:
-            names = [n for u, n in columns if u == unit]
-            if names:
-                ordered += [(unit, n) for n in names]
-                reads.append((self.slaves[unit], [self.variables[unit][n].valueReference for n in names]))
-        return ordered, reads
+    @staticmethod
+    def _grouped(columns):
+        """The columns unit by unit, in stepping order (one read per unit)."""
+        return [(unit, n) for unit in ORDER for u, n in columns if u == unit]
 
     def free(self):
         free_all(self.slaves.values())
@@ -153,7 +120,7 @@ class LoopInstances:
     def run(self, job, start_values):
         """One run from t = 0: returns its trace, {"time": ..., "unit.variable": ...} of
         the loop's recorded outputs, one value per step."""
-        self.log.errors.clear()
+        self.log.clear()
         if not self.fresh:
             for slave in self.slaves.values():
                 slave.reset()
@@ -173,34 +140,16 @@ class LoopInstances:
             self.slaves[unit].exitInitializationMode()
 
         step = job.step
-        if job.stop is None:
-            limit, steps = int(round(job.max_stop / step)), None
-        else:
-            limit = steps = int(round(job.stop / step))
-        settle = int(round(job.settle / step))
         interpolator = self.slaves["interpolator"]
-        stepped = [(self.slaves[unit], self.links[unit]) for unit in ORDER]
-        before, after = [], []
-        k = 0
-        while k < (limit if steps is None else steps):
-            if steps is None and interpolator.getBoolean(self.done_vr)[0]:
-                steps = k + settle
-                continue
-            t = k * step
-            row = []
-            for slave, vrs in self.before_vrs:
-                row.extend(slave.getReal(vrs))
-            before.append(row)
-            for slave, links in stepped:
-                for source, source_vrs, vrs in links:
-                    slave.setReal(vrs, source.getReal(source_vrs))
-                slave.doStep(currentCommunicationPoint=t, communicationStepSize=step)
-            row = []
-            for slave, vrs in self.after_vrs:
-                row.extend(slave.getReal(vrs))
-            after.append(row)
-            k += 1
-        if steps is None:
+        if job.stop is None:
+            k, before, after = self.stepping.run(
+                step, int(round(job.max_stop / step)), self.before, self.after,
+                ended=lambda: interpolator.getBoolean(self.done_vr)[0],
+                settle=int(round(job.settle / step)))
+        else:
+            k, before, after = self.stepping.run(step, int(round(job.stop / step)),
+                                                 self.before, self.after)
+        if k is None:
             raise RunFailed(f"the path did not end within max_stop = {job.max_stop!r} s")
         trace = {"time": np.arange(k) * step}
         for columns, values in ((self.before, before), (self.after, after)):
@@ -252,7 +201,7 @@ def run_batch(job, runs, archives=None):
                 values, _ = run_one(job, instances, start_values)
                 row.update(values)
             except Exception as e:  # noqa: BLE001  every failure of a run is its row's message
-                logged = instances.log.errors
+                logged = instances.log.failures()
                 row.update({m: float("nan") for m in job.metrics})
                 row["status"] = "error"
                 row["message"] = "; ".join([*logged[-3:], f"{type(e).__name__}: {e}"])

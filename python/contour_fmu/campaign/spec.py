@@ -51,6 +51,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import repo
+from ..extras import needs
 from ..loops import LOOPS
 from ..tuned import start_values as tuned_start_values
 from .metrics import METRICS, check_metrics
@@ -454,7 +455,8 @@ class _Reader:
         return float(f)
 
     def latin_hypercube(self, sweep, parameters):
-        from scipy.stats import qmc
+        with needs("campaign"):
+            from scipy.stats import qmc
 
         samples, seed = sweep.get("samples"), sweep.get("seed", 0)
         if not isinstance(samples, int) or isinstance(samples, bool) or samples < 1:

@@ -12,8 +12,11 @@ import json
 import os
 from pathlib import Path
 
-import pyarrow as pa
-import pyarrow.parquet as pq
+from ..extras import needs
+
+with needs("campaign"):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
 
 # A row's outcome. ok and error are final (an FMU error repeats when rerun); lost (the
 # batch died with its worker twice) and failed (the batch raised outside any run, twice)

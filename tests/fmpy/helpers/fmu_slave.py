@@ -7,7 +7,7 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-from fmu_log import CapturedLog
+from contour_fmu.fmu_log import FmuLog
 
 
 class Slave:
@@ -17,7 +17,7 @@ class Slave:
         self.md = read_model_description(fmu_path)
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
         self.dir = extract(fmu_path)
-        self.log = CapturedLog()
+        self.log = FmuLog()
         self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,
                              modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
         self.fmu.instantiate(callbacks=self.log.callbacks)

@@ -1,7 +1,7 @@
 """Runs one FMU in libcosim (libcosimpy) and prints the last values as JSON.
 
 Kept in its own process: libcosim can take the interpreter down on a broken FMU.
-usage: python cosim_run.py FMU STEP_NS STEPS VR_IN=VALUE... --observe VR...
+usage: python tests/fmpy/helpers/cosim_run.py FMU STEP_NS STEPS VR_IN=VALUE... --observe VR...
 """
 
 import json
