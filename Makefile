@@ -34,7 +34,7 @@ $(PYTHON):
 	python3 -m venv $(VENV)
 
 $(VENV)/.run-installed: requirements/run.txt python/pyproject.toml | $(PYTHON)
-	$(PIP) -r requirements/run.txt -e ./python
+	$(PIP) -r requirements/run.txt -e './python[campaign,engines,plots,reference]'
 	touch $@
 
 $(VENV)/.test-installed: requirements/test.txt requirements/run.txt python/pyproject.toml | $(PYTHON)

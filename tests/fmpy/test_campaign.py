@@ -442,8 +442,8 @@ def test_one_writer_per_output_folder(sixteen, tmp_path):
         ResultStore(tmp_path / "file", sixteen)
 
 
-def test_the_readme_example_runs_on_a_local_cluster_with_a_progress_bar(tmp_path, fmu_dir):
-    """The README's example: 216 runs on a LocalCluster; rows, summary and plots."""
+def test_the_documented_example_runs_on_a_local_cluster_with_a_progress_bar(tmp_path, fmu_dir):
+    """The example of docs/campaigns.md: 216 runs on a LocalCluster; rows, summary and plots."""
     out = tmp_path / "robustness"
     done = run_cli("run", "examples/campaigns/two_axis_robustness.toml", "--out", str(out))
     assert done.returncode == 0, done.stderr
