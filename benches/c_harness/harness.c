@@ -1,7 +1,7 @@
 /* The C harness of issue 21: what one sample costs an importer written in C.
  *
  *   harness [--samples N] [--passes P] [--warmup W] [--json FILE] [--only LABEL]
- *           LABEL=LIBRARY:MODEL_DESCRIPTION ...
+ *           [--dump FILE] LABEL=LIBRARY:MODEL_DESCRIPTION ...
  *
  * Each model is dlopen'ed from LIBRARY (an FMU's binaries/linux64/<id>.so), its GUID,
  * model identifier and Real inputs and outputs read from MODEL_DESCRIPTION (the FMU's
@@ -14,19 +14,31 @@
  * velocity command u the derivative of pos (R = 10 mm, f = 0.5 Hz; the N samples of a
  * pass are whole periods, so passes continue the same circle). Inputs are matched by
  * name: ref.x/ref.y, pos.x/pos.y, u.x/u.y; in1..in4 (the bare pass-through) take ref.x,
- * ref.y, pos.x, pos.y; any other Real input is held at 0. The rows are computed before
- * timing, so the timed loop is the three calls and nothing else.
+ * ref.y, pos.x, pos.y; any other Real input is held at 0.
  *
- * Passes alternate between the models (pass p starts with model p mod M), each timing N
- * samples with CLOCK_MONOTONIC, after W untimed warm-up passes: a burst of load from
- * another process hits neighbouring passes of all models alike. Reported per model: the
- * median and minimum ns per sample over the P passes; per model after the first (the
- * baseline, the bare C pass-through): the median over passes of its time / the
- * baseline's time in the same pass. With --json, the same as JSON.
+ * Two loops are timed, on the same instance:
+ * - calls_only: the inputs of the N samples are computed before timing, so the timed loop
+ *   is the three calls and nothing else: the FMU's own cost, the bare pass-through's
+ *   being the floor of three calls through dlopen'ed pointers;
+ * - importer_loop: the importer computes each sample's inputs on the circle (sin and cos
+ *   of the reference's and of the lagging position's angle) just before the calls, as a
+ *   master generating its inputs does: what a sample costs the importer in all.
+ *
+ * Passes alternate between the models (pass p starts with model p mod M) and between the
+ * loops (calls_only first in even passes), each timing N samples with CLOCK_MONOTONIC,
+ * after W untimed warm-up passes: a burst of load from another process hits neighbouring
+ * passes of all models alike. Reported per model and loop: the median and minimum ns per
+ * sample over the P passes; per model after the first (the baseline, the bare C
+ * pass-through): the median over passes of its time / the baseline's time in the same
+ * pass. With --json, the same as JSON.
  *
  * --only LABEL runs that model's passes alone, for valgrind --tool=callgrind
- * --toggle-collect=run_pass: instructions / (N * P) is then the instruction count of one
- * sample (benches/c_harness/run.sh --callgrind).
+ * --toggle-collect=run_calls_only: instructions / (N * (W + P)) is then the instruction
+ * count of one sample's calls (benches/c_harness/run.sh --callgrind).
+ *
+ * --dump FILE writes every output of every calls_only sample (doubles, in the machine's
+ * byte order): two builds of a library compute the same outputs if their dumps are equal
+ * byte for byte (run with --only LABEL and the same N, P and W).
  *
  * Built by benches/c_harness/run.sh with gcc -O2; `make bench` runs it.
  */
@@ -43,6 +55,10 @@
 #include "fmi2Functions.h"
 
 #define MAX_MODELS 8
+enum loop { CALLS_ONLY, IMPORTER_LOOP, LOOPS };
+static const char *const LOOP_NAME[LOOPS] = {"calls_only", "importer_loop"};
+/* What an input is fed: the lagging circle's coordinates, or 0. */
+enum signal { REF_X, REF_Y, POS_X, POS_Y, U_X, U_Y, ZERO, SIGNALS };
 #define MAX_VARS 256
 #define H 1e-3
 #define RADIUS 10.0
@@ -67,14 +83,15 @@ typedef struct {
     fmi2DoStepTYPE *do_step;
     fmi2Component c;
     fmi2ValueReference in_vr[MAX_VARS];
-    char *in_name[MAX_VARS];
+    enum signal in_signal[MAX_VARS];
     size_t n_in;
     fmi2ValueReference out_vr[MAX_VARS];
     size_t n_out;
-    double *rows;  /* samples x n_in input values */
+    double *rows;  /* samples x n_in input values (calls_only) */
+    double in[MAX_VARS];  /* one sample's inputs (importer_loop) */
     double out[MAX_VARS];
     unsigned long long step; /* communication steps taken */
-    double *ns;  /* per pass */
+    double *ns[LOOPS];  /* per pass */
     double checksum;
 } Model;
 
@@ -132,6 +149,30 @@ static int attribute(const char *start, const char *end, const char *name, char 
     return 0;
 }
 
+/* The signal an input named `name` is fed. */
+static enum signal signal_of(const char *name) {
+    static const char *const names[ZERO] = {"ref.x", "ref.y", "pos.x", "pos.y", "u.x", "u.y"};
+    if (name[0] == 'i' && name[1] == 'n' && name[2] >= '1' && name[2] <= '4' && !name[3])
+        return (enum signal)(name[2] - '1'); /* in1..in4: ref.x, ref.y, pos.x, pos.y */
+    for (int i = 0; i < ZERO; i++)
+        if (!strcmp(name, names[i])) return (enum signal)i;
+    return ZERO;
+}
+
+/* The lagging circle at time t: every signal's value. */
+static inline void circle(double t, double value[SIGNALS]) {
+    const double w = 2.0 * PI * FREQUENCY, r = RADIUS - INSIDE;
+    double ref = w * t, lagged = w * (t - LAG);
+    double c = cos(lagged), s = sin(lagged);
+    value[REF_X] = RADIUS * cos(ref);
+    value[REF_Y] = RADIUS * sin(ref);
+    value[POS_X] = r * c;
+    value[POS_Y] = r * s;
+    value[U_X] = -r * w * s;
+    value[U_Y] = r * w * c;
+    value[ZERO] = 0.0;
+}
+
 /* GUID, model identifier and the Real inputs and outputs of a modelDescription.xml. */
 static void read_description(Model *m) {
     char *xml = read_file(m->description_path);
@@ -157,7 +198,7 @@ static void read_description(Model *m) {
         if (!real || real > end) continue;
         if (strcmp(causality, "input") == 0) {
             if (m->n_in == MAX_VARS) die("too many inputs");
-            m->in_name[m->n_in] = strdup(name);
+            m->in_signal[m->n_in] = signal_of(name);
             m->in_vr[m->n_in++] = (fmi2ValueReference)strtoul(vr, NULL, 10);
         } else if (strcmp(causality, "output") == 0) {
             if (m->n_out == MAX_VARS) die("too many outputs");
@@ -172,6 +213,8 @@ static void *symbol(void *library, const char *path, const char *name) {
     if (!f) die("%s: no %s", path, name);
     return f;
 }
+
+static FILE *dump;
 
 static const fmi2CallbackFunctions CALLBACKS = {logger, calloc, free, NULL, NULL};
 
@@ -198,34 +241,37 @@ static void start(Model *m) {
         die("%s: initialization failed", m->label);
 }
 
-/* The lagging circle's value of input `name` at sample k. */
-static double signal(const char *name, size_t k) {
-    double t = (double)k * H, w = 2.0 * PI * FREQUENCY;
-    double ref = w * t, lagged = w * (t - LAG), r = RADIUS - INSIDE;
-    static const char *const numbered[] = {"ref.x", "ref.y", "pos.x", "pos.y"};
-    if (name[0] == 'i' && name[1] == 'n' && name[2] >= '1' && name[2] <= '4' && !name[3])
-        name = numbered[name[2] - '1'];
-    if (!strcmp(name, "ref.x")) return RADIUS * cos(ref);
-    if (!strcmp(name, "ref.y")) return RADIUS * sin(ref);
-    if (!strcmp(name, "pos.x")) return r * cos(lagged);
-    if (!strcmp(name, "pos.y")) return r * sin(lagged);
-    if (!strcmp(name, "u.x")) return -r * w * sin(lagged);
-    if (!strcmp(name, "u.y")) return r * w * cos(lagged);
-    return 0.0;
-}
-
 static double now_ns(void) {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
 }
 
-/* N samples on one model: the timed loop (and callgrind's --toggle-collect target). */
-__attribute__((noinline)) void run_pass(Model *m, size_t samples) {
+/* N samples on one model with the inputs computed before (callgrind's --toggle-collect
+   target). */
+__attribute__((noinline)) void run_calls_only(Model *m, size_t samples) {
     fmi2Component c = m->c;
     for (size_t k = 0; k < samples; k++) {
         double t = (double)m->step * H;
         fmi2Status status = m->set_real(c, m->in_vr, m->n_in, m->rows + k * m->n_in);
+        status |= m->do_step(c, t, H, fmi2True);
+        status |= m->get_real(c, m->out_vr, m->n_out, m->out);
+        if (status != fmi2OK) die("%s: a call failed at t = %g", m->label, t);
+        if (dump && fwrite(m->out, sizeof *m->out, m->n_out, dump) != m->n_out) die("dump failed");
+        m->step++;
+    }
+    m->checksum += m->n_out ? m->out[0] : 0.0;
+}
+
+/* N samples on one model, each computing its inputs on the circle first. */
+__attribute__((noinline)) void run_importer_loop(Model *m, size_t samples) {
+    fmi2Component c = m->c;
+    double value[SIGNALS];
+    for (size_t k = 0; k < samples; k++) {
+        double t = (double)m->step * H;
+        circle(t, value);
+        for (size_t j = 0; j < m->n_in; j++) m->in[j] = value[m->in_signal[j]];
+        fmi2Status status = m->set_real(c, m->in_vr, m->n_in, m->in);
         status |= m->do_step(c, t, H, fmi2True);
         status |= m->get_real(c, m->out_vr, m->n_out, m->out);
         if (status != fmi2OK) die("%s: a call failed at t = %g", m->label, t);
@@ -275,6 +321,9 @@ int main(int argc, char **argv) {
         else if (!strcmp(arg, "--warmup") && i + 1 < argc) warmup = strtoul(argv[++i], NULL, 10);
         else if (!strcmp(arg, "--json") && i + 1 < argc) json = argv[++i];
         else if (!strcmp(arg, "--only") && i + 1 < argc) only = argv[++i];
+        else if (!strcmp(arg, "--dump") && i + 1 < argc) {
+            if (!(dump = fopen(argv[++i], "wb"))) die("cannot write %s", argv[i]);
+        }
         else if (arg[0] == '-') die("unknown option %s", arg);
         else {
             char *spec = strdup(arg), *eq = strchr(spec, '='), *colon = eq ? strchr(eq, ':') : NULL;
@@ -288,8 +337,9 @@ int main(int argc, char **argv) {
             n++;
         }
     }
-    if (!n || !samples || !passes) die("usage: harness [--samples N] [--passes P] [--warmup W] "
-                                       "[--json FILE] [--only LABEL] LABEL=LIB:XML ...");
+    if (!n || !samples || !passes)
+        die("usage: harness [--samples N] [--passes P] [--warmup W] [--json FILE] "
+            "[--only LABEL] [--dump FILE] LABEL=LIB:XML ...");
     if (only) {
         size_t kept = 0;
         for (size_t i = 0; i < n; i++)
@@ -301,33 +351,48 @@ int main(int argc, char **argv) {
         Model *m = &models[i];
         start(m);
         m->rows = malloc(samples * (m->n_in ? m->n_in : 1) * sizeof *m->rows);
-        m->ns = calloc(passes, sizeof *m->ns);
-        for (size_t k = 0; k < samples; k++)
-            for (size_t j = 0; j < m->n_in; j++) m->rows[k * m->n_in + j] = signal(m->in_name[j], k);
+        for (int l = 0; l < LOOPS; l++) m->ns[l] = calloc(passes, sizeof *m->ns[l]);
+        for (size_t k = 0; k < samples; k++) {
+            double value[SIGNALS];
+            circle((double)k * H, value);
+            for (size_t j = 0; j < m->n_in; j++) m->rows[k * m->n_in + j] = value[m->in_signal[j]];
+        }
         fprintf(stderr, "%-14s %s (%s): %zu Real inputs, %zu Real outputs\n", m->label,
                 m->identifier, m->library, m->n_in, m->n_out);
     }
     for (size_t p = 0; p < warmup + passes; p++) {
         for (size_t j = 0; j < n; j++) {
             Model *m = &models[(p + j) % n];
-            double t0 = now_ns();
-            run_pass(m, samples);
-            double elapsed = now_ns() - t0;
-            if (p >= warmup) m->ns[p - warmup] = elapsed / (double)samples;
+            for (int i = 0; i < LOOPS; i++) {
+                int l = p % 2 ? LOOPS - 1 - i : i;
+                double t0 = now_ns();
+                if (l == CALLS_ONLY) run_calls_only(m, samples);
+                else run_importer_loop(m, samples);
+                double elapsed = now_ns() - t0;
+                if (p >= warmup) m->ns[l][p - warmup] = elapsed / (double)samples;
+            }
         }
     }
-    double *ratios = calloc(passes, sizeof *ratios), ratio[MAX_MODELS] = {0};
-    for (size_t i = 1; i < n; i++) {
-        for (size_t p = 0; p < passes; p++) ratios[p] = models[i].ns[p] / models[0].ns[p];
-        ratio[i] = median(ratios, passes);
-    }
+    double *ratios = calloc(passes, sizeof *ratios), ratio[LOOPS][MAX_MODELS] = {{0}};
+    for (int l = 0; l < LOOPS; l++)
+        for (size_t i = 1; i < n; i++) {
+            for (size_t p = 0; p < passes; p++) ratios[p] = models[i].ns[l][p] / models[0].ns[l][p];
+            ratio[l][i] = median(ratios, passes);
+        }
     printf("ns per sample (fmi2SetReal all Real inputs + fmi2DoStep + fmi2GetReal all Real "
            "outputs), median (min) of %zu passes of %zu samples\n",
            passes, samples);
+    printf("  %-14s %-30s %s\n", "", "calls only", "importer loop (inputs computed)");
     for (size_t i = 0; i < n; i++) {
         Model *m = &models[i];
-        printf("  %-14s %8.1f ns (%.1f)", m->label, median(m->ns, passes), minimum(m->ns, passes));
-        if (i) printf("   %.2fx %s", ratio[i], models[0].label);
+        printf("  %-14s", m->label);
+        for (int l = 0; l < LOOPS; l++) {
+            char text[64];
+            int len = snprintf(text, sizeof text, "%.1f ns (%.1f)", median(m->ns[l], passes),
+                               minimum(m->ns[l], passes));
+            if (i) snprintf(text + len, sizeof text - (size_t)len, "  %.2fx", ratio[l][i]);
+            printf(" %-30s", text);
+        }
         printf("\n");
     }
     if (json) {
@@ -346,25 +411,33 @@ int main(int argc, char **argv) {
             json_string(f, m->identifier);
             fprintf(f, ", \"library\": ");
             json_string(f, m->library);
-            fprintf(f, ", \"real_inputs\": %zu, \"real_outputs\": %zu, "
-                       "\"median_ns_per_sample\": %.2f, \"min_ns_per_sample\": %.2f, "
-                       "\"ns_per_sample\": [",
-                    m->n_in, m->n_out, median(m->ns, passes), minimum(m->ns, passes));
-            for (size_t p = 0; p < passes; p++) fprintf(f, "%s%.2f", p ? ", " : "", m->ns[p]);
-            fprintf(f, "]}%s\n", i + 1 < n ? "," : "");
+            fprintf(f, ", \"real_inputs\": %zu, \"real_outputs\": %zu", m->n_in, m->n_out);
+            for (int l = 0; l < LOOPS; l++) {
+                fprintf(f, ",\n      \"%s\": {\"median_ns_per_sample\": %.2f, "
+                           "\"min_ns_per_sample\": %.2f, \"ns_per_sample\": [",
+                        LOOP_NAME[l], median(m->ns[l], passes), minimum(m->ns[l], passes));
+                for (size_t p = 0; p < passes; p++) fprintf(f, "%s%.2f", p ? ", " : "", m->ns[l][p]);
+                fprintf(f, "]}");
+            }
+            fprintf(f, "}%s\n", i + 1 < n ? "," : "");
         }
         fprintf(f, "  },\n  \"ratios_over_baseline\": {");
-        for (size_t i = 1; i < n; i++) {
-            fprintf(f, "%s", i > 1 ? ", " : "");
-            json_string(f, models[i].label);
-            fprintf(f, ": %.4f", ratio[i]);
+        for (int l = 0; l < LOOPS; l++) {
+            fprintf(f, "%s\n    \"%s\": {", l ? "," : "", LOOP_NAME[l]);
+            for (size_t i = 1; i < n; i++) {
+                fprintf(f, "%s", i > 1 ? ", " : "");
+                json_string(f, models[i].label);
+                fprintf(f, ": %.4f", ratio[l][i]);
+            }
+            fprintf(f, "}");
         }
-        fprintf(f, "}\n}\n");
+        fprintf(f, "\n  }\n}\n");
         fclose(f);
     }
     double checksum = 0;
     for (size_t i = 0; i < n; i++) checksum += models[i].checksum;
     if (!isfinite(checksum)) die("non-finite outputs");
     for (size_t i = 0; i < n; i++) models[i].free_instance(models[i].c);
+    if (dump && fclose(dump) != 0) die("dump failed");
     return 0;
 }

@@ -8,8 +8,8 @@
 #   benches/c_harness/run.sh --callgrind [--json FILE]          instructions per sample
 #
 # The second runs each model alone under valgrind --tool=callgrind, counting only the
-# timed loop (--toggle-collect=run_pass): instruction counts do not depend on the load of
-# the machine, so they show a change that timings on 2 shared cores would hide.
+# calls-only loop (--toggle-collect=run_calls_only): instruction counts do not depend on
+# the load of the machine, so they show a change that timings on 2 shared cores hide.
 set -eu
 HERE=$(cd "$(dirname "$0")" && pwd)
 ROOT=$(cd "$HERE/../.." && pwd)
@@ -59,7 +59,7 @@ for spec in $specs; do
     label=${spec%%=*}
     file=$OUT/callgrind.$label.out
     # shellcheck disable=SC2086
-    valgrind --tool=callgrind --toggle-collect=run_pass --callgrind-out-file="$file" \
+    valgrind --tool=callgrind --toggle-collect=run_calls_only --callgrind-out-file="$file" \
         "$OUT/harness" --samples $SAMPLES --passes $PASSES --warmup $WARMUP --only "$label" \
         $specs >/dev/null 2>"$OUT/callgrind.$label.log" \
         || { cat "$OUT/callgrind.$label.log" >&2; exit 1; }
