@@ -7,23 +7,16 @@
 use std::ffi::{c_char, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::ptr;
-use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use super::bindings::*;
 
 use super::instance::Instance;
 use super::logger::{Category, Logger};
-use super::registry::{self, InstanceCell};
+use super::registry;
 use super::resource_uri::resource_dir;
 use super::state_machine::{Call, Mode};
 use super::status::{Failure, Outcome, Status};
 use crate::models::{self, Environment, Value, VarType};
-
-fn lock(cell: &InstanceCell) -> MutexGuard<'_, Instance> {
-    // A poisoned lock means an earlier call panicked: the instance is already marked
-    // Fatal (see `run`), so handing it out again is safe and lets us answer.
-    cell.instance.lock().unwrap_or_else(PoisonError::into_inner)
-}
 
 fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
     payload
@@ -33,29 +26,20 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "unknown panic".into())
 }
 
-/// Runs one instance function: looks `c` up in the registry (a NULL, freed or foreign
-/// pointer is `fmi2Error` without touching it; there is no instance to log to), then
-/// [`run`]s `body` on it.
+/// Runs one instance function: looks `c` up in the registry, which locks the instance for
+/// the call (a NULL, freed or foreign pointer is `fmi2Error` without touching it; there is
+/// no instance to log to), checks the mode, runs `body`, logs a failure, and turns a panic
+/// into `fmi2Fatal` (the instance then only accepts `fmi2FreeInstance` and
+/// `fmi2FreeFMUstate`).
+#[inline]
 fn dispatch(
     c: fmi2Component,
     call: Call,
     body: impl FnOnce(&mut Instance) -> Outcome,
 ) -> fmi2Status {
-    match registry::instance(c as usize) {
-        Some(cell) => run(&cell, call, body),
-        None => Status::Error.code(),
-    }
-}
-
-/// Checks the mode, runs `body`, logs a failure, and turns a panic into `fmi2Fatal` (the
-/// instance then only accepts `fmi2FreeInstance` and `fmi2FreeFMUstate`).
-fn run(
-    cell: &Arc<InstanceCell>,
-    call: Call,
-    body: impl FnOnce(&mut Instance) -> Outcome,
-) -> fmi2Status {
+    let handle = c as usize;
     let result = catch_unwind(AssertUnwindSafe(|| {
-        let mut instance = lock(cell);
+        let mut instance = registry::instance(handle)?;
         let status = if !call.is_allowed_in(instance.mode) {
             let failure =
                 Failure::error(format!("illegal call sequence (state {:?})", instance.mode));
@@ -76,31 +60,40 @@ fn run(
         if let Some(outbox) = outbox {
             outbox.send();
         }
-        status
+        Some(status)
     }));
     match result {
-        Ok(status) => status.code(),
-        Err(payload) => {
-            let message = panic_text(payload.as_ref());
-            let _ = catch_unwind(AssertUnwindSafe(|| {
-                let mut instance = lock(cell);
-                instance.mode = Mode::Fatal;
-                instance.report(
-                    call,
-                    &Failure {
-                        status: Status::Fatal,
-                        message: format!("internal error (panic): {message}"),
-                    },
-                );
-                let outbox = instance.logger.take();
-                drop(instance);
-                if let Some(outbox) = outbox {
-                    outbox.send();
-                }
-            }));
-            Status::Fatal.code()
-        }
+        Ok(Some(status)) => status.code(),
+        Ok(None) => Status::Error.code(),
+        Err(payload) => fatal(handle, call, payload),
     }
+}
+
+/// After a panic in a call: marks the instance Fatal (if it is still there: the guard was
+/// dropped as the panic unwound, so another thread may have freed it) and logs why.
+#[cold]
+#[inline(never)]
+fn fatal(handle: usize, call: Call, payload: Box<dyn std::any::Any + Send>) -> fmi2Status {
+    let message = panic_text(payload.as_ref());
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        let Some(mut instance) = registry::instance(handle) else {
+            return;
+        };
+        instance.mode = Mode::Fatal;
+        instance.report(
+            call,
+            &Failure {
+                status: Status::Fatal,
+                message: format!("internal error (panic): {message}"),
+            },
+        );
+        let outbox = instance.logger.take();
+        drop(instance);
+        if let Some(outbox) = outbox {
+            outbox.send();
+        }
+    }));
+    Status::Fatal.code()
 }
 
 /// A slice from a C array, refusing NULL with a non-zero length.
@@ -219,17 +212,21 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 ),
             }
         }
-        let instance = Instance::new(info, environment, logger);
+        let instance = Instance::new(info, environment, logger, name);
         instance.log_event(&format!("instantiated {} (GUID {guid})", info.identifier));
         instance.logger.flush();
-        let cell = Arc::new(InstanceCell {
-            name: name.to_owned(),
-            instance: Mutex::new(instance),
-        });
-        let handle = registry::new_handle();
-        lock(&cell).handle = handle;
-        registry::add_instance(handle, Arc::clone(&cell));
-        Some(handle as fmi2Component)
+        match registry::add_instance(instance) {
+            Ok(handle) => Some(handle as fmi2Component),
+            Err(instance) => {
+                instance.logger.log(
+                    Status::Error,
+                    Category::StatusError,
+                    "fmi2Instantiate: too many live instances in this process",
+                );
+                instance.logger.flush();
+                None
+            }
+        }
     }));
     match result {
         Ok(Some(c)) => c,
@@ -242,22 +239,16 @@ pub unsafe extern "C" fn fmi2Instantiate(
 /// foreign `c` is ignored.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-    let handle = c as usize;
-    let Some(cell) = registry::instance(handle) else {
-        return;
-    };
-    run(&cell, Call::FreeInstance, |instance| {
+    // Nothing happens for a handle that is not a live instance.
+    dispatch(c, Call::FreeInstance, |instance| {
         instance.log_event("freed");
         Ok(())
     });
     // Unregistered whatever the log call did (even a panic in it must not leak the
-    // instance). The instance, with its FMU states, is dropped with the last `Arc`: here,
-    // or at the end of a call still running on another thread.
-    let removed = registry::remove_instance(handle);
-    let _ = catch_unwind(AssertUnwindSafe(move || {
-        drop(removed);
-        drop(cell);
-    }));
+    // instance), once a call still running on another thread has ended. The instance,
+    // with its FMU states, is dropped here, outside the registry.
+    let removed = registry::remove_instance(c as usize);
+    let _ = catch_unwind(AssertUnwindSafe(move || drop(removed)));
 }
 
 /// # Safety

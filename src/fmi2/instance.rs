@@ -7,7 +7,7 @@ use std::ffi::CString;
 
 use super::fmu_state::{self, Snapshot};
 use super::logger::{to_c_string, Category, Logger};
-use super::registry;
+use super::registry::{self, StateOwner};
 use super::state_machine::{Call, Mode};
 use super::status::{Failure, Outcome, Status};
 use crate::models::{Causality, Environment, Model, ModelInfo, Value, Values, Variability, Vr};
@@ -27,6 +27,8 @@ pub struct Instance {
     /// The handle the importer knows this instance by (its `fmi2Component`), set at
     /// registration; the owner recorded for its FMU states.
     pub handle: usize,
+    /// The instance name, for messages about FMU states that belong to it.
+    name: String,
     guid: String,
     environment: Environment,
     model: Box<dyn Model>,
@@ -60,9 +62,15 @@ fn time_matches(a: f64, b: f64) -> bool {
 }
 
 impl Instance {
-    pub fn new(info: &'static ModelInfo, environment: Environment, logger: Logger) -> Self {
+    pub fn new(
+        info: &'static ModelInfo,
+        environment: Environment,
+        logger: Logger,
+        name: &str,
+    ) -> Self {
         Instance {
             info,
+            name: name.to_owned(),
             guid: info.guid(),
             model: (info.create)(&environment),
             environment,
@@ -418,11 +426,11 @@ impl Instance {
             return Failure::error("FMUstate is NULL");
         }
         match registry::state_owner(handle) {
-            Some(owner) if owner != self.handle => Failure::error(format!(
+            Some(owner) if owner.handle != self.handle => Failure::error(format!(
                 "FMUstate {handle:#x} belongs to instance '{}', not to this one: an FMU state \
                  can only be used with the instance that made it (serialize it and \
                  deserialize it here to move it)",
-                registry::instance_name(owner).unwrap_or_default()
+                owner.name
             )),
             _ => Failure::error(format!(
                 "FMUstate {handle:#x} is not a live FMU state of this instance (already \
@@ -441,9 +449,15 @@ impl Instance {
 
     /// Stores a new FMU state; returns its handle.
     pub fn new_state(&mut self, bytes: Vec<u8>) -> usize {
-        let handle = registry::new_handle();
+        let handle = registry::new_state_handle();
         self.states.insert(handle, Box::new(StoredState { bytes }));
-        registry::add_state(handle, self.handle);
+        registry::add_state(
+            handle,
+            StateOwner {
+                handle: self.handle,
+                name: self.name.clone(),
+            },
+        );
         handle
     }
 
@@ -506,7 +520,7 @@ mod tests {
     fn started_at(start: f64) -> Instance {
         let logger = Logger::new(None, std::ptr::null_mut(), "t", false);
         let info = &path_interpolator_2d::INFO;
-        let mut instance = Instance::new(info, Environment::default(), logger);
+        let mut instance = Instance::new(info, Environment::default(), logger, "t");
         instance.setup_experiment(start, None).unwrap();
         instance.enter_initialization_mode().unwrap();
         instance.exit_initialization_mode().unwrap();
