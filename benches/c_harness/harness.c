@@ -54,7 +54,7 @@
 
 #include "fmi2Functions.h"
 
-#define MAX_MODELS 8
+#define MAX_MODELS 16
 enum loop { CALLS_ONLY, IMPORTER_LOOP, LOOPS };
 static const char *const LOOP_NAME[LOOPS] = {"calls_only", "importer_loop"};
 /* What an input is fed: the lagging circle's coordinates, or 0. */
@@ -310,7 +310,7 @@ static void json_string(FILE *f, const char *s) {
 }
 
 int main(int argc, char **argv) {
-    size_t samples = 4000, passes = 51, warmup = 3;
+    size_t samples = 4000, passes = 101, warmup = 3;
     const char *json = NULL, *only = NULL;
     Model models[MAX_MODELS];
     size_t n = 0;
@@ -382,10 +382,13 @@ int main(int argc, char **argv) {
     printf("ns per sample (fmi2SetReal all Real inputs + fmi2DoStep + fmi2GetReal all Real "
            "outputs), median (min) of %zu passes of %zu samples\n",
            passes, samples);
-    printf("  %-14s %-30s %s\n", "", "calls only", "importer loop (inputs computed)");
+    int width = 14;
+    for (size_t i = 0; i < n; i++)
+        width = (int)strlen(models[i].label) > width ? (int)strlen(models[i].label) : width;
+    printf("  %-*s %-30s %s\n", width, "", "calls only", "importer loop (inputs computed)");
     for (size_t i = 0; i < n; i++) {
         Model *m = &models[i];
-        printf("  %-14s", m->label);
+        printf("  %-*s", width, m->label);
         for (int l = 0; l < LOOPS; l++) {
             char text[64];
             int len = snprintf(text, sizeof text, "%.1f ns (%.1f)", median(m->ns[l], passes),
