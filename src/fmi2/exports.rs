@@ -41,13 +41,10 @@ fn dispatch(
     let result = catch_unwind(AssertUnwindSafe(|| {
         let mut instance = registry::instance(handle)?;
         let status = if !call.is_allowed_in(instance.mode) {
-            let failure =
-                Failure::error(format!("illegal call sequence (state {:?})", instance.mode));
-            instance.report(call, &failure)
+            refuse_in_this_mode(&instance, call)
         } else {
             if instance.logger.is_enabled(Category::All) {
-                let trace = format!("{} called", call.name());
-                instance.logger.log(Status::Ok, Category::All, &trace);
+                trace(&instance, call);
             }
             match body(&mut instance) {
                 Ok(()) => Status::Ok,
@@ -67,6 +64,65 @@ fn dispatch(
         Ok(None) => Status::Error.code(),
         Err(payload) => fatal(handle, call, payload),
     }
+}
+
+/// [`dispatch`] for `fmi2SetReal` and `fmi2GetReal`: `fast` does the call's common case
+/// with the instance locked once and none of the general path's bookkeeping, or declines
+/// (`None`, having changed nothing); then [`dispatch`] runs `body`, the call in full (it
+/// looks the instance up again: if another thread freed it meanwhile, the call is refused
+/// as if it had come a moment later). `fast` does exactly what `body` does in the case it
+/// accepts, in a mode the state machine allows and with `logAll` off (no trace to log).
+#[inline(always)]
+fn dispatch_fast(
+    c: fmi2Component,
+    call: Call,
+    fast: impl FnOnce(&mut Instance) -> Option<()>,
+    body: impl FnOnce(&mut Instance) -> Outcome,
+) -> fmi2Status {
+    let handle = c as usize;
+    let done = catch_unwind(AssertUnwindSafe(|| {
+        let mut instance = registry::instance(handle)?;
+        if !call.is_allowed_in(instance.mode) || instance.logger.is_enabled(Category::All) {
+            return None;
+        }
+        fast(&mut instance)?;
+        let outbox = instance.logger.take();
+        drop(instance);
+        if let Some(outbox) = outbox {
+            outbox.send();
+        }
+        Some(())
+    }));
+    match done {
+        Ok(Some(())) => Status::Ok.code(),
+        Ok(None) => dispatch_out_of_line(c, call, body),
+        Err(payload) => fatal(handle, call, payload),
+    }
+}
+
+#[inline(never)]
+fn dispatch_out_of_line(
+    c: fmi2Component,
+    call: Call,
+    body: impl FnOnce(&mut Instance) -> Outcome,
+) -> fmi2Status {
+    dispatch(c, call, body)
+}
+
+// The rare paths of `dispatch`, out of line: the per-sample calls stay short.
+
+#[cold]
+#[inline(never)]
+fn refuse_in_this_mode(instance: &Instance, call: Call) -> Status {
+    let failure = Failure::error(format!("illegal call sequence (state {:?})", instance.mode));
+    instance.report(call, &failure)
+}
+
+#[cold]
+#[inline(never)]
+fn trace(instance: &Instance, call: Call) {
+    let trace = format!("{} called", call.name());
+    instance.logger.log(Status::Ok, Category::All, &trace);
 }
 
 /// After a panic in a call: marks the instance Fatal (if it is still there: the guard was
@@ -97,28 +153,51 @@ fn fatal(handle: usize, call: Call, payload: Box<dyn std::any::Any + Send>) -> f
 }
 
 /// A slice from a C array, refusing NULL with a non-zero length.
+#[inline]
 unsafe fn slice<'a, T>(data: *const T, len: usize, what: &str) -> Outcome<&'a [T]> {
     if len == 0 {
         Ok(&[])
     } else if data.is_null() {
-        Err(Failure::error(format!(
-            "{what} is NULL but its length is {len}"
-        )))
+        Err(null_array(what, len))
     } else {
         Ok(std::slice::from_raw_parts(data, len))
     }
 }
 
+#[inline]
 unsafe fn slice_mut<'a, T>(data: *mut T, len: usize, what: &str) -> Outcome<&'a mut [T]> {
     if len == 0 {
         Ok(&mut [])
     } else if data.is_null() {
-        Err(Failure::error(format!(
-            "{what} is NULL but its length is {len}"
-        )))
+        Err(null_array(what, len))
     } else {
         Ok(std::slice::from_raw_parts_mut(data, len))
     }
+}
+
+/// A slice from a C array for a fast path: `None` for NULL with a non-zero length.
+#[inline(always)]
+unsafe fn array<'a, T>(data: *const T, len: usize) -> Option<&'a [T]> {
+    match len {
+        0 => Some(&[]),
+        _ if data.is_null() => None,
+        _ => Some(std::slice::from_raw_parts(data, len)),
+    }
+}
+
+#[inline(always)]
+unsafe fn array_mut<'a, T>(data: *mut T, len: usize) -> Option<&'a mut [T]> {
+    match len {
+        0 => Some(&mut []),
+        _ if data.is_null() => None,
+        _ => Some(std::slice::from_raw_parts_mut(data, len)),
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn null_array(what: &str, len: usize) -> Failure {
+    Failure::error(format!("{what} is NULL but its length is {len}"))
 }
 
 unsafe fn c_str<'a>(text: fmi2String) -> Option<&'a str> {
@@ -338,8 +417,7 @@ unsafe fn get<T>(
     dispatch(c, Call::GetValues(name), |instance| {
         let vrs = slice(vr, nvr, "vr")?;
         let out = slice_mut(value, nvr, "value")?;
-        instance.check_type(vrs, var_type)?;
-        instance.get_values(vrs, |i, v| out[i] = convert(v))
+        instance.get_values_checked(vrs, var_type, |i, v| out[i] = convert(v))
     })
 }
 
@@ -368,16 +446,15 @@ pub unsafe extern "C" fn fmi2GetReal(
     nvr: usize,
     value: *mut fmi2Real,
 ) -> fmi2Status {
-    get(
+    // One of the sample's calls (with fmi2SetReal and fmi2DoStep).
+    dispatch_fast(
         c,
-        "fmi2GetReal",
-        VarType::Real,
-        vr,
-        nvr,
-        value,
-        |v| match *v {
-            Value::Real(x) => x,
-            _ => unreachable!("type checked"),
+        Call::GetValues("fmi2GetReal"),
+        |instance| instance.get_real_values(array(vr, nvr)?, array_mut(value, nvr)?),
+        |instance| {
+            let vrs = slice(vr, nvr, "vr")?;
+            let out = slice_mut(value, nvr, "value")?;
+            instance.get_reals(vrs, out)
         },
     )
 }
@@ -458,7 +535,16 @@ pub unsafe extern "C" fn fmi2SetReal(
     nvr: usize,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    set(c, "fmi2SetReal", vr, nvr, value, |x| Ok(Value::Real(x)))
+    dispatch_fast(
+        c,
+        Call::SetValues("fmi2SetReal"),
+        |instance| instance.set_free_reals(array(vr, nvr)?, array(value, nvr)?),
+        |instance| {
+            let vrs = slice(vr, nvr, "vr")?;
+            let values = slice(value, nvr, "value")?;
+            instance.set_reals(vrs, values)
+        },
+    )
 }
 
 /// # Safety
