@@ -102,7 +102,7 @@ impl<T> Slot<T> {
         }
     }
 
-    /// Takes the lock: one atomic exchange when nobody holds it (the only case a correct
+    /// Takes the lock: one compare-exchange when nobody holds it (the only case a correct
     /// importer produces: FMI 2.0 forbids overlapping calls on one instance), and the
     /// unlock is a plain store.
     #[inline]
