@@ -122,12 +122,16 @@ bindings: libclang
 # --- measurements -------------------------------------------------------------------------
 
 # One page of ratios measured in this run (target/bench-report/report.md); a part that
-# fails still lets the page print, marked "not measured".
+# fails still lets the page print, marked "not measured". benches/c_harness/run.sh times
+# the packaged FMUs from a C importer against a bare C pass-through FMU it builds (gcc),
+# then counts their instructions per sample under callgrind (needs valgrind).
 BENCH_REPORT := $(or $(CARGO_TARGET_DIR),target)/bench-report
 CRITERION    := --warm-up-time 1 --measurement-time 3 --sample-size 50 --noplot
 
 bench: fmus ccc-tune $(VENV)/.test-installed
 	$(PYTHON) benches/report.py --start
+	-PYTHON=$(PYTHON) benches/c_harness/run.sh --json $(BENCH_REPORT)/c_harness.json
+	-PYTHON=$(PYTHON) benches/c_harness/run.sh --callgrind --json $(BENCH_REPORT)/c_harness_callgrind.json
 	-$(CARGO) bench --features test-hooks --bench fuzzy --bench controller --bench five_axis \
 		--bench fmu_abi -- $(CRITERION)
 	-$(CARGO) build --release -p contour-fmu --example fuzzy_timing --example fuzzy_dump

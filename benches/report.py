@@ -1,7 +1,8 @@
 """One page of the project's speed as ratios measured in the same `make bench` run.
 
 Reads what the bench parts leave in <target>/bench-report/ (<target> is $CARGO_TARGET_DIR,
-else target/): fmu_abi.json (benches/fmu_abi.rs), fuzzy_vs_skfuzzy.json,
+else target/): fmu_abi.json (benches/fmu_abi.rs), c_harness.json and
+c_harness_callgrind.json (benches/c_harness/run.sh), fuzzy_vs_skfuzzy.json,
 tuning_vs_pyswarms_fmu.json, pso_tables.json and campaign_scaling.json (the Python
 benches' --json), plus
 criterion's own estimates in <target>/criterion/. Prints the page and writes it to
@@ -26,6 +27,8 @@ TARGET = Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target")
 REPORT = TARGET / "bench-report"
 STAMP = REPORT / ".started"
 NOT_MEASURED = "not measured"
+# Issue 21: XYServoPlant through the C ABI at most this many times the bare C pass-through.
+PLANT_OVER_BARE_TARGET = 2.0
 
 
 def fresh(path):
@@ -100,6 +103,8 @@ def page():
     tuning = load("tuning_vs_pyswarms_fmu.json")
     pso = load("pso_tables.json")
     campaign = load("campaign_scaling.json")
+    harness = load("c_harness.json")
+    instructions = load("c_harness_callgrind.json").get("instructions_per_sample") or {}
     med = lambda name: dig(abi, "median_s_per_sample", name)  # noqa: E731
 
     now = datetime.datetime.now(datetime.timezone.utc)
@@ -119,6 +124,25 @@ def page():
     for label, key in (("ContourCCC2D sample / pass-through", "ccc_2d_over_pass_through"),
                        ("ContourCCC5X sample / pass-through", "ccc_5x_over_pass_through")):
         lines.append(line(label, *paired(key)))
+
+    lines.append("\nA sample from a C importer (benches/c_harness: fmi2SetReal of all Real inputs, fmi2DoStep,")
+    lines.append("fmi2GetReal of all Real outputs; dlopen'ed FMU binaries) / a bare C pass-through FMU;")
+    lines.append("importer loop: the lagging circle's inputs computed each sample; calls only: precomputed")
+    bare = harness.get("baseline", "bare")
+    for model, target in (("XYServoPlant", PLANT_OVER_BARE_TARGET), ("ContourCCC2D", None)):
+        for loop, name in (("importer_loop", "importer loop"), ("calls_only", "calls only")):
+            ns = dig(harness, "models", model, loop, "median_ns_per_sample")
+            bare_ns = dig(harness, "models", bare, loop, "median_ns_per_sample")
+            r = dig(harness, "ratios_over_baseline", loop, model)
+            verdict = ""
+            if target is not None and loop == "importer_loop" and r is not None:
+                verdict = f"; target <= {target:g}x: " + ("met" if r <= target else "MISSED")
+            lines.append(line(f"{model} / bare, {name}", r,
+                              f"{ns:.1f} vs {bare_ns:.1f} ns per sample{verdict}" if ns and bare_ns else ""))
+    counted = [f"{name} {int(count):,}" for name, count in instructions.items()
+               if isinstance(count, (int, float))]
+    lines.append("  instructions per sample, calls only (callgrind): "
+                 + (", ".join(counted) if counted else NOT_MEASURED))
 
     lines.append("\nFuzzy inference (3 outputs), scikit-fuzzy / Rust, time per inference")
     rust = dig(fuzzy, "rust_s_per_eval")

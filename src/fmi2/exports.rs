@@ -7,25 +7,18 @@
 use std::ffi::{c_char, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::ptr;
-use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use super::bindings::*;
 
 use super::instance::Instance;
 use super::logger::{Category, Logger};
-use super::registry::{self, InstanceCell};
+use super::registry;
 use super::resource_uri::resource_dir;
 use super::state_machine::{Call, Mode};
 use super::status::{Failure, Outcome, Status};
 use crate::framework::model::Environment;
 use crate::framework::variables::{Value, VarType};
 use crate::models;
-
-fn lock(cell: &InstanceCell) -> MutexGuard<'_, Instance> {
-    // A poisoned lock means an earlier call panicked: the instance is already marked
-    // Fatal (see `run`), so handing it out again is safe and lets us answer.
-    cell.instance.lock().unwrap_or_else(PoisonError::into_inner)
-}
 
 fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
     payload
@@ -35,37 +28,25 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "unknown panic".into())
 }
 
-/// Runs one instance function: looks `c` up in the registry (a NULL, freed or foreign
-/// pointer is `fmi2Error` without touching it; there is no instance to log to), then
-/// [`run`]s `body` on it.
+/// Runs one instance function: looks `c` up in the registry, which locks the instance for
+/// the call (a NULL, freed or foreign pointer is `fmi2Error` without touching it; there is
+/// no instance to log to), checks the mode, runs `body`, logs a failure, and turns a panic
+/// into `fmi2Fatal` (the instance then only accepts `fmi2FreeInstance` and
+/// `fmi2FreeFMUstate`).
+#[inline]
 fn dispatch(
     c: fmi2Component,
     call: Call,
     body: impl FnOnce(&mut Instance) -> Outcome,
 ) -> fmi2Status {
-    match registry::instance(c as usize) {
-        Some(cell) => run(&cell, call, body),
-        None => Status::Error.code(),
-    }
-}
-
-/// Checks the mode, runs `body`, logs a failure, and turns a panic into `fmi2Fatal` (the
-/// instance then only accepts `fmi2FreeInstance` and `fmi2FreeFMUstate`).
-fn run(
-    cell: &Arc<InstanceCell>,
-    call: Call,
-    body: impl FnOnce(&mut Instance) -> Outcome,
-) -> fmi2Status {
+    let handle = c as usize;
     let result = catch_unwind(AssertUnwindSafe(|| {
-        let mut instance = lock(cell);
+        let mut instance = registry::instance(handle)?;
         let status = if !call.is_allowed_in(instance.mode) {
-            let failure =
-                Failure::error(format!("illegal call sequence (state {:?})", instance.mode));
-            instance.report(call, &failure)
+            refuse_in_this_mode(&instance, call)
         } else {
             if instance.logger.is_enabled(Category::All) {
-                let trace = format!("{} called", call.name());
-                instance.logger.log(Status::Ok, Category::All, &trace);
+                trace(&instance, call);
             }
             match body(&mut instance) {
                 Ok(()) => Status::Ok,
@@ -78,56 +59,147 @@ fn run(
         if let Some(outbox) = outbox {
             outbox.send();
         }
-        status
+        Some(status)
     }));
     match result {
-        Ok(status) => status.code(),
-        Err(payload) => {
-            let message = panic_text(payload.as_ref());
-            let _ = catch_unwind(AssertUnwindSafe(|| {
-                let mut instance = lock(cell);
-                instance.mode = Mode::Fatal;
-                instance.report(
-                    call,
-                    &Failure {
-                        status: Status::Fatal,
-                        message: format!("internal error (panic): {message}"),
-                    },
-                );
-                let outbox = instance.logger.take();
-                drop(instance);
-                if let Some(outbox) = outbox {
-                    outbox.send();
-                }
-            }));
-            Status::Fatal.code()
-        }
+        Ok(Some(status)) => status.code(),
+        Ok(None) => Status::Error.code(),
+        Err(payload) => fatal(handle, call, payload),
     }
 }
 
+/// [`dispatch`] for `fmi2SetReal` and `fmi2GetReal`: `fast` does the call's common case
+/// with the instance locked once and none of the general path's bookkeeping, or declines
+/// (`None`, having changed nothing); then [`dispatch`] runs `body`, the call in full (it
+/// looks the instance up again: if another thread freed it meanwhile, the call is refused
+/// as if it had come a moment later). `fast` does exactly what `body` does in the case it
+/// accepts, in a mode the state machine allows and with `logAll` off (no trace to log).
+#[inline(always)]
+fn dispatch_fast(
+    c: fmi2Component,
+    call: Call,
+    fast: impl FnOnce(&mut Instance) -> Option<()>,
+    body: impl FnOnce(&mut Instance) -> Outcome,
+) -> fmi2Status {
+    let handle = c as usize;
+    let done = catch_unwind(AssertUnwindSafe(|| {
+        let mut instance = registry::instance(handle)?;
+        if !call.is_allowed_in(instance.mode) || instance.logger.is_enabled(Category::All) {
+            return None;
+        }
+        fast(&mut instance)?;
+        let outbox = instance.logger.take();
+        drop(instance);
+        if let Some(outbox) = outbox {
+            outbox.send();
+        }
+        Some(())
+    }));
+    match done {
+        Ok(Some(())) => Status::Ok.code(),
+        Ok(None) => dispatch_out_of_line(c, call, body),
+        Err(payload) => fatal(handle, call, payload),
+    }
+}
+
+#[inline(never)]
+fn dispatch_out_of_line(
+    c: fmi2Component,
+    call: Call,
+    body: impl FnOnce(&mut Instance) -> Outcome,
+) -> fmi2Status {
+    dispatch(c, call, body)
+}
+
+// The rare paths of `dispatch`, out of line: the per-sample calls stay short.
+
+#[cold]
+#[inline(never)]
+fn refuse_in_this_mode(instance: &Instance, call: Call) -> Status {
+    let failure = Failure::error(format!("illegal call sequence (state {:?})", instance.mode));
+    instance.report(call, &failure)
+}
+
+#[cold]
+#[inline(never)]
+fn trace(instance: &Instance, call: Call) {
+    let trace = format!("{} called", call.name());
+    instance.logger.log(Status::Ok, Category::All, &trace);
+}
+
+/// After a panic in a call: marks the instance Fatal (if it is still there: the guard was
+/// dropped as the panic unwound, so another thread may have freed it) and logs why.
+#[cold]
+#[inline(never)]
+fn fatal(handle: usize, call: Call, payload: Box<dyn std::any::Any + Send>) -> fmi2Status {
+    let message = panic_text(payload.as_ref());
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        let Some(mut instance) = registry::instance(handle) else {
+            return;
+        };
+        instance.mode = Mode::Fatal;
+        instance.report(
+            call,
+            &Failure {
+                status: Status::Fatal,
+                message: format!("internal error (panic): {message}"),
+            },
+        );
+        let outbox = instance.logger.take();
+        drop(instance);
+        if let Some(outbox) = outbox {
+            outbox.send();
+        }
+    }));
+    Status::Fatal.code()
+}
+
 /// A slice from a C array, refusing NULL with a non-zero length.
+#[inline]
 unsafe fn slice<'a, T>(data: *const T, len: usize, what: &str) -> Outcome<&'a [T]> {
     if len == 0 {
         Ok(&[])
     } else if data.is_null() {
-        Err(Failure::error(format!(
-            "{what} is NULL but its length is {len}"
-        )))
+        Err(null_array(what, len))
     } else {
         Ok(std::slice::from_raw_parts(data, len))
     }
 }
 
+#[inline]
 unsafe fn slice_mut<'a, T>(data: *mut T, len: usize, what: &str) -> Outcome<&'a mut [T]> {
     if len == 0 {
         Ok(&mut [])
     } else if data.is_null() {
-        Err(Failure::error(format!(
-            "{what} is NULL but its length is {len}"
-        )))
+        Err(null_array(what, len))
     } else {
         Ok(std::slice::from_raw_parts_mut(data, len))
     }
+}
+
+/// A slice from a C array for a fast path: `None` for NULL with a non-zero length.
+#[inline(always)]
+unsafe fn array<'a, T>(data: *const T, len: usize) -> Option<&'a [T]> {
+    match len {
+        0 => Some(&[]),
+        _ if data.is_null() => None,
+        _ => Some(std::slice::from_raw_parts(data, len)),
+    }
+}
+
+#[inline(always)]
+unsafe fn array_mut<'a, T>(data: *mut T, len: usize) -> Option<&'a mut [T]> {
+    match len {
+        0 => Some(&mut []),
+        _ if data.is_null() => None,
+        _ => Some(std::slice::from_raw_parts_mut(data, len)),
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn null_array(what: &str, len: usize) -> Failure {
+    Failure::error(format!("{what} is NULL but its length is {len}"))
 }
 
 unsafe fn c_str<'a>(text: fmi2String) -> Option<&'a str> {
@@ -221,17 +293,21 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 ),
             }
         }
-        let instance = Instance::new(info, environment, logger);
+        let instance = Instance::new(info, environment, logger, name);
         instance.log_event(&format!("instantiated {} (GUID {guid})", info.identifier));
         instance.logger.flush();
-        let cell = Arc::new(InstanceCell {
-            name: name.to_owned(),
-            instance: Mutex::new(instance),
-        });
-        let handle = registry::new_handle();
-        lock(&cell).handle = handle;
-        registry::add_instance(handle, Arc::clone(&cell));
-        Some(handle as fmi2Component)
+        match registry::add_instance(instance) {
+            Ok(handle) => Some(handle as fmi2Component),
+            Err(instance) => {
+                instance.logger.log(
+                    Status::Error,
+                    Category::StatusError,
+                    "fmi2Instantiate: too many live instances in this process",
+                );
+                instance.logger.flush();
+                None
+            }
+        }
     }));
     match result {
         Ok(Some(c)) => c,
@@ -244,22 +320,16 @@ pub unsafe extern "C" fn fmi2Instantiate(
 /// foreign `c` is ignored.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-    let handle = c as usize;
-    let Some(cell) = registry::instance(handle) else {
-        return;
-    };
-    run(&cell, Call::FreeInstance, |instance| {
+    // Nothing happens for a handle that is not a live instance.
+    dispatch(c, Call::FreeInstance, |instance| {
         instance.log_event("freed");
         Ok(())
     });
     // Unregistered whatever the log call did (even a panic in it must not leak the
-    // instance). The instance, with its FMU states, is dropped with the last `Arc`: here,
-    // or at the end of a call still running on another thread.
-    let removed = registry::remove_instance(handle);
-    let _ = catch_unwind(AssertUnwindSafe(move || {
-        drop(removed);
-        drop(cell);
-    }));
+    // instance), once a call still running on another thread has ended. The instance,
+    // with its FMU states, is dropped here, outside the registry.
+    let removed = registry::remove_instance(c as usize);
+    let _ = catch_unwind(AssertUnwindSafe(move || drop(removed)));
 }
 
 /// # Safety
@@ -349,8 +419,7 @@ unsafe fn get<T>(
     dispatch(c, Call::GetValues(name), |instance| {
         let vrs = slice(vr, nvr, "vr")?;
         let out = slice_mut(value, nvr, "value")?;
-        instance.check_type(vrs, var_type)?;
-        instance.get_values(vrs, |i, v| out[i] = convert(v))
+        instance.get_values_checked(vrs, var_type, |i, v| out[i] = convert(v))
     })
 }
 
@@ -379,16 +448,15 @@ pub unsafe extern "C" fn fmi2GetReal(
     nvr: usize,
     value: *mut fmi2Real,
 ) -> fmi2Status {
-    get(
+    // One of the sample's calls (with fmi2SetReal and fmi2DoStep).
+    dispatch_fast(
         c,
-        "fmi2GetReal",
-        VarType::Real,
-        vr,
-        nvr,
-        value,
-        |v| match *v {
-            Value::Real(x) => x,
-            _ => unreachable!("type checked"),
+        Call::GetValues("fmi2GetReal"),
+        |instance| instance.get_real_values(array(vr, nvr)?, array_mut(value, nvr)?),
+        |instance| {
+            let vrs = slice(vr, nvr, "vr")?;
+            let out = slice_mut(value, nvr, "value")?;
+            instance.get_reals(vrs, out)
         },
     )
 }
@@ -469,7 +537,16 @@ pub unsafe extern "C" fn fmi2SetReal(
     nvr: usize,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    set(c, "fmi2SetReal", vr, nvr, value, |x| Ok(Value::Real(x)))
+    dispatch_fast(
+        c,
+        Call::SetValues("fmi2SetReal"),
+        |instance| instance.set_free_reals(array(vr, nvr)?, array(value, nvr)?),
+        |instance| {
+            let vrs = slice(vr, nvr, "vr")?;
+            let values = slice(value, nvr, "value")?;
+            instance.set_reals(vrs, values)
+        },
+    )
 }
 
 /// # Safety

@@ -7,11 +7,11 @@ use std::ffi::CString;
 
 use super::fmu_state::{self, Snapshot};
 use super::logger::{to_c_string, Category, Logger};
-use super::registry;
+use super::registry::{self, StateOwner};
 use super::state_machine::{Call, Mode};
 use super::status::{Failure, Outcome, Status};
 use crate::framework::model::{Environment, Model, ModelInfo};
-use crate::framework::variables::{Causality, Value, Values, Variability, Vr};
+use crate::framework::variables::{Causality, Value, Values, VarType, Variability, Variable, Vr};
 
 /// Relative tolerance when comparing the importer's communication point with our clock:
 /// importers accumulate time in floating point (fmpy: 0.009999999999999998).
@@ -23,11 +23,43 @@ pub struct StoredState {
     bytes: Vec<u8>,
 }
 
+/// What the per-sample calls need to know of a variable, by value reference (see
+/// [`Access::of`]): one byte instead of the table's row, checked once per value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Access(u8);
+
+impl Access {
+    /// A Real variable: `fmi2GetReal` reads it as it is.
+    const REAL: u8 = 1;
+    /// A Real input without bounds: `fmi2SetReal` stores any finite value in any mode
+    /// that allows the call, without telling the model (see [`Instance::set_reals`]).
+    const FREE_REAL_INPUT: u8 = 2;
+
+    fn of(v: &Variable) -> Access {
+        let real = v.var_type() == VarType::Real;
+        let free_input =
+            real && v.causality == Causality::Input && v.min.is_none() && v.max.is_none();
+        Access(
+            if real { Self::REAL } else { 0 } | if free_input { Self::FREE_REAL_INPUT } else { 0 },
+        )
+    }
+
+    fn has(self, flag: u8) -> bool {
+        self.0 & flag != 0
+    }
+}
+
 pub struct Instance {
     pub info: &'static ModelInfo,
     /// The handle the importer knows this instance by (its `fmi2Component`), set at
     /// registration; the owner recorded for its FMU states.
     pub handle: usize,
+    /// The instance name, for messages about FMU states that belong to it.
+    name: String,
+    /// [`Access`] of every variable, by value reference.
+    access: Box<[Access]>,
+    /// The Real outputs, in table order: checked for overflow after each step.
+    real_outputs: Box<[Vr]>,
     guid: String,
     environment: Environment,
     model: Box<dyn Model>,
@@ -57,13 +89,31 @@ impl Drop for Instance {
 }
 
 fn time_matches(a: f64, b: f64) -> bool {
-    (a - b).abs() <= TIME_TOLERANCE * a.abs().max(b.abs()).max(1.0)
+    // max(|a|, |b|, 1) by comparisons: `f64::max` spends instructions on NaN, but with a
+    // NaN the left side is NaN and the answer false whatever the scale.
+    let (a_abs, b_abs) = (a.abs(), b.abs());
+    let scale = if a_abs > b_abs { a_abs } else { b_abs };
+    let scale = if scale > 1.0 { scale } else { 1.0 };
+    (a - b).abs() <= TIME_TOLERANCE * scale
 }
 
 impl Instance {
-    pub fn new(info: &'static ModelInfo, environment: Environment, logger: Logger) -> Self {
+    pub fn new(
+        info: &'static ModelInfo,
+        environment: Environment,
+        logger: Logger,
+        name: &str,
+    ) -> Self {
         Instance {
             info,
+            name: name.to_owned(),
+            access: info.variables.iter().map(Access::of).collect(),
+            real_outputs: info
+                .variables
+                .iter()
+                .filter(|v| v.causality == Causality::Output && v.var_type() == VarType::Real)
+                .map(|v| v.vr)
+                .collect(),
             guid: info.guid(),
             model: (info.create)(&environment),
             environment,
@@ -195,6 +245,110 @@ impl Instance {
         Ok(())
     }
 
+    /// Whether every reference is a Real variable.
+    #[inline]
+    fn all_real(&self, vrs: &[u32]) -> bool {
+        vrs.iter().all(|&vr| {
+            self.access
+                .get(vr as usize)
+                .is_some_and(|a| a.has(Access::REAL))
+        })
+    }
+
+    /// `fmi2GetReal` in the sample's case only: every reference a Real, and not in
+    /// initialization mode (where a read may initialize the model first). Reads the
+    /// values and returns `Some`; `None`, having written nothing, for any other call.
+    #[inline]
+    pub fn get_real_values(&self, vrs: &[u32], out: &mut [f64]) -> Option<()> {
+        if self.mode == Mode::Initialization || !self.all_real(vrs) {
+            return None;
+        }
+        for (slot, &vr) in out.iter_mut().zip(vrs) {
+            *slot = self.values.real(vr as Vr);
+        }
+        Some(())
+    }
+
+    /// `fmi2GetReal`: [`Instance::check_type`] then [`Instance::get_values`], with one
+    /// byte per value to check when every reference is a Real (the sample's case).
+    #[inline]
+    pub fn get_reals(&mut self, vrs: &[u32], out: &mut [f64]) -> Outcome {
+        if !self.all_real(vrs) {
+            return self.get_values_checked(vrs, VarType::Real, |i, v| match *v {
+                Value::Real(x) => out[i] = x,
+                _ => unreachable!("type checked"),
+            });
+        }
+        if self.mode == Mode::Initialization {
+            self.initialize_if_needed()?;
+        }
+        for (slot, &vr) in out.iter_mut().zip(vrs) {
+            *slot = self.values.real(vr as Vr);
+        }
+        Ok(())
+    }
+
+    /// `fmi2SetReal` in the sample's case only: every reference a Real input without
+    /// bounds and every value finite. Then [`Instance::set_values`] would find nothing to
+    /// refuse and no parameter to pass on to the model: it would store the values in
+    /// order and mark the model for initialization outside step mode, which is what this
+    /// does, returning `Some`; `None`, having changed nothing, for any other call.
+    #[inline]
+    pub fn set_free_reals(&mut self, vrs: &[u32], values: &[f64]) -> Option<()> {
+        let free = vrs.len() == values.len()
+            && vrs.iter().zip(values).all(|(&vr, x)| {
+                x.is_finite()
+                    && self
+                        .access
+                        .get(vr as usize)
+                        .is_some_and(|a| a.has(Access::FREE_REAL_INPUT))
+            });
+        if !free {
+            return None;
+        }
+        for (&vr, &x) in vrs.iter().zip(values) {
+            self.values.set_real(vr as Vr, x);
+        }
+        if self.mode != Mode::StepComplete {
+            self.needs_initialize = true;
+        }
+        Some(())
+    }
+
+    /// `fmi2SetReal`: [`Instance::set_free_reals`] for the sample's case, else
+    /// [`Instance::set_values`].
+    #[inline]
+    pub fn set_reals(&mut self, vrs: &[u32], values: &[f64]) -> Outcome {
+        match self.set_free_reals(vrs, values) {
+            Some(()) => Ok(()),
+            None => self.set_values_cold(vrs, |i| Ok(Value::Real(values[i]))),
+        }
+    }
+
+    /// [`Instance::check_type`] then [`Instance::get_values`] (out of line: the general
+    /// case of the getters, and `fmi2GetReal`'s refusals).
+    #[inline(never)]
+    pub fn get_values_checked(
+        &mut self,
+        vrs: &[u32],
+        var_type: VarType,
+        emit: impl FnMut(usize, &Value),
+    ) -> Outcome {
+        self.check_type(vrs, var_type)?;
+        self.get_values(vrs, emit)
+    }
+
+    /// [`Instance::set_values`], out of line (for `set_reals`: not the sample's case).
+    #[cold]
+    #[inline(never)]
+    fn set_values_cold(
+        &mut self,
+        vrs: &[u32],
+        value_at: impl Fn(usize) -> Result<Value, String>,
+    ) -> Outcome {
+        self.set_values(vrs, value_at)
+    }
+
     /// Keeps C copies of strings alive until the next call on this instance.
     pub fn hold_strings(&mut self, vrs: &[u32]) -> Outcome<&[CString]> {
         self.check_type(vrs, crate::framework::variables::VarType::String)?;
@@ -258,38 +412,28 @@ impl Instance {
         Ok(())
     }
 
+    /// `fmi2DoStep`. The checks of the arguments run first, as one condition; a step they
+    /// refuse is explained by [`Instance::refuse_step`], out of line.
+    #[inline]
     pub fn do_step(&mut self, current: f64, step: f64) -> Outcome {
-        if !(step.is_finite() && step > 0.0) {
-            return Err(Failure::error(format!(
-                "communication step size must be finite and > 0 (got {step})"
-            )));
-        }
-        if !current.is_finite() || !time_matches(current, self.time) {
-            return Err(Failure::error(format!(
-                "communication point {current} does not match the instance time {}",
-                self.time
-            )));
-        }
         let end = current + step;
-        // Far from t = 0 a step can vanish in rounding (1e300 + 1e-3 == 1e300): a sampled
-        // model would then wait for ever for its next sample to fall due.
-        if end - current < 0.5 * step {
-            return Err(Failure::error(format!(
-                "communication step size {step:e} s is lost in the rounding of the time \
-                 {current:e} s"
-            )));
-        }
-        if let Some(stop) = self.stop_time {
-            if end > stop && !time_matches(end, stop) {
-                return Err(Failure::error(format!(
-                    "step to t = {end} would pass the stop time {stop}"
-                )));
-            }
+        let acceptable = step.is_finite()
+            && step > 0.0
+            && current.is_finite()
+            && time_matches(current, self.time)
+            && end - current >= 0.5 * step
+            && self
+                .stop_time
+                .is_none_or(|stop| end <= stop || time_matches(end, stop));
+        if !acceptable {
+            return Err(self.refuse_step(current, step));
         }
         // Refused before anything changes: the mode stays.
-        self.model.check_step(current, step).map_err(|e| {
-            Failure::error(format!("communication step size {step:e} s refused: {e}"))
-        })?;
+        if let Err(e) = self.model.check_step(current, step) {
+            return Err(Failure::error(format!(
+                "communication step size {step:e} s refused: {e}"
+            )));
+        }
         if let Err(message) = self.model.do_step(&mut self.values, current, step) {
             self.mode = Mode::Error;
             return Err(Failure::error(format!(
@@ -299,22 +443,56 @@ impl Instance {
         // Never report success with a non-finite output: parameters at the edge of f64
         // (an inertia of 1e-300) can overflow a model, the importer would carry the NaN
         // on, and a state saved now could not be restored.
-        let overflowed = self.info.variables.iter().find(|v| {
-            v.causality == Causality::Output
-                && matches!(self.values.get(v.vr), Value::Real(x) if !x.is_finite())
-        });
-        if let Some(v) = overflowed {
-            self.mode = Mode::Error;
-            return Err(Failure::error(format!(
-                "step at t = {current} failed: output '{}' = {} is not finite (the model \
-                 overflowed: check the parameters and inputs)",
-                v.name,
-                self.values.real(v.vr)
-            )));
+        for &vr in self.real_outputs.iter() {
+            if !matches!(self.values.get(vr), Value::Real(x) if x.is_finite()) {
+                return Err(self.overflowed(current, vr));
+            }
         }
         self.time = end;
         self.last_successful_time = end;
         Ok(())
+    }
+
+    /// Why `do_step` refused its arguments: the first of its checks that fails.
+    #[cold]
+    #[inline(never)]
+    fn refuse_step(&self, current: f64, step: f64) -> Failure {
+        if !(step.is_finite() && step > 0.0) {
+            return Failure::error(format!(
+                "communication step size must be finite and > 0 (got {step})"
+            ));
+        }
+        if !current.is_finite() || !time_matches(current, self.time) {
+            return Failure::error(format!(
+                "communication point {current} does not match the instance time {}",
+                self.time
+            ));
+        }
+        let end = current + step;
+        // Far from t = 0 a step can vanish in rounding (1e300 + 1e-3 == 1e300): a sampled
+        // model would then wait for ever for its next sample to fall due.
+        if end - current < 0.5 * step {
+            return Failure::error(format!(
+                "communication step size {step:e} s is lost in the rounding of the time \
+                 {current:e} s"
+            ));
+        }
+        let stop = self.stop_time.unwrap_or(f64::NAN);
+        Failure::error(format!("step to t = {end} would pass the stop time {stop}"))
+    }
+
+    /// The failure of a step that left the output `vr` non-finite.
+    #[cold]
+    #[inline(never)]
+    fn overflowed(&mut self, current: f64, vr: Vr) -> Failure {
+        let v = &self.info.variables[vr];
+        self.mode = Mode::Error;
+        Failure::error(format!(
+            "step at t = {current} failed: output '{}' = {} is not finite (the model \
+             overflowed: check the parameters and inputs)",
+            v.name,
+            self.values.real(v.vr)
+        ))
     }
 
     pub fn last_successful_time(&self) -> f64 {
@@ -423,11 +601,11 @@ impl Instance {
             return Failure::error("FMUstate is NULL");
         }
         match registry::state_owner(handle) {
-            Some(owner) if owner != self.handle => Failure::error(format!(
+            Some(owner) if owner.handle != self.handle => Failure::error(format!(
                 "FMUstate {handle:#x} belongs to instance '{}', not to this one: an FMU state \
                  can only be used with the instance that made it (serialize it and \
                  deserialize it here to move it)",
-                registry::instance_name(owner).unwrap_or_default()
+                owner.name
             )),
             _ => Failure::error(format!(
                 "FMUstate {handle:#x} is not a live FMU state of this instance (already \
@@ -446,9 +624,15 @@ impl Instance {
 
     /// Stores a new FMU state; returns its handle.
     pub fn new_state(&mut self, bytes: Vec<u8>) -> usize {
-        let handle = registry::new_handle();
+        let handle = registry::new_state_handle();
         self.states.insert(handle, Box::new(StoredState { bytes }));
-        registry::add_state(handle, self.handle);
+        registry::add_state(
+            handle,
+            StateOwner {
+                handle: self.handle,
+                name: self.name.clone(),
+            },
+        );
         handle
     }
 
@@ -512,7 +696,7 @@ mod tests {
     fn started_at(start: f64) -> Instance {
         let logger = Logger::new(None, std::ptr::null_mut(), "t", false);
         let info = &path_interpolator_2d::INFO;
-        let mut instance = Instance::new(info, Environment::default(), logger);
+        let mut instance = Instance::new(info, Environment::default(), logger, "t");
         instance.setup_experiment(start, None).unwrap();
         instance.enter_initialization_mode().unwrap();
         instance.exit_initialization_mode().unwrap();

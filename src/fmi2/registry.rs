@@ -3,80 +3,70 @@
 //! An importer may pass anything: a freed instance, another library's instance, one of our
 //! FMU states in place of its address (fmusim 0.0.39's `fmi2FreeFMUstate(c, state)`).
 //! Pointers are therefore never dereferenced to find out what they are; they are looked
-//! up here first. Instances live in an `Arc`, so a call that found its instance keeps it
-//! alive even if another thread frees it meanwhile (an importer bug, but not a
-//! use-after-free).
+//! up here first.
 //!
 //! Handles are not addresses: the allocator hands freed addresses out again, and a stale
-//! handle would then name a new instance or state (of another model, even). They are
-//! numbers from one counter that never repeats, with the top bit set so that no handle is
-//! a user-space address on x86-64 Linux: a handle can never be mistaken for the address
-//! of an importer's variable (see `state_slot` in exports.rs). Importers treat both
-//! `fmi2Component` and `fmi2FMUstate` as opaque.
+//! handle would then name a new instance or state (of another model, even). Every handle
+//! has the top bit set, so that no handle is a user-space address on x86-64 Linux: a
+//! handle can never be mistaken for the address of an importer's variable (see
+//! `state_slot` in exports.rs). Importers treat both `fmi2Component` and `fmi2FMUstate`
+//! as opaque.
 //!
-//! The registry is the library's only global mutable state. A lookup takes a read lock and
-//! walks a `BTreeMap`: no allocation, so `fmi2DoStep` stays allocation-free.
+//! - An instance handle is the index of the instance's slot in a [`Slab`] (the low
+//!   [`INDEX_BITS`] bits) and the slot's generation, which grows each time the slot gets a
+//!   new instance. A slot whose generations are used up is never used again, so no two
+//!   instances ever get the same handle, and a stale handle never names a new instance.
+//! - An FMU state handle has the second-highest bit set as well (so it is never an
+//!   instance handle) and a number from a counter that never repeats (2^62 of them: a
+//!   process cannot exhaust them).
 //!
-//! Lock order: an instance's mutex may be held while the registry lock is taken (to add or
-//! remove its FMU states), never the other way round: nothing here locks an instance.
+//! Looking an instance up takes no global lock and allocates nothing, so `fmi2DoStep`,
+//! `fmi2SetReal` and `fmi2GetReal` stay allocation-free: the handle's index selects a
+//! chunk of slots (one atomic load of a pointer published once, chunks are never freed)
+//! and a slot in it; the slot's live handle is compared with the handle before the slot
+//! is locked (a stale handle is refused without waiting), and again once it is. The slot's
+//! lock is the instance's lock: a call holds it from the lookup to its end, so a call in
+//! flight keeps its instance alive if another thread frees it meanwhile (an importer bug,
+//! but not a use-after-free): `fmi2FreeInstance` waits for the call, then takes the
+//! instance out of the slot and drops it outside the lock. A foreign, NULL, freed or
+//! made-up handle is only ever compared with numbers the registry holds.
+//!
+//! The registry is the library's only global mutable state: the instance slab, and the
+//! FMU states by handle with their owner (needed only by the FMU state functions, behind
+//! one mutex).
+//!
+//! Lock order: an instance's slot may be held while the FMU state map is locked (to add
+//! or remove its FMU states), never the other way round; no code holds two slots at once
+//! (a message about another instance's FMU state takes that instance's name from the map).
 
+use std::cell::UnsafeCell;
 use std::collections::BTreeMap;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex, PoisonError, RwLock, RwLockReadGuard, RwLockWriteGuard};
+use std::hint::spin_loop;
+use std::marker::PhantomData;
+use std::ops::{Deref, DerefMut};
+use std::ptr;
+use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicUsize, Ordering};
+use std::sync::{Mutex, MutexGuard, PoisonError};
+use std::time::Duration;
 
 use super::instance::Instance;
 
-/// What an `fmi2Component` points to: the `Arc`'s allocation.
-pub struct InstanceCell {
-    /// The instance name, readable without locking the instance (for messages about
-    /// FMU states that belong to it).
-    pub name: String,
-    pub instance: Mutex<Instance>,
-}
-
-// The instance cell is shared between threads (through the `Arc`s in the registry and
-// the calls in flight): the compiler must agree that this is sound. `Instance` is `Send`
-// (see the SAFETY note on `Logger`), which makes `Mutex<Instance>` `Send + Sync`.
-const _: () = {
-    const fn assert_send_sync<T: Send + Sync>() {}
-    assert_send_sync::<InstanceCell>();
-    assert_send_sync::<Arc<InstanceCell>>();
-    assert_send_sync::<RwLock<Registry>>();
-};
-
-struct Registry {
-    /// Live instances by handle.
-    instances: BTreeMap<usize, Arc<InstanceCell>>,
-    /// Live FMU states by handle, with the handle of the instance that owns them (the
-    /// states themselves live in their instance).
-    states: BTreeMap<usize, usize>,
-}
-
-static REGISTRY: RwLock<Registry> = RwLock::new(Registry {
-    instances: BTreeMap::new(),
-    states: BTreeMap::new(),
-});
-
-// Nothing panics while holding the lock, but should it ever, the maps are still
-// consistent (each operation is a single insert or remove): keep using them.
-fn read() -> RwLockReadGuard<'static, Registry> {
-    REGISTRY.read().unwrap_or_else(PoisonError::into_inner)
-}
-
-fn write() -> RwLockWriteGuard<'static, Registry> {
-    REGISTRY.write().unwrap_or_else(PoisonError::into_inner)
-}
-
 /// Top bit of every handle: above the 47-bit user address space of x86-64 Linux.
 const HANDLE_TAG: usize = 1 << (usize::BITS - 1);
-
-static NEXT_HANDLE: AtomicUsize = AtomicUsize::new(1);
-
-/// A handle never handed out before (for an instance or an FMU state).
-pub fn new_handle() -> usize {
-    // 2^63 handles: a process cannot exhaust them.
-    HANDLE_TAG | NEXT_HANDLE.fetch_add(1, Ordering::Relaxed)
-}
+/// Set in FMU state handles, clear in instance handles.
+const STATE_KIND: usize = 1 << (usize::BITS - 2);
+/// Bits of an instance handle that hold the slot index: at most 2^20 (a million) live
+/// instances.
+const INDEX_BITS: u32 = if usize::BITS >= 64 { 20 } else { 12 };
+const INDEX_MASK: usize = (1 << INDEX_BITS) - 1;
+/// The generations of a slot are 1..=MAX_GENERATION (the bits between the index and the
+/// kind bit): 2^42 instances, one after the other, in one slot.
+const MAX_GENERATION: usize = (STATE_KIND >> INDEX_BITS) - 1;
+/// Slots per chunk.
+const CHUNK_BITS: u32 = 6;
+const CHUNK: usize = 1 << CHUNK_BITS;
+/// Chunks for every index: a table of 16 384 pointers, filled as instances are made.
+const CHUNKS: usize = 1 << (INDEX_BITS - CHUNK_BITS);
 
 /// Whether `value` has the form of one of our handles (live or not). Such a value is never
 /// a user-space address, so it must not be dereferenced as one.
@@ -84,39 +74,515 @@ pub fn is_handle(value: usize) -> bool {
     value & HANDLE_TAG != 0
 }
 
-/// Registers a new instance under `handle` (from [`new_handle`]).
-pub fn add_instance(handle: usize, cell: Arc<InstanceCell>) {
-    write().instances.insert(handle, cell);
+// ---------------------------------------------------------------------------------------
+// The slab: slots of values addressed by generation-checked handles
+
+/// One slot: a value (or none) and the lock that guards it.
+// Aligned to a cache line pair so that calls on instances in neighbouring slots, made on
+// different threads, do not share the line of their locks.
+#[repr(align(128))]
+struct Slot<T> {
+    /// The handle of the value in the slot, 0 when there is none. Written only with the
+    /// lock held; read without it to refuse a stale handle without waiting for the lock.
+    live: AtomicUsize,
+    /// The generation of the slot's last value. Written only by the inserter that owns
+    /// the free slot.
+    generation: AtomicUsize,
+    locked: AtomicBool,
+    value: UnsafeCell<Option<T>>,
 }
 
-/// The live instance with `handle`, if there is one.
-pub fn instance(handle: usize) -> Option<Arc<InstanceCell>> {
-    read().instances.get(&handle).cloned()
+impl<T> Slot<T> {
+    const fn new() -> Self {
+        Slot {
+            live: AtomicUsize::new(0),
+            generation: AtomicUsize::new(0),
+            locked: AtomicBool::new(false),
+            value: UnsafeCell::new(None),
+        }
+    }
+
+    /// Takes the lock: one compare-exchange when nobody holds it (the only case a correct
+    /// importer produces: FMI 2.0 forbids overlapping calls on one instance), and the
+    /// unlock is a plain store.
+    #[inline]
+    fn lock(&self) {
+        if self
+            .locked
+            .compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed)
+            .is_err()
+        {
+            self.lock_contended();
+        }
+    }
+
+    /// Waits for another call on the same slot (an importer calling one instance from two
+    /// threads at once, or freeing it during a call): spins briefly, then yields, then
+    /// sleeps in short naps, so a long step on the other thread costs little CPU.
+    #[cold]
+    #[inline(never)]
+    fn lock_contended(&self) {
+        let mut attempts = 0u32;
+        loop {
+            if !self.locked.load(Ordering::Relaxed)
+                && self
+                    .locked
+                    .compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed)
+                    .is_ok()
+            {
+                return;
+            }
+            attempts = attempts.saturating_add(1);
+            if attempts < 64 {
+                spin_loop();
+            } else if attempts < 128 {
+                std::thread::yield_now();
+            } else {
+                std::thread::sleep(Duration::from_micros(50));
+            }
+        }
+    }
+
+    #[inline]
+    fn unlock(&self) {
+        self.locked.store(false, Ordering::Release);
+    }
 }
 
-/// Unregisters an instance and its FMU states; the caller drops the returned cell (outside
-/// the registry lock), which frees the instance once no call uses it any more.
-pub fn remove_instance(handle: usize) -> Option<Arc<InstanceCell>> {
-    let mut registry = write();
-    registry.states.retain(|_, owner| *owner != handle);
-    registry.instances.remove(&handle)
+/// Values of type `T` in slots, each behind its own lock, addressed by handles that carry
+/// the slot's index and generation. Slots live in chunks that are allocated as needed and
+/// never freed while the slab lives (the registry's slab lives as long as the library),
+/// so any index that has a chunk can be read, whatever the handle's history.
+pub struct Slab<T> {
+    /// Chunk k: the `CHUNK` slots from index `k · CHUNK` on, published once with Release,
+    /// null until then.
+    chunks: [AtomicPtr<Slot<T>>; CHUNKS],
+    allocator: Mutex<Allocator>,
+    /// The slab owns the values in its chunks (for the drop check).
+    owns: PhantomData<T>,
 }
 
-/// Records that the FMU state `state` belongs to the instance `owner` (both handles).
-pub fn add_state(state: usize, owner: usize) {
-    write().states.insert(state, owner);
+struct Allocator {
+    /// Slots without a value whose generations are not used up.
+    free: Vec<usize>,
+    /// Slots handed out so far (the next fresh index).
+    fresh: usize,
+}
+
+// SAFETY: a value in a slot is only reached through a `Guard` (while the slot's lock is
+// held, as with a `Mutex<T>`) or moved in and out of the slot with the lock held, so
+// sharing the slab between threads only ever moves values from one thread to another:
+// `T: Send` suffices, as for `Mutex<T>: Sync`. Everything else is atomics and a mutex.
+unsafe impl<T: Send> Sync for Slab<T> {}
+unsafe impl<T: Send> Send for Slab<T> {}
+
+/// The chunk of slot `index` and its position in the chunk.
+#[inline]
+fn chunk_of(index: usize) -> (usize, usize) {
+    (index >> CHUNK_BITS, index & (CHUNK - 1))
+}
+
+/// The slot index and generation of an instance handle.
+fn decode(handle: usize) -> Option<(usize, usize)> {
+    (handle & (HANDLE_TAG | STATE_KIND) == HANDLE_TAG)
+        .then_some((handle & INDEX_MASK, (handle & !HANDLE_TAG) >> INDEX_BITS))
+}
+
+/// A value of the slab, locked: other calls on it wait until the guard is dropped.
+pub struct Guard<'a, T> {
+    slot: &'a Slot<T>,
+    value: &'a mut T,
+}
+
+impl<T> Deref for Guard<'_, T> {
+    type Target = T;
+    #[inline]
+    fn deref(&self) -> &T {
+        &*self.value
+    }
+}
+
+impl<T> DerefMut for Guard<'_, T> {
+    #[inline]
+    fn deref_mut(&mut self) -> &mut T {
+        &mut *self.value
+    }
+}
+
+impl<T> Drop for Guard<'_, T> {
+    #[inline]
+    fn drop(&mut self) {
+        self.slot.unlock();
+    }
+}
+
+impl<T> Slab<T> {
+    pub const fn new() -> Self {
+        Slab {
+            chunks: [const { AtomicPtr::new(ptr::null_mut()) }; CHUNKS],
+            allocator: Mutex::new(Allocator {
+                free: Vec::new(),
+                fresh: 0,
+            }),
+            owns: PhantomData,
+        }
+    }
+
+    fn allocator(&self) -> MutexGuard<'_, Allocator> {
+        // Nothing panics while holding it; should it ever, the lists are still usable.
+        self.allocator
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// Slot `index`, if its chunk exists.
+    #[inline]
+    fn slot(&self, index: usize) -> Option<&Slot<T>> {
+        let (chunk, offset) = chunk_of(index);
+        let first = self.chunks.get(chunk)?.load(Ordering::Acquire);
+        if first.is_null() {
+            return None;
+        }
+        // SAFETY: chunk `chunk` is an array of `CHUNK` initialised slots (`offset` is
+        // below that by construction), published with Release after it was
+        // written (the Acquire load above pairs with it) and freed only by `Drop`.
+        Some(unsafe { &*first.add(offset) })
+    }
+
+    /// A slot without a value, with its chunk allocated; `None` when every index is in use.
+    fn take_free_slot(&self) -> Option<usize> {
+        let mut allocator = self.allocator();
+        if let Some(index) = allocator.free.pop() {
+            return Some(index);
+        }
+        let index = allocator.fresh;
+        if index > INDEX_MASK {
+            return None;
+        }
+        let (chunk, offset) = chunk_of(index);
+        if offset == 0 {
+            let slots: Box<[Slot<T>]> = (0..CHUNK).map(|_| Slot::new()).collect();
+            let first = Box::into_raw(slots) as *mut Slot<T>;
+            self.chunks[chunk].store(first, Ordering::Release);
+        }
+        allocator.fresh = index + 1;
+        Some(index)
+    }
+
+    /// Stores the value `make` builds from its handle (it must not panic: the slot would be
+    /// lost, harmlessly); `None`, without calling `make`, when the slab is full.
+    pub fn insert(&self, make: impl FnOnce(usize) -> T) -> Option<usize> {
+        let index = self.take_free_slot()?;
+        let slot = self.slot(index).expect("a slot handed out has its chunk");
+        // The slot is free and ours alone: no other inserter has it, and lookups do not
+        // get past `live`, which is 0.
+        let generation = slot.generation.load(Ordering::Relaxed) + 1;
+        debug_assert!(generation <= MAX_GENERATION);
+        slot.generation.store(generation, Ordering::Relaxed);
+        let handle = HANDLE_TAG | generation << INDEX_BITS | index;
+        let value = make(handle);
+        slot.lock();
+        // SAFETY: the lock is held, so nothing else reaches the value.
+        unsafe { *slot.value.get() = Some(value) };
+        slot.live.store(handle, Ordering::Release);
+        slot.unlock();
+        Some(handle)
+    }
+
+    /// The live value with `handle`, locked; `None` for any other number (NULL, a freed
+    /// or foreign handle), which is only compared, never followed.
+    #[inline]
+    pub fn lock(&self, handle: usize) -> Option<Guard<'_, T>> {
+        let (index, _) = decode(handle)?;
+        let slot = self.slot(index)?;
+        if slot.live.load(Ordering::Acquire) != handle {
+            return None;
+        }
+        slot.lock();
+        // Freed (and perhaps reused) between the check and the lock?
+        if slot.live.load(Ordering::Relaxed) != handle {
+            slot.unlock();
+            return None;
+        }
+        // SAFETY: the lock is held until the guard drops it, and `live` names a value.
+        match unsafe { (*slot.value.get()).as_mut() } {
+            Some(value) => Some(Guard { slot, value }),
+            None => {
+                slot.unlock();
+                None
+            }
+        }
+    }
+
+    /// Takes the live value with `handle` out of the slab (waiting for a call that holds
+    /// it); the handle is refused from then on. The caller drops the value, outside any
+    /// lock.
+    pub fn remove(&self, handle: usize) -> Option<T> {
+        let (index, generation) = decode(handle)?;
+        let slot = self.slot(index)?;
+        if slot.live.load(Ordering::Acquire) != handle {
+            return None;
+        }
+        slot.lock();
+        if slot.live.load(Ordering::Relaxed) != handle {
+            slot.unlock();
+            return None;
+        }
+        slot.live.store(0, Ordering::Release);
+        // SAFETY: the lock is held.
+        let value = unsafe { (*slot.value.get()).take() };
+        slot.unlock();
+        // A slot whose generations are used up is retired: its handles never come back.
+        if generation < MAX_GENERATION {
+            self.allocator().free.push(index);
+        }
+        value
+    }
+}
+
+impl<T> Drop for Slab<T> {
+    /// Frees the chunks (only a slab that is not the registry's is ever dropped).
+    fn drop(&mut self) {
+        for first in &mut self.chunks {
+            let first = *first.get_mut();
+            if !first.is_null() {
+                let slots = ptr::slice_from_raw_parts_mut(first, CHUNK);
+                // SAFETY: allocated in `take_free_slot` as a boxed slice of this length,
+                // and no guard can outlive `&mut self`.
+                drop(unsafe { Box::from_raw(slots) });
+            }
+        }
+    }
+}
+
+impl<T> Default for Slab<T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// The registry: the instances, and the FMU states with their owners
+
+static INSTANCES: Slab<Instance> = Slab::new();
+
+/// An instance found by its handle, locked for the call.
+pub type InstanceGuard = Guard<'static, Instance>;
+
+// The instances are shared between threads (every call locks its instance's slot): the
+// compiler must agree that this is sound. `Instance` is `Send` (see the SAFETY note on
+// `Logger`), which makes the slab `Sync`.
+const _: () = {
+    const fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<Slab<Instance>>();
+    assert_send_sync::<Mutex<BTreeMap<usize, StateOwner>>>();
+};
+
+/// Registers a new instance, setting its handle; gives it back when the registry is full.
+pub fn add_instance(instance: Instance) -> Result<usize, Box<Instance>> {
+    let mut instance = Some(instance);
+    INSTANCES
+        .insert(|handle| {
+            let mut instance = instance.take().expect("taken once");
+            instance.handle = handle;
+            instance
+        })
+        .ok_or_else(|| Box::new(instance.take().expect("not taken by a failed insert")))
+}
+
+/// The live instance with `handle`, locked, if there is one.
+#[inline]
+pub fn instance(handle: usize) -> Option<InstanceGuard> {
+    INSTANCES.lock(handle)
+}
+
+/// Unregisters an instance (waiting for a call in flight on it); the caller drops it,
+/// outside any lock, and its FMU states are unregistered as it drops.
+pub fn remove_instance(handle: usize) -> Option<Instance> {
+    INSTANCES.remove(handle)
+}
+
+/// The instance an FMU state belongs to.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StateOwner {
+    pub handle: usize,
+    /// For messages about the state in another instance.
+    pub name: String,
+}
+
+static STATES: Mutex<BTreeMap<usize, StateOwner>> = Mutex::new(BTreeMap::new());
+
+// Nothing panics while holding the lock, but should it ever, the map is still consistent
+// (each operation is a single insert or remove): keep using it.
+fn states() -> MutexGuard<'static, BTreeMap<usize, StateOwner>> {
+    STATES.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+static NEXT_STATE: AtomicUsize = AtomicUsize::new(1);
+
+/// A handle for a new FMU state, never handed out before.
+pub fn new_state_handle() -> usize {
+    HANDLE_TAG | STATE_KIND | NEXT_STATE.fetch_add(1, Ordering::Relaxed)
+}
+
+/// Records that the FMU state `state` belongs to the instance `owner`.
+pub fn add_state(state: usize, owner: StateOwner) {
+    states().insert(state, owner);
 }
 
 pub fn remove_state(state: usize) {
-    write().states.remove(&state);
+    states().remove(&state);
 }
 
 /// The instance an FMU state belongs to, if `state` is a live FMU state.
-pub fn state_owner(state: usize) -> Option<usize> {
-    read().states.get(&state).copied()
+pub fn state_owner(state: usize) -> Option<StateOwner> {
+    states().get(&state).cloned()
 }
 
-/// The name of the live instance with `handle`.
-pub fn instance_name(handle: usize) -> Option<String> {
-    read().instances.get(&handle).map(|cell| cell.name.clone())
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::AtomicU64;
+    use std::sync::Barrier;
+
+    #[test]
+    fn every_index_has_a_place() {
+        assert_eq!(chunk_of(0), (0, 0));
+        assert_eq!(chunk_of(CHUNK - 1), (0, CHUNK - 1));
+        assert_eq!(chunk_of(CHUNK), (1, 0));
+        assert_eq!(chunk_of(INDEX_MASK), (CHUNKS - 1, CHUNK - 1));
+        // A handle's bits: tag, kind, generation, index, without overlap.
+        assert_eq!(MAX_GENERATION << INDEX_BITS & INDEX_MASK, 0);
+        assert_eq!(
+            (MAX_GENERATION << INDEX_BITS) & (HANDLE_TAG | STATE_KIND),
+            0
+        );
+        assert_eq!(
+            HANDLE_TAG | STATE_KIND | MAX_GENERATION << INDEX_BITS | INDEX_MASK,
+            usize::MAX
+        );
+    }
+
+    #[test]
+    fn handles_are_tagged_and_never_name_a_later_value() {
+        let slab = Slab::new();
+        let first = slab.insert(|_| 1u32).unwrap();
+        assert!(is_handle(first));
+        assert_eq!(*slab.lock(first).unwrap(), 1);
+        assert_eq!(slab.remove(first), Some(1));
+        assert!(slab.lock(first).is_none());
+        assert_eq!(slab.remove(first), None);
+        // The slot is reused at once, under a new generation.
+        let second = slab.insert(|_| 2).unwrap();
+        assert_eq!(second & INDEX_MASK, first & INDEX_MASK);
+        assert_ne!(second, first);
+        assert!(slab.lock(first).is_none());
+        assert_eq!(*slab.lock(second).unwrap(), 2);
+        // Made-up numbers: no tag, a state's kind bit, an index without a chunk, a slot
+        // never used, NULL.
+        for made_up in [
+            second & !HANDLE_TAG,
+            second | STATE_KIND,
+            HANDLE_TAG | 1 << INDEX_BITS | INDEX_MASK,
+            HANDLE_TAG | 1 << INDEX_BITS | 5,
+            0,
+            new_state_handle(),
+        ] {
+            assert!(slab.lock(made_up).is_none(), "{made_up:#x}");
+            assert!(slab.remove(made_up).is_none(), "{made_up:#x}");
+        }
+        assert_eq!(*slab.lock(second).unwrap(), 2);
+    }
+
+    #[test]
+    fn a_slot_whose_generations_are_used_up_is_retired() {
+        let slab = Slab::new();
+        let handle = slab.insert(|_| 0u8).unwrap();
+        let index = handle & INDEX_MASK;
+        slab.remove(handle);
+        let slot = slab.slot(index).unwrap();
+        slot.generation.store(MAX_GENERATION - 1, Ordering::Relaxed);
+        let last = slab.insert(|_| 1).unwrap();
+        assert_eq!(last, HANDLE_TAG | MAX_GENERATION << INDEX_BITS | index);
+        assert!(decode(last).is_some_and(|(i, g)| i == index && g == MAX_GENERATION));
+        assert_eq!(slab.remove(last), Some(1));
+        let next = slab.insert(|_| 2).unwrap();
+        assert_ne!(next & INDEX_MASK, index);
+    }
+
+    /// A call holding a value keeps it: a removal on another thread waits for the guard,
+    /// and the value is gone only afterwards.
+    #[test]
+    fn a_removal_waits_for_the_call_in_flight() {
+        let slab = Slab::new();
+        let handle = slab.insert(|_| vec![1u64, 2, 3]).unwrap();
+        let removed = AtomicBool::new(false);
+        let barrier = Barrier::new(2);
+        std::thread::scope(|scope| {
+            let mut guard = slab.lock(handle).unwrap();
+            scope.spawn(|| {
+                barrier.wait();
+                let value = slab.remove(handle);
+                removed.store(true, Ordering::SeqCst);
+                assert_eq!(value, Some(vec![1, 2, 3, 4]));
+            });
+            barrier.wait();
+            std::thread::sleep(Duration::from_millis(50));
+            assert!(!removed.load(Ordering::SeqCst), "removed during the call");
+            guard.push(4);
+            drop(guard);
+        });
+        assert!(removed.load(Ordering::SeqCst));
+        assert!(slab.lock(handle).is_none());
+    }
+
+    /// Calls on many threads, each on its own values and on the others' (overlapping, as
+    /// a broken importer would), while values come and go: every locked value is the
+    /// one its handle named, and no two calls hold one value at once.
+    #[test]
+    fn concurrent_calls_inserts_and_removals_stay_consistent() {
+        struct Counted {
+            handle: usize,
+            inside: AtomicU64,
+        }
+        let slab = Slab::<Counted>::new();
+        let shared: Vec<usize> = (0..4)
+            .map(|_| {
+                slab.insert(|handle| Counted {
+                    handle,
+                    inside: AtomicU64::new(0),
+                })
+                .unwrap()
+            })
+            .collect();
+        std::thread::scope(|scope| {
+            for _ in 0..4 {
+                scope.spawn(|| {
+                    for round in 0..2000 {
+                        let own = slab
+                            .insert(|handle| Counted {
+                                handle,
+                                inside: AtomicU64::new(0),
+                            })
+                            .unwrap();
+                        for &h in shared.iter().chain([&own]) {
+                            let guard = slab.lock(h).unwrap();
+                            assert_eq!(guard.handle, h);
+                            assert_eq!(guard.inside.fetch_add(1, Ordering::Relaxed), 0);
+                            if round % 64 == 0 {
+                                std::thread::yield_now();
+                            }
+                            guard.inside.fetch_sub(1, Ordering::Relaxed);
+                        }
+                        let value = slab.remove(own).unwrap();
+                        assert_eq!(value.handle, own);
+                        assert!(slab.lock(own).is_none());
+                    }
+                });
+            }
+        });
+        for h in shared {
+            assert!(slab.remove(h).is_some());
+        }
+    }
 }

@@ -87,6 +87,7 @@ impl Call {
         }
     }
 
+    #[inline]
     pub fn is_allowed_in(self, mode: Mode) -> bool {
         self.allowed() & mode.bit() != 0
     }
