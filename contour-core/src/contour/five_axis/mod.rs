@@ -10,3 +10,4 @@ pub mod hmm;
 pub mod hmm_online;
 pub mod pose_error;
 pub mod run_evaluation;
+pub mod viterbi;
