@@ -1,7 +1,9 @@
 //! Mapping measured five-axis samples to reference segments with a hidden Markov model
-//! solved by Viterbi (docs/design.md §5.2) — the offline form over a whole run, and the
-//! nearest-segment mapping it is compared with (the online form: `hmm_online`; the
-//! windowed offline form: `run_evaluation`).
+//! solved by Viterbi (docs/design.md §5.2) — the model's costs, the offline form over a
+//! whole run, and the nearest-segment mapping it is compared with (the online form:
+//! `hmm_online`; the windowed offline form: `run_evaluation`). The recursion, the
+//! back-pointer table and the backtrack of all three forms are the shared core's
+//! ([`viterbi`]); the offline form keeps every segment and sample.
 //!
 //! The reference is a polyline of tool tips R_j with a second polyline S_j = R_j + L·O_j
 //! (the point L mm up the tool axis), so the tool orientation takes part in the match.

@@ -5,8 +5,10 @@
 //! which drops the states that have fallen far behind the best — and nothing is
 //! allocated after construction (every buffer is a ring of fixed size).
 //!
-//! With a band covering the whole reference and a lag covering the whole run it decodes
-//! what [`viterbi_offline`](super::hmm::viterbi_offline) decodes.
+//! The recursion step, the fresh start, the best state and the read-back are the shared
+//! core's ([`viterbi`]); the band, the beam and the rings are this file's. With a band
+//! covering the whole reference and a lag covering the whole run it decodes what
+//! [`viterbi_offline`](super::hmm::viterbi_offline) decodes.
 
 use serde::{Deserialize, Serialize};
 

@@ -8,8 +8,11 @@
 //! byte (the skip j − i ≤ 255), and decisions are committed as soon as every surviving
 //! path passes through one segment, after which their rows are dropped. Memory is
 //! O(window · undecided samples) — a few hundred rows in practice — plus O(samples) for
-//! the result; time is O(samples · window · max_skip). Where the window holds every
-//! segment that matters the result is exactly [`viterbi_offline`](super::hmm::viterbi_offline)'s.
+//! the result; time is O(samples · window · max_skip). The recursion step, the
+//! back-pointer table and the backtrack are the shared core's ([`viterbi`]); the
+//! window's placement and the commits are this file's. Where the window holds every
+//! segment that matters the result is exactly
+//! [`viterbi_offline`](super::hmm::viterbi_offline)'s.
 
 use std::fmt;
 
