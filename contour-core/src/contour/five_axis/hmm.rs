@@ -1,7 +1,9 @@
 //! Mapping measured five-axis samples to reference segments with a hidden Markov model
-//! solved by Viterbi (docs/design/five-axis.md §5.2) — the offline form over a whole run, and the
-//! nearest-segment mapping it is compared with (the online form: `hmm_online`; the
-//! windowed offline form: `run_evaluation`).
+//! solved by Viterbi (docs/design/five-axis.md §5.2) — the model's costs, the offline form over a
+//! whole run, and the nearest-segment mapping it is compared with (the online form:
+//! `hmm_online`; the windowed offline form: `run_evaluation`). The recursion, the
+//! back-pointer table and the backtrack of all three forms are the shared core's
+//! ([`viterbi`]); the offline form keeps every segment and sample.
 //!
 //! The reference is a polyline of tool tips R_j with a second polyline S_j = R_j + L·O_j
 //! (the point L mm up the tool axis), so the tool orientation takes part in the match.
@@ -15,6 +17,7 @@
 //! decoded mapping minimises the summed cost:
 //!   C(k, j) = c(k, j) + min over j − max_skip ≤ i ≤ j of C(k − 1, i).
 
+use super::viterbi::{self, BackTable};
 use crate::geometry::Vector;
 
 /// Distance from `p` to the segment a–b. (A plain square root of the squared distance:
@@ -153,39 +156,32 @@ pub fn viterbi_offline(
     }
     let mut cost = vec![0.0; m];
     let mut next = vec![0.0; m];
-    let mut back = vec![0usize; n * m];
+    // Full indices: the offline form allows any skip.
+    let mut back = BackTable::<usize>::with_capacity(m, n);
     for k in 0..n {
         let motion = if k == 0 {
             Vector::zeros()
         } else {
             tips[k] - tips[k - 1]
         };
-        for j in 0..m {
-            let c = state_cost(reference, params, j, &tips[k], &seconds[k], &motion);
-            if k == 0 {
-                next[j] = c;
-                continue;
-            }
-            let from = j.saturating_sub(params.max_skip);
-            let (mut best, mut arg) = (f64::INFINITY, from);
-            for (i, &ci) in cost.iter().enumerate().take(j + 1).skip(from) {
-                if ci < best {
-                    (best, arg) = (ci, i);
-                }
-            }
-            next[j] = best + c;
-            back[k * m + j] = arg;
+        let c = |j| state_cost(reference, params, j, &tips[k], &seconds[k], &motion);
+        let mut row = back.push_row(0);
+        if k == 0 {
+            viterbi::start(0..m, c, |j, cj, _| next[j] = cj);
+        } else {
+            let previous = |i: usize| cost[i];
+            let score = |j, best| best + c(j);
+            viterbi::step(params.max_skip, 0..m, 0..m, previous, score, |j, cj, i| {
+                next[j] = cj;
+                row.set(j, i);
+            });
         }
         std::mem::swap(&mut cost, &mut next);
     }
-    let mut j = (0..m).fold(0, |best, j| if cost[j] < cost[best] { j } else { best });
+    let last = viterbi::best_state(0..m, |j| cost[j]);
     let mut path = vec![0; n];
-    for k in (0..n).rev() {
-        path[k] = j;
-        if k > 0 {
-            j = back[k * m + j];
-        }
-    }
+    let predecessor = |k, j| back.predecessor(k, j);
+    viterbi::backtrack(n - 1, last, 0, predecessor, |k, j| path[k] = j);
     path
 }
 

@@ -5,12 +5,15 @@
 //! which drops the states that have fallen far behind the best — and nothing is
 //! allocated after construction (every buffer is a ring of fixed size).
 //!
-//! With a band covering the whole reference and a lag covering the whole run it decodes
-//! what [`viterbi_offline`](super::hmm::viterbi_offline) decodes.
+//! The recursion step, the fresh start, the best state and the read-back are the shared
+//! core's ([`viterbi`]); the band, the beam and the rings are this file's. With a band
+//! covering the whole reference and a lag covering the whole run it decodes what
+//! [`viterbi_offline`](super::hmm::viterbi_offline) decodes.
 
 use serde::{Deserialize, Serialize};
 
 use super::hmm::{segment_cost, HmmParams};
+use super::viterbi;
 use crate::geometry::{self, Vector};
 use crate::kinematics::Pose;
 
@@ -35,7 +38,9 @@ pub struct OnlineMapper {
     next: Vec<f64>,
     valid: (usize, usize),
     /// Predecessors (absolute segments) of the last `lag + 1` samples: row k mod
-    /// (lag + 1), column j & mask.
+    /// (lag + 1), column j & mask. Not the core's `BackTable`: that one grows and drops
+    /// rows (allocation and copying per sample), and this ring is sized once and saved
+    /// as it is in the FMU state.
     back: Vec<usize>,
     samples: usize,
     previous_tip: Option<Vector<3>>,
@@ -176,18 +181,6 @@ impl OnlineMapper {
         self.samples
     }
 
-    fn cost_of(&self, j: usize, tip: &Vector<3>, second: &Vector<3>, motion: &Vector<3>) -> f64 {
-        let (a, b) = (j & self.mask, (j + 1) & self.mask);
-        segment_cost(
-            &self.params,
-            [&self.tips[a], &self.tips[b]],
-            [&self.seconds[a], &self.seconds[b]],
-            tip,
-            second,
-            motion,
-        )
-    }
-
     /// Maps the next measured sample (tip and unit tool axis); returns the best segment
     /// for it now, or `None` while the reference has no segment.
     pub fn push_sample(&mut self, tip: Vector<3>, axis: Vector<3>) -> Option<usize> {
@@ -198,39 +191,41 @@ impl OnlineMapper {
         }
         let second = tip + axis * self.length;
         let motion = self.previous_tip.map_or(Vector::zeros(), |p| tip - p);
-        let row = (self.samples % (self.lag + 1)) * (self.mask + 1);
-        let skip = self.params.max_skip;
+        let (mask, skip) = (self.mask, self.params.max_skip);
+        let row = (self.samples % (self.lag + 1)) * (mask + 1);
         // Live states of the previous sample are [vlo, vhi); they reach [vlo, vhi − 1 + K].
         let (vlo, vhi) = self.valid;
-        let (mut from, mut to) = if self.samples > 0 && vlo < vhi {
-            (lo.max(vlo), hi.min(vhi + skip))
-        } else {
+        let live = if self.samples > 0 { vlo..vhi } else { 0..0 };
+        let (mut from, mut to) = if live.is_empty() {
             (lo, hi)
+        } else {
+            (lo.max(vlo), hi.min(vhi + skip))
         };
-        let mut reachable = false;
-        for j in from..to {
-            let c = self.cost_of(j, &tip, &second, &motion);
-            let mut best = (f64::INFINITY, j);
-            if self.samples > 0 {
-                for i in j.saturating_sub(skip).max(vlo)..=j.min(vhi.wrapping_sub(1)) {
-                    let ci = self.cost[i & self.mask];
-                    if ci < best.0 {
-                        best = (ci, i);
-                    }
-                }
-            }
-            reachable |= best.0.is_finite();
-            self.next[j & self.mask] = best.0 + c;
-            self.back[row + (j & self.mask)] = best.1;
-        }
+        let (tips, seconds, params) = (&self.tips, &self.seconds, &self.params);
+        let c = |j: usize| {
+            let (a, b) = (j & mask, (j + 1) & mask);
+            let (r, s) = ([&tips[a], &tips[b]], [&seconds[a], &seconds[b]]);
+            segment_cost(params, r, s, &tip, &second, &motion)
+        };
+        let (cost, next, back) = (&self.cost, &mut self.next, &mut self.back[row..]);
+        let mut store = |j: usize, cj, i| {
+            next[j & mask] = cj;
+            back[j & mask] = i;
+        };
+        let previous = |i: usize| cost[i & mask];
+        let reachable = viterbi::step(
+            skip,
+            from..to,
+            live,
+            previous,
+            |j, best| best + c(j),
+            &mut store,
+        );
         if !reachable {
             // The first sample, or the band ran past every path: start afresh (any
             // segment, no history).
             (from, to) = (lo, hi);
-            for j in lo..hi {
-                self.next[j & self.mask] = self.cost_of(j, &tip, &second, &motion);
-                self.back[row + (j & self.mask)] = j;
-            }
+            viterbi::start(lo..hi, c, store);
         }
         // The beam: states costlier than the best by more than `beam` are dropped.
         let least = (from..to)
@@ -261,13 +256,7 @@ impl OnlineMapper {
     /// The segment of least cost for the newest sample (ties to the lower segment).
     fn best(&self) -> usize {
         let (lo, hi) = self.valid;
-        (lo..hi).fold(lo, |best, j| {
-            if self.cost[j & self.mask] < self.cost[best & self.mask] {
-                j
-            } else {
-                best
-            }
-        })
+        viterbi::best_state(lo..hi, |j| self.cost[j & self.mask])
     }
 
     /// The mapping of the sample `steps` before the newest (0 = the newest), along the
@@ -276,12 +265,16 @@ impl OnlineMapper {
         if self.samples == 0 || steps > self.lag || steps >= self.samples {
             return None;
         }
-        let mut j = self.best();
-        for s in 0..steps {
-            let k = self.samples - 1 - s;
-            j = self.back[(k % (self.lag + 1)) * (self.mask + 1) + (j & self.mask)];
-        }
-        Some(j)
+        let newest = self.samples - 1;
+        let (rows, columns) = (self.lag + 1, self.mask + 1);
+        let predecessor = |k: usize, j: usize| self.back[(k % rows) * columns + (j & self.mask)];
+        Some(viterbi::backtrack(
+            newest,
+            self.best(),
+            newest - steps,
+            predecessor,
+            |_, _| {},
+        ))
     }
 }
 

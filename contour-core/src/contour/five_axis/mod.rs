@@ -2,7 +2,9 @@
 //! to reference segments by a hidden Markov model solved by Viterbi (offline over a run,
 //! windowed, or online as samples arrive), the tip and orientation errors at the foot
 //! point, and the evaluation-function estimate; [`run_evaluation`] puts them together for
-//! a whole measured run.
+//! a whole measured run. The three mappers differ in which segments are candidates and
+//! where the costs and back-pointers are kept; the recursion itself is one core,
+//! [`viterbi`], that they share.
 
 pub mod evaluation;
 pub mod evaluation_online;
@@ -10,3 +12,4 @@ pub mod hmm;
 pub mod hmm_online;
 pub mod pose_error;
 pub mod run_evaluation;
+pub mod viterbi;

@@ -8,14 +8,18 @@
 //! byte (the skip j − i ≤ 255), and decisions are committed as soon as every surviving
 //! path passes through one segment, after which their rows are dropped. Memory is
 //! O(window · undecided samples) — a few hundred rows in practice — plus O(samples) for
-//! the result; time is O(samples · window · max_skip). Where the window holds every
-//! segment that matters the result is exactly [`viterbi_offline`](super::hmm::viterbi_offline)'s.
+//! the result; time is O(samples · window · max_skip). The recursion step, the
+//! back-pointer table and the backtrack are the shared core's ([`viterbi`]); the
+//! window's placement and the commits are this file's. Where the window holds every
+//! segment that matters the result is exactly
+//! [`viterbi_offline`](super::hmm::viterbi_offline)'s.
 
 use std::fmt;
 
 use super::evaluation::{self, Evaluation};
 use super::hmm::{state_cost, HmmParams, ReferencePolyline};
 use super::pose_error::{foot_point_error_between, nearest_segment_near};
+use super::viterbi::{self, BackTable};
 use crate::geometry::slerp;
 use crate::geometry::{self, Vector};
 use crate::kinematics::{Joints, Pose, TableTiltingAc};
@@ -34,11 +38,8 @@ pub struct WindowedViterbi<'a> {
     /// C(k, lo + s) of the newest sample.
     cost: Vec<f64>,
     next: Vec<f64>,
-    /// Skip offsets j − i of the undecided rows (`width` bytes a row) and their windows.
-    back: Vec<u8>,
-    lows: Vec<usize>,
-    /// The first undecided sample.
-    first: usize,
+    /// Back-pointers of the undecided samples (from the first undecided one), as bytes.
+    back: BackTable<u8>,
     decided: Vec<usize>,
     samples: usize,
     previous_tip: Option<Vector<3>>,
@@ -63,9 +64,7 @@ impl<'a> WindowedViterbi<'a> {
             lo: 0,
             cost: vec![f64::INFINITY; width],
             next: vec![f64::INFINITY; width],
-            back: Vec::new(),
-            lows: Vec::new(),
-            first: 0,
+            back: BackTable::new(width),
             decided: Vec::new(),
             samples: 0,
             previous_tip: None,
@@ -89,7 +88,7 @@ impl<'a> WindowedViterbi<'a> {
 
     /// Samples whose mapping is still open (their back-pointer rows are held).
     pub fn pending(&self) -> usize {
-        self.samples - self.first
+        self.samples - self.back.first()
     }
 
     /// The mapping of the samples decided so far, in order.
@@ -97,9 +96,9 @@ impl<'a> WindowedViterbi<'a> {
         &self.decided
     }
 
-    /// Index in the newest row of its least cost (ties to the lower segment).
-    fn best_slot(&self) -> usize {
-        (0..self.width).fold(0, |b, s| if self.cost[s] < self.cost[b] { s } else { b })
+    /// The segment of least cost for the newest sample (ties to the lower segment).
+    fn best(&self) -> usize {
+        viterbi::best_state(self.lo..self.lo + self.width, |j| self.cost[j - self.lo])
     }
 
     /// Adds the next observation: tool tip and second point (L mm up the tool axis).
@@ -118,46 +117,37 @@ impl<'a> WindowedViterbi<'a> {
                 )
                 .0;
             self.lo = best.saturating_sub(w / 2).min(m - w);
-            for s in 0..w {
-                self.cost[s] = state_cost(
-                    self.reference,
-                    &self.params,
-                    self.lo + s,
-                    tip,
-                    second,
-                    &zero,
-                );
-            }
-            self.back.resize(w, 0);
+            let (lo, cost) = (self.lo, &mut self.cost);
+            let mut row = self.back.push_row(lo);
+            let c = |j| state_cost(self.reference, &self.params, j, tip, second, &zero);
+            viterbi::start(lo..lo + w, c, |j, cj, i| {
+                cost[j - lo] = cj;
+                row.set(j, i);
+            });
         } else {
             let previous_lo = self.lo;
-            let best = previous_lo + self.best_slot();
+            let best = self.best();
             // The window never moves back: nothing below the previous one is reachable.
             self.lo = best.saturating_sub(w / 2).max(previous_lo).min(m - w);
-            let row = self.back.len();
-            self.back.resize(row + w, 0);
-            for s in 0..w {
-                let j = self.lo + s;
-                let from = j.saturating_sub(skip).max(previous_lo);
-                let to = j.min(previous_lo + w - 1);
-                let (mut best, mut arg) = (f64::INFINITY, j);
-                // Empty (from > to) when the window moved past every predecessor.
-                for i in from..=to {
-                    let ci = self.cost[i - previous_lo];
-                    if ci < best {
-                        (best, arg) = (ci, i);
-                    }
-                }
-                self.next[s] = if best.is_finite() {
+            let (lo, cost, next) = (self.lo, &self.cost, &mut self.next);
+            let mut row = self.back.push_row(lo);
+            let previous = |i: usize| cost[i - previous_lo];
+            // A state without a finite predecessor (the window moved past them all) stays
+            // out of reach, whatever its own cost.
+            let score = |j, best: f64| {
+                if best.is_finite() {
                     best + state_cost(self.reference, &self.params, j, tip, second, &motion)
                 } else {
                     f64::INFINITY
-                };
-                self.back[row + s] = (j - arg) as u8;
-            }
+                }
+            };
+            let live = previous_lo..previous_lo + w;
+            viterbi::step(skip, lo..lo + w, live, previous, score, |j, cj, i| {
+                next[j - lo] = cj;
+                row.set(j, i);
+            });
             std::mem::swap(&mut self.cost, &mut self.next);
         }
-        self.lows.push(self.lo);
         self.samples += 1;
         self.previous_tip = Some(*tip);
         if self.samples >= self.next_check {
@@ -173,27 +163,16 @@ impl<'a> WindowedViterbi<'a> {
         }
     }
 
-    /// The predecessor of segment `j` at sample `k` (> first).
-    fn predecessor(&self, k: usize, j: usize) -> usize {
-        let r = k - self.first;
-        j - self.back[r * self.width + j - self.lows[r]] as usize
-    }
-
     /// Writes the path ending in segment `j` at sample `k` back to the first undecided
     /// sample, and drops those rows.
-    fn commit_through(&mut self, k: usize, mut j: usize) {
-        let count = k + 1 - self.first;
+    fn commit_through(&mut self, k: usize, j: usize) {
+        let first = self.back.first();
         let start = self.decided.len();
-        self.decided.resize(start + count, 0);
-        for kk in (self.first..=k).rev() {
-            self.decided[start + kk - self.first] = j;
-            if kk > self.first {
-                j = self.predecessor(kk, j);
-            }
-        }
-        self.back.drain(..count * self.width);
-        self.lows.drain(..count);
-        self.first = k + 1;
+        self.decided.resize(start + k + 1 - first, 0);
+        let (back, decided) = (&self.back, &mut self.decided[start..]);
+        let predecessor = |kk, j| back.predecessor(kk, j);
+        viterbi::backtrack(k, j, first, predecessor, |kk, j| decided[kk - first] = j);
+        self.back.drop_before(k + 1);
     }
 
     /// Commits every sample through which all finite survivors of the newest row pass.
@@ -204,9 +183,9 @@ impl<'a> WindowedViterbi<'a> {
             .map(|s| self.lo + s)
             .collect();
         let mut k = newest;
-        while alive.len() > 1 && k > self.first {
+        while alive.len() > 1 && k > self.back.first() {
             for j in alive.iter_mut() {
-                *j = self.predecessor(k, *j);
+                *j = self.back.predecessor(k, *j);
             }
             alive.sort_unstable();
             alive.dedup();
@@ -220,8 +199,8 @@ impl<'a> WindowedViterbi<'a> {
 
     /// The whole mapping: the rest traced back from the last sample's best segment.
     pub fn finish(mut self) -> Vec<usize> {
-        if self.samples > self.first {
-            let j = self.lo + self.best_slot();
+        if self.samples > self.back.first() {
+            let j = self.best();
             self.commit_through(self.samples - 1, j);
         }
         self.decided
