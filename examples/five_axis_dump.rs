@@ -20,7 +20,7 @@
 //!   the axis parameters, the start, the command of every step and the positions and
 //!   velocities after every step (row k is after step k + 1).
 //! - `five_axis_dump closed_loop PATH MODE [FEED]`: the in-process five-axis closed loop
-//!   (`contour_core::sim::five_axis`) on a built-in path or a CL/JSON file, CCC `off`,
+//!   (`contour_core::sim::simulate_five_axis`) on a built-in path or a CL/JSON file, CCC `off`,
 //!   `fixed` or `fuzzy`, at FEED mm/s (default 50): the metrics and every sample's record
 //!   (time, reference and actual joints, command, true and estimated errors), for the
 //!   FMU closed loop to reproduce (tests/fmpy/test_five_axis_fmus.py).

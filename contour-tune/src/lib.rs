@@ -1,5 +1,5 @@
 //! Tuning the fuzzy CCC's five scaling factors with particle swarm optimisation: the PSO
-//! (`pso`), the closed-loop objective over contour-fmu's simulator (`objective`) and the
+//! (`pso`), the closed-loop objective over contour-core's simulator (`objective`) and the
 //! `ccc-tune` program. Kept out of the contour-fmu crate so that the FMU library links
 //! nothing of it (no rayon, no random generator, no progress bar).
 

@@ -1,8 +1,8 @@
-"""contour-fmu's Python side: run the FMUs that `fmu-build` packages (PathInterpolator2D,
-ContourCCC2D, XYServoPlant) in a closed loop.
+"""contour-fmu's Python side: run the six FMUs that `fmu-build` packages in their closed
+loops (two-axis and five-axis).
 
 Modules (imported on demand; this package imports nothing itself, so `wiring` stays usable
-without fmpy). The core needs fmpy and numpy; a module marked [extra] needs that extra of
+without fmpy). The core needs fmpy, numpy and attrs; a module marked [extra] needs that extra of
 python/pyproject.toml (contour_fmu.extras) and says so when it is missing:
 
 - wiring: the paper's loop as a list of connections, shared by every master;

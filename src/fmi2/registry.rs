@@ -31,7 +31,8 @@
 //! instance out of the slot and drops it outside the lock. A foreign, NULL, freed or
 //! made-up handle is only ever compared with numbers the registry holds.
 //!
-//! The registry is the library's only global mutable state: the instance slab, and the
+//! The registry is the library's only global mutable state (beside contour-core's
+//! write-once cache of the built-in five-axis paths): the instance slab, and the
 //! FMU states by handle with their owner (needed only by the FMU state functions, behind
 //! one mutex).
 //!

@@ -1,4 +1,4 @@
-//! `FiveAxisPlant`: the five-axis test plant of docs/design/five-axis.md §5.5 as an FMU model —
+//! `FiveAxisPlant`: the five-axis test plant of docs/design/five-axis.md §5.1 (the FMU: §5.6) as an FMU model —
 //! X, Y, Z ball-screw axes as the two-axis plant's, A and C on a small trunnion table
 //! (worm gears). Velocity commands in (mm/s, rad/s), positions and velocities out;
 //! integrated exactly, so the trajectory does not depend on the communication step.
