@@ -2,10 +2,10 @@
 #   make demo   build the FMUs and the tuner, run the closed-loop demo; needs only cargo and
 #               python3 (no root): the venv gets the run set and the contour_fmu package
 #   make test   lint, then every test (Rust unit/ABI tests, fmpy/libcosim/ecos and reference
-#               tests); installs libclang-dev and libtbb12 through apt when they are missing
-#               (root), the venv gets the test set and the package
-# Other targets: check (the fast development loop), fmus, ccc-tune, bindings, lint, asan, fuzz-smoke, fuzz-long, bench,
-# leak-check, pso-claim, setup.
+#               tests); installs libclang-dev, libtbb12 and valgrind through apt when they
+#               are missing (root), the venv gets the test set and the package
+# Other targets: check (the fast development loop), fmus, ccc-tune, bindings, lint, asan,
+# fuzz-smoke, fuzz-long, bench, leak-check, pso-claim, setup.
 
 VENV   := .venv
 PYTHON := $(VENV)/bin/python
@@ -100,8 +100,8 @@ fuzz-long: cargo-fuzz
 	fuzz/long.sh 10000000
 
 # AddressSanitizer, with its leak checker, over the FMI boundary: the libraries' unit tests
-# (contour-fmu's and contour-core's) and the ABI tests, the dlopened cdylib instrumented as well. The stable toolchain's
-# -Zsanitizer needs RUSTC_BOOTSTRAP; --target keeps build scripts and proc macros
+# (contour-fmu's and contour-core's) and the ABI test binary, the dlopened cdylib
+# instrumented as well. The stable toolchain's -Zsanitizer needs RUSTC_BOOTSTRAP; --target keeps build scripts and proc macros
 # uninstrumented; the test executables export the ASan runtime for the cdylib to find.
 HOST       := $(shell rustc -vV 2>/dev/null | sed -n 's/^host: //p')
 ASAN_FLAGS := -Zsanitizer=address -Clink-arg=-Wl,--export-dynamic
