@@ -5,73 +5,12 @@
 //! table an importer's dlsym looks in.
 
 use std::collections::BTreeSet;
-use std::path::PathBuf;
 
 use object::{Object, ObjectSymbol, SymbolKind};
 
-/// FMI 2.0 for Co-Simulation, in the order of fmi2Functions.h.
-const FMI2_CO_SIMULATION: [&str; 34] = [
-    // Common functions.
-    "fmi2GetTypesPlatform",
-    "fmi2GetVersion",
-    "fmi2SetDebugLogging",
-    "fmi2Instantiate",
-    "fmi2FreeInstance",
-    "fmi2SetupExperiment",
-    "fmi2EnterInitializationMode",
-    "fmi2ExitInitializationMode",
-    "fmi2Terminate",
-    "fmi2Reset",
-    "fmi2GetReal",
-    "fmi2GetInteger",
-    "fmi2GetBoolean",
-    "fmi2GetString",
-    "fmi2SetReal",
-    "fmi2SetInteger",
-    "fmi2SetBoolean",
-    "fmi2SetString",
-    "fmi2GetFMUstate",
-    "fmi2SetFMUstate",
-    "fmi2FreeFMUstate",
-    "fmi2SerializedFMUstateSize",
-    "fmi2SerializeFMUstate",
-    "fmi2DeSerializeFMUstate",
-    "fmi2GetDirectionalDerivative",
-    // Co-Simulation functions.
-    "fmi2SetRealInputDerivatives",
-    "fmi2GetRealOutputDerivatives",
-    "fmi2DoStep",
-    "fmi2CancelStep",
-    "fmi2GetStatus",
-    "fmi2GetRealStatus",
-    "fmi2GetIntegerStatus",
-    "fmi2GetBooleanStatus",
-    "fmi2GetStringStatus",
-];
-
-/// The cdylib built for this test: cargo builds the library's cdylib next to the test
-/// binary (target/<profile>/deps/) when it builds the integration tests of this
-/// cdylib+rlib crate; `cargo build` puts it in target/<profile>/.
-fn library_path() -> PathBuf {
-    let exe = std::env::current_exe().expect("test binary path");
-    let deps = exe.parent().expect("deps directory");
-    let profile = deps.parent().expect("profile directory");
-    [deps, profile]
-        .iter()
-        .map(|dir| dir.join("libcontour_fmu.so"))
-        .find(|path| path.exists())
-        .unwrap_or_else(|| {
-            panic!(
-                "no libcontour_fmu.so in {} or {}",
-                deps.display(),
-                profile.display()
-            )
-        })
-}
-
 #[test]
 fn the_library_exports_exactly_the_fmi2_co_simulation_functions() {
-    let path = library_path();
+    let path = crate::common::library_path();
     let data =
         std::fs::read(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     let file = object::File::parse(&*data)
@@ -92,7 +31,10 @@ fn the_library_exports_exactly_the_fmi2_co_simulation_functions() {
         }
     }
 
-    let expected: BTreeSet<String> = FMI2_CO_SIMULATION.iter().map(|s| s.to_string()).collect();
+    let expected: BTreeSet<String> = crate::common::FMI2_CO_SIMULATION
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     assert_eq!(expected.len(), 34);
     let missing: Vec<_> = expected.difference(&functions).collect();
     let extra: Vec<_> = functions.difference(&expected).collect();

@@ -55,6 +55,46 @@ pub const DISCARD: fmi2Status = fmi2Status_fmi2Discard;
 pub const ERROR: fmi2Status = fmi2Status_fmi2Error;
 pub const FATAL: fmi2Status = fmi2Status_fmi2Fatal;
 
+/// FMI 2.0 for Co-Simulation, in the order of fmi2Functions.h.
+pub const FMI2_CO_SIMULATION: [&str; 34] = [
+    // Common functions.
+    "fmi2GetTypesPlatform",
+    "fmi2GetVersion",
+    "fmi2SetDebugLogging",
+    "fmi2Instantiate",
+    "fmi2FreeInstance",
+    "fmi2SetupExperiment",
+    "fmi2EnterInitializationMode",
+    "fmi2ExitInitializationMode",
+    "fmi2Terminate",
+    "fmi2Reset",
+    "fmi2GetReal",
+    "fmi2GetInteger",
+    "fmi2GetBoolean",
+    "fmi2GetString",
+    "fmi2SetReal",
+    "fmi2SetInteger",
+    "fmi2SetBoolean",
+    "fmi2SetString",
+    "fmi2GetFMUstate",
+    "fmi2SetFMUstate",
+    "fmi2FreeFMUstate",
+    "fmi2SerializedFMUstateSize",
+    "fmi2SerializeFMUstate",
+    "fmi2DeSerializeFMUstate",
+    "fmi2GetDirectionalDerivative",
+    // Co-Simulation functions.
+    "fmi2SetRealInputDerivatives",
+    "fmi2GetRealOutputDerivatives",
+    "fmi2DoStep",
+    "fmi2CancelStep",
+    "fmi2GetStatus",
+    "fmi2GetRealStatus",
+    "fmi2GetIntegerStatus",
+    "fmi2GetBooleanStatus",
+    "fmi2GetStringStatus",
+];
+
 /// The cdylib cargo built with this test binary: `cargo test` leaves it beside the test
 /// in target/<profile>/deps/, `cargo build` in target/<profile>/.
 pub fn library_path() -> PathBuf {
