@@ -84,9 +84,19 @@ fn drz(angle: f64) -> Matrix3<f64> {
 }
 
 /// `angle` plus the whole turns that bring it nearest to `near`.
-fn unwrap_near(angle: f64, near: f64) -> f64 {
+pub fn unwrap_near(angle: f64, near: f64) -> f64 {
     let tau = std::f64::consts::TAU;
     angle + ((near - angle) / tau).round() * tau
+}
+
+/// The rotary angles of a unit tool axis on the A ≥ 0 branch: its tilt from the C axis,
+/// A = atan2(|o_xy|, o_z), and its azimuth C = atan2(o_x, o_y) in (−π, π] (meaningless
+/// when A = 0). The other branch is (−A, C + π).
+pub fn axis_angles(axis: &Vector<3>) -> (f64, f64) {
+    (
+        axis[0].hypot(axis[1]).atan2(axis[2]),
+        axis[0].atan2(axis[1]),
+    )
 }
 
 impl TableTiltingAc {
@@ -123,11 +133,15 @@ impl TableTiltingAc {
         } else {
             unwrap_near(o[0].atan2(o[1]), previous_c)
         };
-        let (a, c) = (self.a_pivot, self.c_pivot);
-        let machine = rx(a_angle) * (rz(c_angle) * (pose.tip - c) + c - a) + a;
-        Some(Joints::new(
-            machine[0], machine[1], machine[2], a_angle, c_angle,
-        ))
+        Some(self.joints_at(&pose.tip, a_angle, c_angle))
+    }
+
+    /// The joints that put the tool tip at workpiece point `tip` with the rotary axes at
+    /// `a` and `c` (rad): the linear axes follow the table.
+    pub fn joints_at(&self, tip: &Vector<3>, a: f64, c: f64) -> Joints {
+        let (pa, pc) = (self.a_pivot, self.c_pivot);
+        let machine = rx(a) * (rz(c) * (tip - pc) + pc - pa) + pa;
+        Joints::new(machine[0], machine[1], machine[2], a, c)
     }
 
     /// ∂(tip, axis)/∂q at `q`, analytic.

@@ -2,7 +2,7 @@
 //! `contour-fmu` compute, and the in-process loops and offline evaluation that the tools
 //! (`contour-eval`, `contour-tune`), tests and benchmarks run.
 //!
-//! The floors, each using only those above it: [`geometry`] and [`kinematics`]; [`path`]
+//! The floors, each using only those above it: [`geometry`], [`kinematics`] and [`limits`]; [`path`]
 //! (reference paths and the feed-rate interpolator); [`contour`] (contour errors, split by
 //! paper into `planar` and `five_axis`); [`control`] (PID, fuzzy gain scheduling, the
 //! cross-coupled controllers); [`plant`] (the test plants); [`sim`] (the closed loops in
@@ -15,6 +15,7 @@ pub mod contour;
 pub mod control;
 pub mod geometry;
 pub mod kinematics;
+pub mod limits;
 pub mod path;
 pub mod plant;
 pub mod sim;

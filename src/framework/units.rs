@@ -40,6 +40,8 @@ pub const UNITS: &[UnitDefinition] = &[
     unit("1/s2", 0, 0, -2, 0, 0, 1.0),
     unit("mm", 0, 1, 0, 0, 0, 1e-3),
     unit("mm/s", 0, 1, -1, 0, 0, 1e-3),
+    unit("mm/s2", 0, 1, -2, 0, 0, 1e-3),
+    unit("mm/s3", 0, 1, -3, 0, 0, 1e-3),
     unit("A", 0, 0, 0, 1, 0, 1.0),
     unit("kg.m2", 1, 2, 0, 0, 0, 1.0),
     unit("N.m.s/rad", 1, 2, -1, 0, -1, 1.0),
@@ -48,6 +50,7 @@ pub const UNITS: &[UnitDefinition] = &[
     unit("A/rad", 0, 0, 0, 1, -1, 1.0),
     unit("rad", 0, 0, 0, 0, 1, 1.0),
     unit("rad/s", 0, 0, -1, 0, 1, 1.0),
+    unit("rad/s2", 0, 0, -2, 0, 1, 1.0),
     unit("mm/rad", 0, 1, 0, 0, -1, 1e-3),
 ];
 

@@ -131,6 +131,7 @@ pub static INFO: ModelInfo = ModelInfo {
     },
     // Every output starts at 0: the control law first runs in fmi2DoStep.
     initial_dependencies: &[],
+    initial_dependencies_on_some_paths: &[],
     create: |_: &Environment| Box::new(ContourCCC2D { state: None }),
 };
 

@@ -57,6 +57,7 @@ pub static INFO: ModelInfo = ModelInfo {
     },
     // `echo` is the label as initialized; `steps` starts at 0.
     initial_dependencies: &[(ECHO.vr(), &[LABEL.vr()])],
+    initial_dependencies_on_some_paths: &[],
     create: |_: &Environment| Box::new(FaultProbe { steps: 0 }),
 };
 

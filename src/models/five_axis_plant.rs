@@ -48,6 +48,7 @@ pub static INFO: ModelInfo = ModelInfo {
         (POS.at(3).vr(), &[POS0.at(3).vr()]),
         (POS.at(4).vr(), &[POS0.at(4).vr()]),
     ],
+    initial_dependencies_on_some_paths: &[],
     create: |_: &Environment| Box::new(FiveAxisPlant::default()),
 };
 

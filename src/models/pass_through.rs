@@ -51,6 +51,7 @@ pub static INFO: ModelInfo = ModelInfo {
     },
     // The outputs change only in fmi2DoStep: they start at 0 whatever the inputs.
     initial_dependencies: &[],
+    initial_dependencies_on_some_paths: &[],
     create: |_: &Environment| Box::new(PassThrough),
 };
 

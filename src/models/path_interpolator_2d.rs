@@ -79,6 +79,7 @@ pub static INFO: ModelInfo = ModelInfo {
             ],
         ),
     ],
+    initial_dependencies_on_some_paths: &[],
     create: |environment: &Environment| {
         Box::new(PathInterpolator2D {
             environment: environment.clone(),

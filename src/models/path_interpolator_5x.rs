@@ -1,21 +1,24 @@
-//! `PathInterpolator5X`: the five-axis reference. The tool tip follows a built-in path, a
-//! two-curve JSON file or APT CL data at a constant feed, one sample every `Ts`, the tool
-//! axis the path's at that point; the machine's inverse kinematics give the joints
-//! (docs/design/five-axis.md §5.3a, §5.1). `ref.X` … `ref.C` hold the latest sample between
-//! samples.
+//! `PathInterpolator5X`: the five-axis reference. The tool follows a built-in path, a
+//! two-curve JSON file or APT CL data, one sample every `Ts`. With `accel` > 0 (the
+//! default) the reference is planned at initialization within the machine's limits:
+//! the branch and turn of the rotary axes chosen over the whole path, the feed within
+//! every joint's velocity and acceleration and the tip's acceleration, a jerk filter
+//! (docs/design/five-axis.md §5.3b). With `accel` = 0 the tip moves at the constant feed
+//! and the joints come from the inverse kinematics on the A ≥ 0 branch, as before limits
+//! (§5.3a, §5.1). `ref.X` … `ref.C` hold the latest sample between samples.
 
 use std::path::Path;
 
 use super::axis_variables::REFERENCE_OUT;
-use super::kinematics_parameters;
+use super::{joint_limits_parameters, kinematics_parameters};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
 use crate::framework::state_codec::{SavedState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, XYZAC};
 use crate::framework::variables::{Start, Values, Variable};
-use contour_core::kinematics::TableTiltingAc;
-use contour_core::path::JointReference;
-use contour_core::path::{ToolPath, BUILTIN_TOOL_PATHS};
+use contour_core::limits::PathLimits;
+use contour_core::path::cl_data;
+use contour_core::path::{FiveAxisReference, ToolPath, BUILTIN_TOOL_PATHS};
 
 variable_table! {
     static VARIABLES;
@@ -35,7 +38,7 @@ variable_table! {
     FEED: Real = Variable::parameter(
         "feed",
         Start::Real(50.0),
-        "Tool-tip feed rate along the path (> 0)",
+        "Tool-tip feed rate along the path (> 0): the greatest, where the plan allows it",
     )
     .unit("mm/s");
     TS: Real = Variable::parameter(
@@ -45,6 +48,59 @@ variable_table! {
     )
     .unit("s");
     MACHINE: Reals<{ kinematics_parameters::COUNT }> = kinematics_parameters::VARIABLES;
+    ACCEL: Real = Variable::parameter(
+        "accel",
+        Start::Real(2000.0),
+        "Greatest tool-tip acceleration, tangential and centripetal (0: no plan, the tip \
+         at constant feed)",
+    )
+    .unit("mm/s2")
+    .min(0.0);
+    JERK: Real = Variable::parameter(
+        "jerk",
+        Start::Real(1e5),
+        "Greatest tool-tip jerk (0: no jerk limit)",
+    )
+    .unit("mm/s3")
+    .min(0.0);
+    TOLERANCE: Real = Variable::parameter(
+        "tolerance",
+        Start::Real(0.005),
+        "How far the planned tool tip may leave the programmed path",
+    )
+    .unit("mm")
+    .min(0.0);
+    ORIENTATION_TOLERANCE: Real = Variable::parameter(
+        "orientationTolerance",
+        Start::Real(2e-3),
+        "How far the planned tool axis may leave the programmed one",
+    )
+    .unit("rad")
+    .min(0.0);
+    POLE_CONE: Real = Variable::parameter(
+        "poleCone",
+        Start::Real(2.0 * std::f64::consts::PI / 180.0),
+        "Half-angle of the cone about the C axis within which C's turn is planned",
+    )
+    .unit("rad")
+    .min(0.0);
+    LIMITS: Reals<{ joint_limits_parameters::COUNT }> = joint_limits_parameters::VARIABLES;
+    DURATION: Real = Variable::output(
+        "plannedDuration",
+        "Duration of the planned reference, from the start to rest at the end (0 without \
+         a plan)",
+    )
+    .unit("s");
+    TIP_DEVIATION: Real = Variable::output(
+        "deviation.tip",
+        "Distance of the reference's tool tip from the programmed path",
+    )
+    .unit("mm");
+    ORIENTATION_DEVIATION: Real = Variable::output(
+        "deviation.orientation",
+        "Angle between the reference's tool axis and the programmed one",
+    )
+    .unit("rad");
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -59,13 +115,29 @@ pub static INFO: ModelInfo = ModelInfo {
         step_size: 1e-3,
     },
     // The first sample is the path's start pose through the inverse kinematics: it
-    // depends on the path and the machine; feed and Ts only matter from the first step on.
+    // depends on the path and the machine; feed and Ts only matter from the first step
+    // on. With a plan, a path that starts near the pole or that the A ≥ 0 branch cannot
+    // drive starts where the plan's choice of branch and turn puts it (the travel, the
+    // rotary speeds that weigh the choice, the pole's cone and tolerance). The planned
+    // duration depends on everything, each limit where it binds.
     initial_dependencies: &[
         (REF.at(0).vr(), &X_KNOWNS),
         (REF.at(1).vr(), &YZ_KNOWNS),
         (REF.at(2).vr(), &YZ_KNOWNS),
         (REF.at(3).vr(), &[PATH.vr()]),
         (REF.at(4).vr(), &[PATH.vr()]),
+        (DURATION.vr(), &[PATH.vr(), FEED.vr()]),
+        (ORIENTATION_DEVIATION.vr(), &[PATH.vr()]),
+    ],
+    initial_dependencies_on_some_paths: &[
+        (REF.at(0).vr(), &ROTARY_KNOWNS),
+        (REF.at(1).vr(), &ROTARY_KNOWNS),
+        (REF.at(2).vr(), &ROTARY_KNOWNS),
+        (REF.at(3).vr(), &ROTARY_KNOWNS),
+        (REF.at(4).vr(), &ROTARY_KNOWNS),
+        (DURATION.vr(), &ALL_KNOWNS),
+        (TIP_DEVIATION.vr(), &ALL_KNOWNS),
+        (ORIENTATION_DEVIATION.vr(), &ALL_KNOWNS),
     ],
     create: |environment: &Environment| {
         Box::new(PathInterpolator5X {
@@ -76,6 +148,19 @@ pub static INFO: ModelInfo = ModelInfo {
     },
 };
 
+/// What the start A and C may depend on besides the path: the plan's branch choice.
+const ROTARY_KNOWNS: [usize; 10] = [
+    ACCEL.vr(),
+    ORIENTATION_TOLERANCE.vr(),
+    POLE_CONE.vr(),
+    LIMITS.at(0).vr(),
+    LIMITS.at(1).vr(),
+    LIMITS.at(2).vr(),
+    LIMITS.at(3).vr(),
+    LIMITS.at(7).vr(),
+    LIMITS.at(8).vr(),
+    PATH.vr(),
+];
 /// X, Y, Z at the start: the path's start pose turned by the start A and C about the
 /// pivots. A turns about an axis along x, so X does not see the A pivot; Y and Z see
 /// both.
@@ -87,18 +172,32 @@ const YZ_KNOWNS: [usize; 5] = [
     MACHINE.at(2).vr(),
     MACHINE.at(3).vr(),
 ];
+/// Every parameter: the path and those after it, up to the outputs that end the table.
+const KNOWN_COUNT: usize = 8 + kinematics_parameters::COUNT + joint_limits_parameters::COUNT;
+const _: () =
+    assert!(PATH.vr() + KNOWN_COUNT == LIMITS.at(joint_limits_parameters::COUNT - 1).vr() + 1);
+const ALL_KNOWNS: [usize; KNOWN_COUNT] = {
+    let mut all = [0; KNOWN_COUNT];
+    let mut i = 0;
+    while i < KNOWN_COUNT {
+        all[i] = PATH.vr() + i;
+        i += 1;
+    }
+    all
+};
 
 /// Version 1: `Option<State>` as below, the path saved twice (with the interpolator's
 /// copy of its tip curve) and a built-in's poses in full. Version 2: the path once, a
-/// built-in by name (see `JointReference`'s saved form).
+/// built-in by name (see `JointReference`'s saved form). Version 3: the reference is
+/// constant-feed or planned (a plan saved as its inputs and the place on it).
 const LAYOUT: StateLayout = StateLayout {
     model: "PathInterpolator5X",
-    version: 2,
+    version: 3,
 };
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct State {
-    reference: JointReference,
+    reference: FiveAxisReference,
     clock: SampleClock,
 }
 
@@ -107,7 +206,7 @@ impl SavedState for State {
         self.clock.validate_at(time)?;
         // Not `state_check::all_finite`: it names every float of the path, megabytes of
         // text for a built-in; the path checked itself when decoded, and `check` covers
-        // the rest.
+        // the rest (a plan checked its place when restored).
         self.reference
             .check(self.clock.period())
             .map_err(|e| format!("reference: {e}"))
@@ -121,36 +220,57 @@ pub struct PathInterpolator5X {
     warnings: Vec<String>,
 }
 
-/// The reference on the path the `path` parameter names (files relative to the resources
-/// folder), with the CL reader's warnings; errors name the file and line.
-fn joint_reference(
-    spec: &str,
-    environment: &Environment,
-    machine: TableTiltingAc,
-    feed: f64,
-    ts: f64,
-) -> Result<(JointReference, Vec<String>), String> {
+/// The programmed path the `path` parameter names (files relative to the resources
+/// folder): the path, a built-in's name, the CL lines of its poses, the reader's
+/// warnings; errors name the file and line.
+struct Programmed {
+    path: ToolPath,
+    builtin: Option<String>,
+    lines: Option<(String, Vec<usize>)>,
+    warnings: Vec<String>,
+}
+
+fn programmed(spec: &str, environment: &Environment) -> Result<Programmed, String> {
     let spec = spec.trim();
     let message = |e: contour_core::path::PathError| format!("parameter 'path': {e}");
     let file = Path::new(spec);
     // A bare name is a built-in (the error lists them); anything else is a file.
     let bare = file.extension().is_none() && !spec.contains(['/', '\\']);
     if BUILTIN_TOOL_PATHS.contains(&spec) || bare {
-        return JointReference::builtin(spec, machine, feed, ts)
-            .map(|r| (r, Vec::new()))
-            .map_err(message);
+        return Ok(Programmed {
+            path: ToolPath::builtin(spec).map_err(message)?,
+            builtin: Some(spec.to_owned()),
+            lines: None,
+            warnings: Vec::new(),
+        });
     }
     let full = match environment.resource_dir.as_deref() {
         Some(dir) if file.is_relative() && !file.exists() => dir.join(file),
         _ => file.to_path_buf(),
     };
-    let (path, warnings) = ToolPath::load(&full.to_string_lossy()).map_err(|e| {
-        let e = message(e);
-        let hint = super::path_interpolator_2d::resource_hint(spec, environment, &e);
-        e + hint
-    })?;
-    let reference = JointReference::new(path, machine, feed, ts).map_err(message)?;
-    Ok((reference, warnings))
+    let hint = |e: String| {
+        let h = super::path_interpolator_2d::resource_hint(spec, environment, &e);
+        e + h
+    };
+    let lower = spec.to_ascii_lowercase();
+    if lower.ends_with(".cl") || lower.ends_with(".apt") {
+        // Read here rather than through ToolPath::load: the plan names CL lines.
+        let data = cl_data::load_cl(&full).map_err(|e| hint(message(e)))?;
+        let path = ToolPath::from_poses(&data.poses).map_err(message)?;
+        return Ok(Programmed {
+            path,
+            builtin: None,
+            lines: Some((spec.to_owned(), data.lines)),
+            warnings: data.warnings,
+        });
+    }
+    let (path, warnings) = ToolPath::load(&full.to_string_lossy()).map_err(|e| hint(message(e)))?;
+    Ok(Programmed {
+        path,
+        builtin: None,
+        lines: None,
+        warnings,
+    })
 }
 
 impl Model for PathInterpolator5X {
@@ -162,9 +282,37 @@ impl Model for PathInterpolator5X {
         }
         let ts = check_period("Ts", TS.get(values))?;
         let machine = kinematics_parameters::machine(values, MACHINE);
-        let (reference, warnings) =
-            joint_reference(PATH.get(values), &self.environment, machine, feed, ts)?;
-        self.warnings = warnings
+        let joints = joint_limits_parameters::joint_limits(values, LIMITS)?;
+        let limits = PathLimits {
+            feed,
+            accel: ACCEL.get(values),
+            jerk: JERK.get(values),
+            tolerance: TOLERANCE.get(values),
+            orientation_tolerance: ORIENTATION_TOLERANCE.get(values),
+            pole_cone: POLE_CONE.get(values),
+        };
+        limits.check().map_err(|e| format!("plan: {e}"))?;
+        let programmed = programmed(PATH.get(values), &self.environment)?;
+        let lines = &programmed.lines;
+        let name = |i: usize| match lines {
+            Some((file, lines)) => match lines.get(i) {
+                Some(line) => format!("{file}:{line}"),
+                None => format!("{file}: GOTO record {}", i + 1),
+            },
+            None => format!("pose {i} of the path"),
+        };
+        let reference = FiveAxisReference::new(
+            programmed.path,
+            programmed.builtin,
+            machine,
+            joints,
+            limits,
+            ts,
+            &name,
+        )
+        .map_err(|e| format!("parameter 'path': {e}"))?;
+        self.warnings = programmed
+            .warnings
             .into_iter()
             .map(|w| format!("parameter 'path': {w}"))
             .collect();
@@ -198,11 +346,14 @@ impl Model for PathInterpolator5X {
 }
 
 impl PathInterpolator5X {
-    fn write_outputs(&self, values: &mut Values) {
-        if let Some(state) = &self.state {
-            let sample = state.reference.current();
-            REF.set(values, &sample.joints);
-            DONE.set(values, sample.done);
+    fn write_outputs(&mut self, values: &mut Values) {
+        if let Some(state) = &mut self.state {
+            let out = state.reference.current();
+            REF.set(values, &out.joints);
+            DONE.set(values, out.done);
+            DURATION.set(values, state.reference.planned_duration().unwrap_or(0.0));
+            TIP_DEVIATION.set(values, out.tip_deviation);
+            ORIENTATION_DEVIATION.set(values, out.orientation_deviation);
         }
     }
 }

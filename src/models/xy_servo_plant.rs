@@ -40,6 +40,7 @@ pub static INFO: ModelInfo = ModelInfo {
         (POS.at(0).vr(), &[POS0.at(0).vr()]),
         (POS.at(1).vr(), &[POS0.at(1).vr()]),
     ],
+    initial_dependencies_on_some_paths: &[],
     create: |_: &Environment| Box::new(XYServoPlant::default()),
 };
 

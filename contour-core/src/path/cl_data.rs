@@ -21,6 +21,8 @@ const UNIT_TOLERANCE: f64 = 1e-6;
 pub struct ClData {
     /// One per GOTO record.
     pub poses: Vec<Pose>,
+    /// The line each GOTO record starts on (1-based), one per pose.
+    pub lines: Vec<usize>,
     /// One line per normalised axis (`file:line: …`).
     pub warnings: Vec<String>,
 }
@@ -41,6 +43,7 @@ pub fn parse_cl(text: &str, name: &str) -> Result<ClData, PathError> {
     };
     let mut data = ClData {
         poses: Vec::new(),
+        lines: Vec::new(),
         warnings: Vec::new(),
     };
     let mut axis = Vector::<3>::z();
@@ -109,6 +112,7 @@ pub fn parse_cl(text: &str, name: &str) -> Result<ClData, PathError> {
             };
         }
         data.poses.push(Pose { tip, axis });
+        data.lines.push(first_line);
     }
     if !record.is_empty() {
         return Err(fail(

@@ -10,14 +10,17 @@ mod arc;
 pub mod builtin;
 pub mod cl_data;
 pub mod file;
+mod five_axis_reference;
 mod interpolator;
 mod joint_reference;
 mod line;
 mod nurbs;
+pub mod plan;
 mod polyline;
 mod tool_path;
 
 pub use arc::CircularArc;
+pub use five_axis_reference::{FiveAxisReference, ReferenceSample};
 pub use interpolator::{Interpolator, Progress, Sample};
 pub use joint_reference::{JointReference, JointSample};
 pub use line::Line;

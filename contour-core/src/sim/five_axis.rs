@@ -1,4 +1,5 @@
-//! In-process five-axis closed loop: joint reference (tip feed, inverse kinematics) →
+//! In-process five-axis closed loop: joint reference (planned within the machine's
+//! limits, or at constant tip feed through the inverse kinematics) →
 //! five-axis controller → five servo axes, sampled every `Ts` (docs/design/five-axis.md §5.5), with
 //! the true contour errors for the metrics.
 //!
@@ -25,9 +26,9 @@ use crate::control::{CccMode, FiveAxisConfig, FiveAxisController};
 use crate::geometry::angle_between;
 use crate::geometry::{self, Vector};
 use crate::kinematics::Joints;
-use crate::path::JointReference;
-use crate::path::ToolPath;
+use crate::limits::{JointLimits, PathLimits};
 use crate::path::{Curve, PathError};
+use crate::path::{FiveAxisReference, ToolPath};
 use crate::plant::{ServoAxes, ServoAxesParams};
 
 /// Reference samples the truth search looks back over: the default loops trail by about
@@ -43,8 +44,13 @@ const ABORT_TIP_ERROR: f64 = 10.0;
 pub struct FiveAxisSimConfig {
     /// The reference tool path.
     pub path: ToolPath,
-    /// Tool-tip feed, mm/s.
-    pub feed: f64,
+    /// The built-in's name when the path is one (plans of it are shared by name).
+    pub builtin: Option<String>,
+    /// The tip's feed and, with `accel` > 0, the plan's limits and tolerances (see
+    /// [`FiveAxisReference`]).
+    pub path_limits: PathLimits,
+    /// The joints' limits a plan keeps.
+    pub joint_limits: JointLimits,
     /// The five-axis controller.
     pub controller: FiveAxisConfig,
     /// The five servo axes, X Y Z A C.
@@ -54,12 +60,14 @@ pub struct FiveAxisSimConfig {
 }
 
 impl FiveAxisSimConfig {
-    /// `path` at `feed` with the default controller (fuzzy CCC on both errors) and the
-    /// trunnion-table plant, 0.1 s of settling.
+    /// `path` at `feed` planned within the default limits, with the default controller
+    /// (fuzzy CCC on both errors) and the trunnion-table plant, 0.1 s of settling.
     pub fn new(path: ToolPath, feed: f64) -> Self {
         FiveAxisSimConfig {
             path,
-            feed,
+            builtin: None,
+            path_limits: PathLimits::at_feed(feed),
+            joint_limits: JointLimits::default(),
             controller: FiveAxisConfig::DEFAULT,
             plant: ServoAxesParams::<5>::TRUNNION,
             settle: 0.1,
@@ -68,7 +76,15 @@ impl FiveAxisSimConfig {
 
     /// A built-in five-axis path (`tilted_helix`, `figure_eight`) at 50 mm/s.
     pub fn builtin(name: &str) -> Result<Self, PathError> {
-        Ok(Self::new(ToolPath::builtin(name)?, 50.0))
+        let mut config = Self::new(ToolPath::builtin(name)?, 50.0);
+        config.builtin = Some(name.to_owned());
+        Ok(config)
+    }
+
+    /// The reference at constant feed, unplanned (`accel` = 0: the loop before limits).
+    pub fn unplanned(mut self) -> Self {
+        self.path_limits.accel = 0.0;
+        self
     }
 
     /// Both contour laws in `mode`.
@@ -125,6 +141,12 @@ pub struct FiveAxisMetrics {
     pub max_tip_estimate_deviation: f64,
     /// Largest |orientation estimate − truth| likewise, rad.
     pub max_orientation_estimate_deviation: f64,
+    /// Largest distance of the reference's tip from the programmed path, mm: the plan's
+    /// share of the true errors, which the controller (seeing only the reference) cannot
+    /// know (0 without a plan).
+    pub max_reference_tip_deviation: f64,
+    /// Largest angle of the reference's tool axis from the programmed one, rad.
+    pub max_reference_orientation_deviation: f64,
     /// Set when the run stopped early.
     pub divergence: Option<Divergence>,
 }
@@ -182,11 +204,14 @@ pub fn simulate_five_axis(
     record: bool,
 ) -> Result<(FiveAxisMetrics, Vec<FiveAxisRecord>), SimError> {
     let ts = config.controller.ts;
-    let mut reference = JointReference::new(
+    let mut reference = FiveAxisReference::new(
         config.path.clone(),
+        config.builtin.clone(),
         config.controller.machine,
-        config.feed,
+        config.joint_limits,
+        config.path_limits,
         ts,
+        &|i| format!("pose {i}"),
     )?;
     let mut controller = FiveAxisController::new(config.controller)?;
     config.plant.validate().map_err(SimError::Plant)?;
@@ -206,6 +231,8 @@ pub fn simulate_five_axis(
         mean_orientation: 0.0,
         max_tip_estimate_deviation: 0.0,
         max_orientation_estimate_deviation: 0.0,
+        max_reference_tip_deviation: 0.0,
+        max_reference_orientation_deviation: 0.0,
         divergence: None,
     };
     let mut sample = start;
@@ -244,6 +271,12 @@ pub fn simulate_five_axis(
                 .max_orientation_estimate_deviation
                 .max((e.orientation - orientation).abs());
         }
+        metrics.max_reference_tip_deviation = metrics
+            .max_reference_tip_deviation
+            .max(sample.tip_deviation);
+        metrics.max_reference_orientation_deviation = metrics
+            .max_reference_orientation_deviation
+            .max(sample.orientation_deviation);
         metrics.max_tip = metrics.max_tip.max(tip);
         metrics.max_orientation = metrics.max_orientation.max(orientation);
         sums = (sums.0 + tip, sums.1 + orientation);

@@ -1,0 +1,279 @@
+//! Planned five-axis references on CL data shaped like a CAM system's: tool axes through
+//! and beside vertical, a hemisphere raster over its apex, a path the A range cannot
+//! reach. Every check is on the samples the FMU would send.
+
+use contour_core::geometry::{self, Vector};
+use contour_core::kinematics::{Pose, TableTiltingAc};
+use contour_core::limits::{JointLimits, PathLimits};
+use contour_core::path::plan::{Plan, PlannedSample};
+
+type V3 = Vector<3>;
+
+const TS: f64 = 1e-3;
+
+/// A straight pass along x, 60 mm in 0.5 mm CL steps, the tool axis tilting from +30°
+/// to −30° about y, `beside` rad to the side of vertical (0: through it).
+fn tilting_pass(beside: f64) -> Vec<Pose> {
+    (0..=120)
+        .map(|i| {
+            let f = i as f64 / 120.0;
+            let theta = (30.0 - 60.0 * f).to_radians();
+            Pose {
+                tip: V3::new(-30.0 + 60.0 * f, 0.0, 0.0),
+                axis: V3::new(
+                    theta.sin() * beside.cos(),
+                    beside.sin(),
+                    theta.cos() * beside.cos(),
+                ),
+            }
+        })
+        .collect()
+}
+
+/// A finishing raster over a hemisphere of radius 40 mm, the tool normal to the surface:
+/// passes along x at step-over 2 mm (the middle one over the apex), zigzag, 0.5 mm steps,
+/// within 45° of the apex.
+fn dome_raster(passes: i32) -> Vec<Pose> {
+    let r = 40.0;
+    let mut poses = Vec::new();
+    for (k, j) in (-passes..=passes).enumerate() {
+        let y = 2.0 * j as f64;
+        let half = ((r * 45f64.to_radians().sin()).powi(2) - y * y).sqrt();
+        let steps = (2.0 * half / 0.5).ceil() as usize;
+        for i in 0..=steps {
+            let f = i as f64 / steps as f64;
+            let f = if k % 2 == 0 { f } else { 1.0 - f };
+            let x = -half + 2.0 * half * f;
+            let p = V3::new(x, y, (r * r - x * x - y * y).sqrt());
+            poses.push(Pose {
+                tip: p,
+                axis: p / r,
+            });
+        }
+    }
+    poses
+}
+
+fn name(i: usize) -> String {
+    format!("pose {i}")
+}
+
+/// Every sample of `plan` from its start to rest at the end.
+fn samples(plan: Plan) -> (Vec<PlannedSample>, std::sync::Arc<Plan>) {
+    let mut cursor = plan.start();
+    let mut out = vec![plan.sample(&mut cursor)];
+    while !out[out.len() - 1].done {
+        plan.advance(&mut cursor);
+        out.push(plan.sample(&mut cursor));
+    }
+    (out, std::sync::Arc::new(plan))
+}
+
+/// Every joint within travel, velocity and acceleration, by differences of the samples;
+/// the tip within feed, accel and jerk, and within the tolerances of the CL path. The
+/// differences are of the samples themselves, so the only slack is the filter's
+/// quantum (2⁻³⁰ per joint) over Ts² or Ts³.
+fn assert_within(samples: &[PlannedSample], joints: &JointLimits, limits: &PathLimits, what: &str) {
+    let q = |k: usize| samples[k].joints;
+    let p = |k: usize| samples[k].pose.tip;
+    let quantum = 2f64.powi(-30);
+    for k in 0..samples.len() {
+        for i in 0..5 {
+            assert!(
+                q(k)[i] >= joints.min[i] - quantum && q(k)[i] <= joints.max[i] + quantum,
+                "{what}: joint {i} at {} outside its travel at sample {k}",
+                q(k)[i]
+            );
+        }
+        if k >= 1 {
+            let v = (q(k) - q(k - 1)) / TS;
+            for i in 0..5 {
+                assert!(
+                    v[i].abs() <= joints.velocity[i] * (1.0 + 1e-9) + 2.0 * quantum / TS,
+                    "{what}: joint {i} at {} /s at sample {k}",
+                    v[i]
+                );
+            }
+            let speed = geometry::dist(&p(k), &p(k - 1)) / TS;
+            assert!(
+                speed <= limits.feed * (1.0 + 1e-6),
+                "{what}: tip at {speed} mm/s, sample {k}"
+            );
+        }
+        if k >= 2 {
+            let a = (q(k) - q(k - 1) * 2.0 + q(k - 2)) / (TS * TS);
+            for i in 0..5 {
+                assert!(
+                    a[i].abs() <= joints.acceleration[i] * (1.0 + 1e-9) + 4.0 * quantum / TS / TS,
+                    "{what}: joint {i} at {} /s² at sample {k}",
+                    a[i]
+                );
+            }
+            let accel = geometry::norm(&(p(k) - p(k - 1) * 2.0 + p(k - 2))) / (TS * TS);
+            assert!(
+                accel <= limits.accel * (1.0 + 1e-6) + 1e-3,
+                "{what}: tip at {accel} mm/s², sample {k}"
+            );
+        }
+        if k >= 3 && limits.jerk > 0.0 {
+            let jerk =
+                geometry::norm(&(p(k) - p(k - 1) * 3.0 + p(k - 2) * 3.0 - p(k - 3))) / TS.powi(3);
+            assert!(
+                jerk <= limits.jerk * (1.0 + 1e-6) + 1.0,
+                "{what}: tip at {jerk} mm/s³, sample {k}"
+            );
+        }
+    }
+}
+
+/// The distance of `tip` from the CL polyline and the angle of `axis` from the CL axis at
+/// that point, by brute force over every CL segment.
+fn cl_deviation(cl: &[Pose], pose: &Pose) -> (f64, f64) {
+    let mut best = (f64::INFINITY, 0.0);
+    for w in cl.windows(2) {
+        let d = w[1].tip - w[0].tip;
+        let t = ((pose.tip - w[0].tip).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+        let distance = geometry::dist(&(w[0].tip + d * t), &pose.tip);
+        if distance < best.0 {
+            let axis = geometry::slerp(&w[0].axis, &w[1].axis, t).unwrap();
+            best = (distance, geometry::angle_between(&axis, &pose.axis));
+        }
+    }
+    best
+}
+
+fn plan(
+    cl: &[Pose],
+    joints: &JointLimits,
+    limits: &PathLimits,
+) -> (Vec<PlannedSample>, std::sync::Arc<Plan>) {
+    samples(Plan::new(cl, TableTiltingAc::default(), joints, limits, TS, &name).unwrap())
+}
+
+fn check_all(
+    cl: &[Pose],
+    joints: &JointLimits,
+    limits: &PathLimits,
+    what: &str,
+) -> Vec<PlannedSample> {
+    let (s, plan) = plan(cl, joints, limits);
+    assert_within(&s, joints, limits, what);
+    let (mut tip, mut axis) = (0.0f64, 0.0f64);
+    for sample in &s {
+        let (d, a) = cl_deviation(cl, &sample.pose);
+        tip = tip.max(d);
+        axis = axis.max(a);
+    }
+    assert!(
+        tip <= limits.tolerance * (1.0 + 1e-6),
+        "{what}: tip {tip} mm off the CL path"
+    );
+    assert!(
+        axis <= limits.orientation_tolerance * (1.0 + 1e-6),
+        "{what}: axis {axis} rad off"
+    );
+    let report = plan.report();
+    eprintln!("{what}: {report:?}, brute force tip {tip:.3e} axis {axis:.3e}");
+    // The plan's own measure of its deviation is the brute force's.
+    assert!(
+        (report.tip_deviation - tip).abs() <= 1e-9 + 1e-6 * tip,
+        "{what}"
+    );
+    s
+}
+
+fn c_travel(samples: &[PlannedSample]) -> f64 {
+    let c: Vec<f64> = samples.iter().map(|s| s.joints[4]).collect();
+    c.iter().cloned().fold(f64::MIN, f64::max) - c.iter().cloned().fold(f64::MAX, f64::min)
+}
+
+#[test]
+fn through_vertical_the_branch_switches_and_c_stays() {
+    let joints = JointLimits::default();
+    let limits = PathLimits::at_feed(50.0);
+    let s = check_all(&tilting_pass(0.0), &joints, &limits, "through vertical");
+    assert!(c_travel(&s) < 1e-6, "C turned by {}", c_travel(&s));
+    let a_first = s[0].joints[3];
+    let a_last = s[s.len() - 1].joints[3];
+    assert!((a_first.abs() - 30f64.to_radians()).abs() < 1e-9);
+    assert!((a_first + a_last).abs() < 1e-9, "{a_first} -> {a_last}");
+}
+
+#[test]
+fn through_vertical_with_a_positive_only_c_turns_through_the_cone() {
+    let mut joints = JointLimits::default();
+    joints.min[3] = 0.0;
+    let limits = PathLimits::at_feed(50.0);
+    let s = check_all(&tilting_pass(0.0), &joints, &limits, "A >= 0");
+    let turn = c_travel(&s);
+    assert!(
+        (turn - std::f64::consts::PI).abs() < 1e-6,
+        "C turned by {turn}"
+    );
+    assert!(s.iter().all(|x| x.joints[3] >= 0.0));
+}
+
+#[test]
+fn beside_vertical_c_swings_within_its_limits() {
+    let joints = JointLimits::default();
+    let limits = PathLimits::at_feed(50.0);
+    let s = check_all(
+        &tilting_pass(0.5f64.to_radians()),
+        &joints,
+        &limits,
+        "beside vertical",
+    );
+    eprintln!("C travel {}", c_travel(&s));
+}
+
+#[test]
+fn a_dome_raster_over_its_apex() {
+    let joints = JointLimits::default();
+    let limits = PathLimits::at_feed(50.0);
+    check_all(&dome_raster(2), &joints, &limits, "dome");
+}
+
+#[test]
+fn a_path_beyond_the_a_travel_is_refused_naming_the_pose() {
+    let mut joints = JointLimits::default();
+    joints.max[3] = 20f64.to_radians();
+    joints.min[3] = -20f64.to_radians();
+    let e = Plan::new(
+        &tilting_pass(0.0),
+        TableTiltingAc::default(),
+        &joints,
+        &PathLimits::at_feed(50.0),
+        TS,
+        &name,
+    )
+    .unwrap_err()
+    .to_string();
+    // 30° → −30° in 0.5° steps: pose 20 is the first beyond 20°... from the start, pose 0 is.
+    assert!(e.contains("pose 0"), "{e}");
+}
+
+#[test]
+fn a_straight_tilting_pass_takes_the_trapezoid_time_plus_the_filter() {
+    // 60 mm at 50 mm/s with 2000 mm/s²: L/v + v/a = 1.225 s, the velocity-and-acceleration
+    // optimum of the tip alone (the joints' limits do not bind on this pass). The jerk
+    // filter adds its own length, 25 ms.
+    let (s, plan) = plan(
+        &tilting_pass(0.0),
+        &JointLimits::default(),
+        &PathLimits::at_feed(50.0),
+    );
+    let optimum = 60.0 / 50.0 + 50.0 / 2000.0;
+    let duration = (s.len() - 1) as f64 * TS;
+    assert!((plan.report().duration - duration).abs() < 1e-12);
+    assert!(
+        duration <= 1.1 * optimum,
+        "{duration} s against {optimum} s"
+    );
+    assert!(
+        duration >= optimum,
+        "{duration} s is faster than the optimum {optimum} s"
+    );
+    // The plan's own optimum agrees with the trapezoid to its grid.
+    let own = plan.report().unfiltered_duration;
+    assert!((own / optimum - 1.0).abs() < 0.02, "{own}");
+}
