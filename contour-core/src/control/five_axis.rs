@@ -29,9 +29,7 @@ use super::pid::{Pid, PidGains};
 use crate::contour::five_axis::evaluation_online::{OnlineEvaluation, PointEvaluation};
 use crate::contour::five_axis::hmm::HmmParams;
 use crate::contour::five_axis::hmm_online::OnlineMapper;
-use crate::contour::five_axis::pose_error::{
-    foot_point_error_between, nearest_segment_near, PoseError,
-};
+use crate::contour::five_axis::pose_error::{foot_near, PoseError};
 use crate::geometry::{self, Vector};
 use crate::kinematics::{damped_least_squares, Joints, Pose, TableTiltingAc};
 
@@ -289,19 +287,11 @@ impl FiveAxisController {
         let pose = machine.forward(actual);
         let segment = self.mapper.push_sample(pose.tip, pose.axis);
         let mapper = &self.mapper;
+        // The foot may lie past the newest reference point: the reference is continued
+        // there (docs/design/five-axis.md §5.3).
         let foot = segment
-            .map(|j| nearest_segment_near(|i| mapper.segment(i), j, &pose.tip))
-            .and_then(|j| mapper.segment(j).map(|s| (j, s)))
-            .and_then(|(j, (r0, r1))| {
-                let tangent = geometry::unit(&(r1.tip - r0.tip)).unwrap_or_else(Vector::zeros);
-                let before = j
-                    .checked_sub(1)
-                    .and_then(|i| mapper.segment(i))
-                    .map(|s| s.0);
-                let after = mapper.segment(j + 1).map(|s| s.1);
-                foot_point_error_between(before.as_ref(), &r0, &r1, after.as_ref(), &pose)
-                    .map(|e| (e, tangent))
-            });
+            .and_then(|j| foot_near(|i| mapper.extended_segment(i), j, &pose))
+            .map(|(_, e, tangent)| (e, tangent));
         let error = foot.map(|(e, _)| e);
         let evaluation = if self.config.evaluate {
             self.evaluation

@@ -166,6 +166,51 @@ impl OnlineMapper {
         })
     }
 
+    /// Reference point `i` while it is held, or, up to [`AHEAD`] points past the newest,
+    /// the reference continued with the newest chord's turn and the newest axis step
+    /// (none beyond that, or with fewer than two points).
+    ///
+    /// The measured tool can be ahead of the newest reference sample the controller has
+    /// (a reference that arrives a few samples late, an offset along the path): its foot
+    /// then lies past the end, where the held points alone would clamp it to the newest
+    /// point and give the newest segment a chord for the tangent at its far end. A path
+    /// sampled at a steady feed continues, over a chord or two, much as its last chords
+    /// turn: on a circle with equal chords and an axis turning evenly the continuation is
+    /// exact.
+    pub fn extended_point(&self, i: usize) -> Option<Pose> {
+        let newest = self.references.checked_sub(1)?;
+        if i <= newest {
+            return self.point(i);
+        }
+        let steps = i - newest;
+        if steps > AHEAD || newest == 0 {
+            return None;
+        }
+        let at = |i: usize| (self.tips[i & self.mask], self.axes[i & self.mask]);
+        let ((r0, o0), (r1, o1)) = (at(newest - 1), at(newest));
+        let chord = r1 - r0;
+        // The turn from the chord before to the newest one (none with two points).
+        let turn = match newest.checked_sub(2).and_then(|i| self.point(i)) {
+            Some(p) => Rotation::between(&(r0 - p.tip), &chord),
+            None => Rotation::NONE,
+        };
+        let mut tip = r1;
+        for step in 1..=steps {
+            tip += turn.apply(&chord, step as f64);
+        }
+        let axis = Rotation::between(&o0, &o1).apply(&o1, steps as f64);
+        Some(Pose { tip, axis })
+    }
+
+    /// Segment `j` with [`OnlineMapper::extended_point`]'s ends: held, or continued past
+    /// the newest point.
+    pub fn extended_segment(&self, j: usize) -> Option<(Pose, Pose)> {
+        Some((
+            self.extended_point(j)?,
+            self.extended_point(j.checked_add(1)?)?,
+        ))
+    }
+
     /// Reference points pushed so far.
     pub fn references(&self) -> usize {
         self.references
@@ -278,6 +323,42 @@ impl OnlineMapper {
     }
 }
 
+/// How many reference points [`OnlineMapper::extended_point`] continues past the newest.
+pub const AHEAD: usize = 3;
+
+/// A rotation about a unit axis, applied as a multiple of its angle (Rodrigues).
+#[derive(Clone, Copy, Debug)]
+struct Rotation {
+    axis: Vector<3>,
+    angle: f64,
+}
+
+impl Rotation {
+    const NONE: Rotation = Rotation {
+        axis: Vector::<3>::new(0.0, 0.0, 1.0),
+        angle: 0.0,
+    };
+
+    /// The least rotation turning the direction of `a` into that of `b` (none when
+    /// either is zero or they are parallel: nothing to continue, or no unique plane).
+    fn between(a: &Vector<3>, b: &Vector<3>) -> Rotation {
+        match geometry::unit(&a.cross(b)) {
+            Some(axis) => Rotation {
+                axis,
+                angle: geometry::angle_between(a, b),
+            },
+            None => Rotation::NONE,
+        }
+    }
+
+    /// `v` turned by `times` the angle.
+    fn apply(&self, v: &Vector<3>, times: f64) -> Vector<3> {
+        let (s, c) = (self.angle * times).sin_cos();
+        let k = &self.axis;
+        v * c + k.cross(v) * s + k * (k.dot(v) * (1.0 - c))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -299,6 +380,80 @@ mod tests {
             })
             .collect();
         (tips, axes)
+    }
+
+    #[test]
+    fn past_the_newest_point_a_circle_and_an_evenly_turning_axis_continue_exactly() {
+        // Chords of 0.03 rad on a circle of radius 1 mm tilted out of the x–y plane, the
+        // axis turning 0.002 rad a point along a great circle: the three points past the
+        // newest are the circle's and the axis's next ones.
+        let (radius, step, turn) = (1.0, 0.03, 0.002);
+        let (u, w) = (
+            V3::new(1.0, 0.0, 0.0),
+            geometry::unit(&V3::new(0.0, 0.8, 0.6)).unwrap(),
+        );
+        let start = geometry::unit(&V3::new(0.1, 0.2, 1.0)).unwrap();
+        let about = geometry::unit(&start.cross(&V3::new(0.3, -1.0, 0.2))).unwrap();
+        let pose = |i: usize| {
+            let phi = step * i as f64;
+            let tip = (u * phi.cos() + w * phi.sin()) * radius + V3::new(5.0, -2.0, 1.0);
+            let axis = Rotation {
+                axis: about,
+                angle: turn,
+            }
+            .apply(&start, i as f64);
+            Pose { tip, axis }
+        };
+        let mut mapper = OnlineMapper::new(
+            HmmParams {
+                max_skip: 3,
+                angle_weight: 0.5,
+            },
+            100.0,
+            8,
+            2,
+        );
+        assert!(mapper.extended_point(0).is_none());
+        mapper.push_reference(pose(0).tip, pose(0).axis);
+        assert!(
+            mapper.extended_point(1).is_none(),
+            "one point: nothing to continue"
+        );
+        for i in 1..20 {
+            mapper.push_reference(pose(i).tip, pose(i).axis);
+        }
+        for i in 11..=22 {
+            let (got, want) = (mapper.extended_point(i).unwrap(), pose(i));
+            let off = geometry::dist(&got.tip, &want.tip);
+            assert!(off < 1e-13, "point {i}: tip off by {off}");
+            let off = geometry::angle_between(&got.axis, &want.axis);
+            assert!(off < 1e-13, "point {i}: axis off by {off}");
+        }
+        // Held points are as pushed; beyond AHEAD, or before the band, nothing.
+        assert_eq!(mapper.extended_point(19), mapper.point(19));
+        assert!(mapper.extended_point(19 + AHEAD + 1).is_none());
+        assert!(mapper.extended_point(10).is_none());
+        assert_eq!(
+            mapper.extended_segment(20).map(|(a, _)| a),
+            mapper.extended_point(20)
+        );
+        assert!(mapper.extended_segment(19 + AHEAD).is_none());
+
+        // With two points, the continuation is straight.
+        let mut two = OnlineMapper::new(
+            HmmParams {
+                max_skip: 3,
+                angle_weight: 0.5,
+            },
+            100.0,
+            8,
+            2,
+        );
+        two.push_reference(V3::zeros(), V3::z());
+        two.push_reference(V3::new(0.03, 0.0, 0.0), V3::z());
+        let next = two.extended_point(3).unwrap();
+        assert!((next.tip - V3::new(0.09, 0.0, 0.0)).amax() < 1e-15);
+        assert_eq!(next.axis, V3::z());
     }
 
     #[test]

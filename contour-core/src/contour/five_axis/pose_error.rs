@@ -77,14 +77,27 @@ pub fn foot_point_error_between(
     actual: &Pose,
 ) -> Option<PoseError> {
     let chord = foot_point_error(r0, r1, actual)?;
+    match swept_fraction(before, r0, r1, after, &actual.tip) {
+        Some(fraction) if (0.0..=1.0).contains(&fraction) => errors_at(r0, r1, fraction, actual),
+        _ => Some(chord),
+    }
+}
+
+/// Where the normal plane swept from r0 to r1 passes through `tip`, as a fraction of the
+/// segment — unclamped: below 0 or above 1 the foot lies on a neighbouring segment.
+/// `None` when a tangent is undefined or the plane never passes through the tip.
+fn swept_fraction(
+    before: Option<&Pose>,
+    r0: &Pose,
+    r1: &Pose,
+    after: Option<&Pose>,
+    tip: &Vector<3>,
+) -> Option<f64> {
     let d = r1.tip - r0.tip;
-    let t0 = geometry::unit(&before.map_or(d, |b| r1.tip - b.tip));
-    let t1 = geometry::unit(&after.map_or(d, |a| a.tip - r0.tip));
-    let (Some(t0), Some(t1)) = (t0, t1) else {
-        return Some(chord);
-    };
+    let t0 = geometry::unit(&before.map_or(d, |b| r1.tip - b.tip))?;
+    let t1 = geometry::unit(&after.map_or(d, |a| a.tip - r0.tip))?;
     // g(f) = (P − r0 − f·d)·(t0 + f·(t1 − t0)) = c + b·f + a·f², zero at the foot.
-    let w = actual.tip - r0.tip;
+    let w = tip - r0.tip;
     let dt = t1 - t0;
     let (a, b, c) = (-d.dot(&dt), w.dot(&dt) - d.dot(&t0), w.dot(&t0));
     let fraction = if a.abs() <= 1e-12 * b.abs() {
@@ -93,14 +106,61 @@ pub fn foot_point_error_between(
         // The root that tends to −c/b as the bend vanishes (a → 0).
         let disc = b * b - 4.0 * a * c;
         if disc < 0.0 {
-            return Some(chord);
+            return None;
         }
         2.0 * c / (-b - b.signum() * disc.sqrt())
     };
-    if !(0.0..=1.0).contains(&fraction) {
-        return Some(chord);
+    fraction.is_finite().then_some(fraction)
+}
+
+/// The per-sample errors of `actual` for control (docs/design/five-axis.md §5.3): from the
+/// mapped segment `mapped`, the segment under the tip ([`nearest_segment_near`]) and on it
+/// the foot of the swept normal plane ([`foot_point_error_between`], tangents from the
+/// neighbouring points). Returns the segment, its errors and its unit chord direction;
+/// `None` when `mapped` is not held or an input is not finite.
+///
+/// Off a bend, the tip may lie where the two chords meeting at a vertex are equally near
+/// (both feet clamped to the vertex): the walk keeps whichever it reached first, and the
+/// swept plane may pass through the tip on the other one. Its fraction then falls outside
+/// 0 … 1, and the foot is taken on the neighbour it points to rather than at the vertex:
+/// clamped there it would lie up to d·θ/2 off (d the error, θ the chord's turn), and the
+/// orientation at it off by that much travel.
+pub fn foot_near(
+    segment: impl Fn(usize) -> Option<(Pose, Pose)>,
+    mapped: usize,
+    actual: &Pose,
+) -> Option<(usize, PoseError, Vector<3>)> {
+    // Segment i's errors at its swept foot, if the plane passes through the tip on it;
+    // else the fraction where it does.
+    let on = |i: usize| -> Option<Result<(PoseError, Vector<3>), f64>> {
+        let (r0, r1) = segment(i)?;
+        let before = i.checked_sub(1).and_then(&segment).map(|s| s.0);
+        let after = i.checked_add(1).and_then(&segment).map(|s| s.1);
+        let f = swept_fraction(before.as_ref(), &r0, &r1, after.as_ref(), &actual.tip)?;
+        if !(0.0..=1.0).contains(&f) {
+            return Some(Err(f));
+        }
+        errors_at(&r0, &r1, f, actual).map(|e| Ok((e, chord_direction(&r0, &r1))))
+    };
+    let j = nearest_segment_near(&segment, mapped, &actual.tip);
+    let (r0, r1) = segment(j)?;
+    // The chord's errors: the finiteness check, and the fallback.
+    let chord = foot_point_error(&r0, &r1, actual)?;
+    let neighbour = match on(j) {
+        Some(Ok((e, tangent))) => return Some((j, e, tangent)),
+        Some(Err(f)) if f < 0.0 => j.checked_sub(1),
+        Some(Err(_)) => j.checked_add(1),
+        None => None,
+    };
+    if let Some((i, Some(Ok((e, tangent))))) = neighbour.map(|i| (i, on(i))) {
+        return Some((i, e, tangent));
     }
-    errors_at(r0, r1, fraction, actual)
+    Some((j, chord, chord_direction(&r0, &r1)))
+}
+
+/// The unit direction from r0's tip to r1's (zero for a point segment).
+fn chord_direction(r0: &Pose, r1: &Pose) -> Vector<3> {
+    geometry::unit(&(r1.tip - r0.tip)).unwrap_or_else(Vector::zeros)
 }
 
 /// The segment nearest the tip `tip` among the neighbours of the mapped segment
@@ -221,6 +281,47 @@ mod tests {
         // where the chord projection is off by up to 0.5·0.3 mm·0.01 rad of travel.
         assert!(worst.0 < 1e-7, "{worst:?}");
         assert!(worst.1 > 1e-6, "{worst:?}");
+    }
+
+    #[test]
+    fn beside_a_vertex_the_foot_is_taken_where_the_swept_plane_meets_the_tip() {
+        // Chords of 0.03 rad on a circle of radius 1 mm, the tool axis tilting by half the
+        // arc angle; tips 0.06 mm outside, across the vertex between segments 10 and 11
+        // where both chords' nearest points are the vertex. Mapped from either side the
+        // walk may stop on the chord the swept plane does not cross at the tip: clamped to
+        // the vertex there, the foot is off by the tip's angle from it (up to 7.5·10⁻⁴ rad
+        // here) and the orientation by half that; taken on the neighbour it is the true
+        // foot.
+        let (radius, step, offset) = (1.0, 0.03, 0.06);
+        let pose = |phi: f64| Pose {
+            tip: V3::new(phi.cos(), phi.sin(), 0.0) * radius,
+            axis: V3::new((0.5 * phi).sin(), 0.0, (0.5 * phi).cos()),
+        };
+        let segment =
+            |i: usize| (i < 30).then(|| (pose(step * i as f64), pose(step * (i + 1) as f64)));
+        let (mut worst, mut worst_before) = (0.0f64, 0.0f64);
+        for k in -50..=50 {
+            let phi = step * (11.0 + k as f64 / 2000.0);
+            let actual = Pose {
+                tip: V3::new(phi.cos(), phi.sin(), 0.0) * (radius + offset),
+                axis: V3::z(),
+            };
+            let truth = 0.5 * phi;
+            for mapped in [8, 13] {
+                let (_, e, _) = foot_near(segment, mapped, &actual).unwrap();
+                worst = worst.max((e.orientation - truth).abs());
+                assert!((geometry::norm(&e.tip) - offset).abs() < 2e-4);
+                // The walk and the swept plane alone, as before.
+                let j = nearest_segment_near(segment, mapped, &actual.tip);
+                let (r0, r1) = segment(j).unwrap();
+                let (before, after) = (segment(j - 1).unwrap().0, segment(j + 1).unwrap().1);
+                let e = foot_point_error_between(Some(&before), &r0, &r1, Some(&after), &actual)
+                    .unwrap();
+                worst_before = worst_before.max((e.orientation - truth).abs());
+            }
+        }
+        assert!(worst < 1e-7, "{worst}");
+        assert!(worst_before > 2e-4, "{worst_before}");
     }
 
     #[test]
