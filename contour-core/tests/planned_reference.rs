@@ -172,6 +172,10 @@ fn check_all(
         axis <= limits.orientation_tolerance * (1.0 + 1e-6),
         "{what}: axis {axis} rad off"
     );
+    // It rests exactly on the path's end: the last node's joints, to the last bit.
+    let end = plan.joint_path().joints.last().copied().unwrap();
+    assert_eq!(s[s.len() - 1].joints, end, "{what}");
+    assert!((s[s.len() - 1].pose.tip - cl[cl.len() - 1].tip).amax() < 1e-12);
     let report = plan.report();
     eprintln!("{what}: {report:?}, brute force tip {tip:.3e} axis {axis:.3e}");
     // The plan's own measure of its deviation is the brute force's.

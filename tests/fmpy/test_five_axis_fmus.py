@@ -337,7 +337,8 @@ def test_a_cl_axis_far_from_unit_is_normalised_with_a_warning(interpolator, tmp_
     interpolator.set(path=str(part), feed=10.0)
     interpolator.fmu.exitInitializationMode()
     assert any("tilted.cl" in m for m in interpolator.log.warnings()), interpolator.log.messages
-    interpolator.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1.0)
+    # 10 mm at 10 mm/s, planned: a second and the ramps.
+    interpolator.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=2.0)
     # At the end: the tip at x = 10 and the axis (0, 1, 1)/√2, so A = 45° and C = 0.
     x, y, z, a, c = interpolator.reals(REF)
     assert abs(a - math.pi / 4) < 1e-12 and abs(c) < 1e-12
@@ -347,7 +348,8 @@ def test_a_cl_file_in_the_fmus_resources_folder_is_found_by_its_relative_name(in
     resources = Path(interpolator.dir) / "resources"
     resources.mkdir(exist_ok=True)
     (resources / "line.cl").write_text("GOTO/1,2,3,0,0,1\nGOTO/5,2,3,0,0,1\n")
-    interpolator.set(path="line.cl", feed=2.0)
+    # At constant feed (no plan), so that the second's travel is exact.
+    interpolator.set(path="line.cl", feed=2.0, accel=0.0)
     interpolator.fmu.exitInitializationMode()
     assert np.allclose(interpolator.reals(REF), [1, 2, 3, 0, 0])
     interpolator.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1.0)

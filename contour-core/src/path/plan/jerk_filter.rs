@@ -5,9 +5,10 @@
 //! acceleration ΔA becomes a ramp of jerk ΔA/(m1·Ts), and the one-sample spike a small
 //! kink of the path gives is spread over (m1 + m2)·Ts.
 //!
-//! The sums are kept exact, in integers of 2⁻³⁰ (about 1 pm or 1 nrad): the filter costs
-//! O(1) per sample, never drifts however long the path, and a restored state continues
-//! bit for bit.
+//! The sums are kept exact, in integers of 2⁻³⁰ (about 1 pm or 1 nrad) from an origin
+//! (the path's end, which the filter therefore reaches exactly): the filter costs O(1) per
+//! sample, never drifts however long the path, and a restored state continues bit for
+//! bit.
 
 use serde::{Deserialize, Serialize};
 
@@ -29,6 +30,8 @@ pub struct JerkFilter<const D: usize> {
     second: Vec<i128>,
     /// The next slot of each ring, in samples.
     at: (usize, usize),
+    /// What the quanta count from.
+    origin: Vec<f64>,
 }
 
 fn quantise(v: f64) -> i128 {
@@ -37,10 +40,10 @@ fn quantise(v: f64) -> i128 {
 
 impl<const D: usize> JerkFilter<D> {
     /// A filter of `m1` then `m2` samples (each ≥ 1; 1 passes samples through) at rest at
-    /// `start`.
-    pub fn new(m1: usize, m2: usize, start: &Vector<D>) -> Self {
+    /// `start`, counting from `origin` (a sample equal to it comes out exactly).
+    pub fn new(m1: usize, m2: usize, start: &Vector<D>, origin: &Vector<D>) -> Self {
         let (m1, m2) = (m1.max(1), m2.max(1));
-        let q: Vec<i128> = start.iter().map(|&v| quantise(v)).collect();
+        let q: Vec<i128> = (0..D).map(|d| quantise(start[d] - origin[d])).collect();
         let first: Vec<i128> = q.iter().map(|v| v * m1 as i128).collect();
         JerkFilter {
             raw: q.repeat(m1),
@@ -48,6 +51,7 @@ impl<const D: usize> JerkFilter<D> {
             second: first.iter().map(|v| v * m2 as i128).collect(),
             first,
             at: (0, 0),
+            origin: origin.iter().copied().collect(),
         }
     }
 
@@ -61,7 +65,7 @@ impl<const D: usize> JerkFilter<D> {
         let (m1, m2) = self.lengths();
         let (i, j) = self.at;
         for d in 0..D {
-            let q = quantise(sample[d]);
+            let q = quantise(sample[d] - self.origin[d]);
             self.first[d] += q - self.raw[i * D + d];
             self.raw[i * D + d] = q;
             self.second[d] += self.first[d] - self.sums[j * D + d];
@@ -75,7 +79,7 @@ impl<const D: usize> JerkFilter<D> {
     pub fn output(&self) -> Vector<D> {
         let (m1, m2) = self.lengths();
         let divisor = (m1 * m2) as f64 * SCALE;
-        Vector::<D>::from_fn(|d, _| self.second[d] as f64 / divisor)
+        Vector::<D>::from_fn(|d, _| self.origin[d] + self.second[d] as f64 / divisor)
     }
 
     /// Checks a filter restored from bytes: rings of whole samples, at least one each,
@@ -86,7 +90,9 @@ impl<const D: usize> JerkFilter<D> {
         let whole = self.raw.len() == m1 * D
             && self.sums.len() == m2 * D
             && self.first.len() == D
-            && self.second.len() == D;
+            && self.second.len() == D
+            && self.origin.len() == D
+            && self.origin.iter().all(|v| v.is_finite());
         if !whole || m1 == 0 || m2 == 0 || self.at.0 >= m1 || self.at.1 >= m2 {
             return Err("the jerk filter's rings are empty or its slots outside them".into());
         }
@@ -147,7 +153,7 @@ mod tests {
         }
         raw.extend(std::iter::repeat_n(p, 100));
         let (m1, m2) = (20, 10);
-        let mut filter = JerkFilter::new(m1, m2, &V1::new(3.0));
+        let mut filter = JerkFilter::new(m1, m2, &V1::new(3.0), &V1::new(p));
         let out: Vec<f64> = raw.iter().map(|&r| filter.push(&V1::new(r))[0]).collect();
         let reference = convolved(&raw, 3.0, m1, m2);
         for (o, r) in out.iter().zip(&reference) {
@@ -172,8 +178,9 @@ mod tests {
                 .fold(0.0, f64::max)
         };
         assert!(accel(&out) <= accel(&raw) * 1.0001);
-        // It ends at rest on the end, and the state continues bit for bit.
-        assert!((out[out.len() - 1] - p).abs() < 1e-9);
+        // It ends at rest exactly on the end (its origin), and the state continues bit
+        // for bit.
+        assert_eq!(out[out.len() - 1], p);
         let mut copy = filter.clone();
         copy.check().unwrap();
         for k in 0..50 {
@@ -184,7 +191,7 @@ mod tests {
 
     #[test]
     fn a_state_whose_sums_disagree_is_refused() {
-        let mut filter = JerkFilter::new(3, 2, &Vector::<2>::new(1.0, 2.0));
+        let mut filter = JerkFilter::new(3, 2, &Vector::<2>::new(1.0, 2.0), &Vector::<2>::zeros());
         filter.push(&Vector::<2>::new(1.5, 2.5));
         filter.check().unwrap();
         let mut bad = filter.clone();

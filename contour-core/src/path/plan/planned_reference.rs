@@ -397,10 +397,11 @@ impl Plan {
     /// The cursor at the first sample (the path's start, at rest).
     pub fn start(&self) -> Cursor {
         let (raw, _, _) = self.raw(0.0, 0);
+        let (end, _, _) = self.raw(self.feed.duration(), self.path.s.len() - 2);
         Cursor {
             sample: 0,
             interval: 0,
-            filter: JerkFilter::new(self.filter.0, self.filter.1, &raw),
+            filter: JerkFilter::new(self.filter.0, self.filter.1, &raw, &end),
             joints: self.path.joints[0],
             foot: 0,
         }
@@ -414,9 +415,17 @@ impl Plan {
         let (s0, s1) = (self.path.s[n], self.path.s[n + 1]);
         let f = ((point.s - s0) / (s1 - s0)).clamp(0.0, 1.0);
         let (a, b) = (&self.path.poses[n].tip, &self.path.poses[n + 1].tip);
-        let tip = a + (b - a) * f;
+        // At a node exactly the node (a + (b − a)·1 may round off b): the reference
+        // rests exactly on the path's end.
+        let tip = if f >= 1.0 { *b } else { a + (b - a) * f };
         let (qa, qb) = (&self.path.joints[n], &self.path.joints[n + 1]);
-        let rotary = |i: usize| qa[i] + (qb[i] - qa[i]) * f;
+        let rotary = |i: usize| {
+            if f >= 1.0 {
+                qb[i]
+            } else {
+                qa[i] + (qb[i] - qa[i]) * f
+            }
+        };
         let raw = Vector::<5>::new(tip[0], tip[1], tip[2], rotary(3), rotary(4));
         let source = self.path.source[n] + (self.path.source[n + 1] - self.path.source[n]) * f;
         (raw, n, source)
