@@ -149,7 +149,11 @@ fn joint_reference(
         let hint = super::path_interpolator_2d::resource_hint(spec, environment, &e);
         e + hint
     })?;
-    let reference = JointReference::new(path, machine, feed, ts).map_err(message)?;
+    // The file read, but its path cannot be followed: say which file.
+    let reference = JointReference::new(path, machine, feed, ts).map_err(|e| match e {
+        contour_core::path::PathError::Invalid(m) => format!("parameter 'path': {spec}: {m}"),
+        other => message(other),
+    })?;
     Ok((reference, warnings))
 }
 
