@@ -222,7 +222,7 @@ fn first_pieces(length: f64, chord: f64, budget: usize) -> Result<usize, PathErr
     }
     let pieces = (length / chord).ceil();
     // n pieces are n + 1 poses; NaN fails too.
-    if !(pieces < budget as f64) {
+    if pieces.is_nan() || pieces >= budget as f64 {
         return Err(PathError::invalid(format!(
             "the tip curve is {length:e} mm long: at chords of at most {chord} mm that takes \
              {pieces:e} poses, more than the {budget} a path may be sampled into"
@@ -605,7 +605,10 @@ mod tests {
             ToolPath::parse_json(&text.replace("1e308", &x.to_string()), "line.json").unwrap()
         };
         let e = line(5e5).poses(0.01).unwrap_err().to_string();
-        assert!(e.contains("is 1e6 mm long") && e.contains("takes 1e8 poses"), "{e}");
+        assert!(
+            e.contains("is 1e6 mm long") && e.contains("takes 1e8 poses"),
+            "{e}"
+        );
         assert_eq!(line(1.0).poses(0.25).map(|p| p.len()), Ok(9));
         assert_eq!(MAX_SAMPLED_POSES, 1 << 24);
     }
@@ -614,11 +617,17 @@ mod tests {
     fn the_pose_budget_counts_poses_not_pieces() {
         // n pieces are n + 1 poses: a budget of 2^24 takes at most 2^24 − 1 pieces.
         let budget = MAX_SAMPLED_POSES;
-        assert_eq!(first_pieces((budget - 1) as f64, 1.0, budget), Ok(budget - 1));
+        assert_eq!(
+            first_pieces((budget - 1) as f64, 1.0, budget),
+            Ok(budget - 1)
+        );
         assert!(first_pieces(budget as f64, 1.0, budget).is_err());
         assert_eq!(first_pieces(0.0, 0.01, budget), Ok(1));
         for (length, chord) in [(1.0, 0.0), (1.0, -1.0), (1.0, f64::NAN), (f64::NAN, 1.0)] {
-            assert!(first_pieces(length, chord, budget).is_err(), "{length} {chord}");
+            assert!(
+                first_pieces(length, chord, budget).is_err(),
+                "{length} {chord}"
+            );
         }
         // A tip that covers 999 of its 1000 mm in the last millionth of its parameter:
         // uniform samples need about 10^9 pieces for chords of 1 mm, so doubling stops at
