@@ -142,11 +142,12 @@ bench: fmus ccc-tune $(VENV)/.test-installed
 	-$(PYTHON) benches/campaign_scaling.py --json $(BENCH_REPORT)/campaign_scaling.json
 	$(PYTHON) benches/report.py
 
-# Every model's life cycle 10 000 times under valgrind's leak checker (hours on 2 cores).
+# Every model's life cycle 10 000 times under valgrind's full memcheck: leaks and
+# uninitialised values (hours on 2 cores).
 leak-check: valgrind
 	$(CARGO) build --release --example lifecycle
 	valgrind --leak-check=full --errors-for-leak-kinds=definite,indirect,possible \
-		--undef-value-errors=no --error-exitcode=1 target/release/examples/lifecycle 10000
+		--undef-value-errors=yes --error-exitcode=1 target/release/examples/lifecycle 10000
 
 # The paper's PSO claim at its full budget (about 10 minutes).
 pso-claim:

@@ -1,7 +1,8 @@
 //! `lifecycle N`: N full life cycles of every model through the C ABI — instantiate, set
 //! up, initialise, step with moving inputs, get the FMU state, serialise it, free it,
 //! deserialise it, set it, free it, terminate, free the instance — for a leak checker to
-//! watch (`valgrind --leak-check=full --error-exitcode=1`, tests/fmpy/test_leaks.py).
+//! watch (`valgrind --leak-check=full --error-exitcode=1`, uninitialised values on,
+//! tests/fmpy/test_leaks.py).
 //! Exits non-zero if any call fails.
 
 #[path = "../tests/abi/common/linked.rs"]

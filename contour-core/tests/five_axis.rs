@@ -190,6 +190,36 @@ fn ramp_config(mode: CccMode) -> FiveAxisConfig {
     FiveAxisConfig::DEFAULT.with_mode(mode)
 }
 
+/// The last reference pose is held with a flag (no uninitialised bytes for the optimised
+/// comparison to branch on) but saved as the `Option<Pose>` it was: `null` before the
+/// first sample, the forward kinematics of the reference after it, and back.
+#[test]
+fn the_last_reference_pose_is_saved_as_an_option() {
+    let config = ramp_config(CccMode::Fuzzy);
+    let mut controller = FiveAxisController::new(config).unwrap();
+    let fresh = serde_json::to_value(&controller).unwrap();
+    assert_eq!(fresh["last_reference"], serde_json::Value::Null);
+    // The state codec's format (JSON cannot hold the mapper's infinite costs).
+    let round_trip = |c: &FiveAxisController| -> FiveAxisController {
+        postcard::from_bytes(&postcard::to_stdvec(c).unwrap()).unwrap()
+    };
+    assert_eq!(round_trip(&controller), controller);
+    let q = Joints::new(1.0, 2.0, 3.0, 0.4, 0.1);
+    controller.sample(&q, &q).unwrap();
+    let saved = serde_json::to_value(&controller).unwrap();
+    let pose = config.machine.forward(&q);
+    assert_eq!(
+        saved["last_reference"],
+        serde_json::to_value(Some(pose)).unwrap()
+    );
+    assert_eq!(round_trip(&controller), controller);
+    controller.reset();
+    assert_eq!(
+        serde_json::to_value(&controller).unwrap()["last_reference"],
+        serde_json::Value::Null
+    );
+}
+
 #[test]
 fn a_non_finite_joint_is_refused_and_changes_nothing() {
     let mut a = FiveAxisController::new(ramp_config(CccMode::Fuzzy)).unwrap();

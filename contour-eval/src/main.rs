@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use contour_core::contour::five_axis::reference_shape::ReferenceShape;
 use contour_core::contour::five_axis::run_evaluation::{
     evaluate_run, suggested_max_skip, RunEvaluation, RunSettings,
 };
@@ -27,6 +28,7 @@ usage: contour-eval --path PART.cl|PART.apt|PART.json|tilted_helix|figure_eight
                     --measured RUN.csv --out ERR.csv [--out-reference REF.csv]
                     [--plot ERR.png] [--tool-length 100] [--pivot-a Y,Z] [--pivot-c X,Y]
                     [--max-skip K] [--angle-weight 0.1] [--window W]
+                    [--reference straight|smooth]
 
 Maps every measured sample to a segment of the reference (HMM, Viterbi) and reports the
 tool-tip and orientation contour errors of a table-tilting A-C machine.
@@ -42,6 +44,11 @@ tool-tip and orientation contour errors of a table-tilting A-C machine.
                  1.5 x the largest measured tip step over the median reference segment
   --angle-weight weight of the motion-direction term of the mapping, mm/rad
   --window       candidate segments per sample of the mapping; default max(64, 8 K)
+  --reference    what the errors are measured against: 'straight' (default) the
+                 straight moves between the reference points, the axis slerped along
+                 each, as CL data means; 'smooth' a G1 cubic through the points, the
+                 axis slerped by its parameter. Either way the tip error is the distance
+                 to the nearest point and the orientation error is taken there.
 A JSON reference is sampled into poses with tip chords of at most 0.01 mm.";
 
 /// Longest tip chord when a JSON reference's curves are sampled into poses, mm.
@@ -139,6 +146,11 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
             }
             "--angle-weight" => o.settings.params.angle_weight = number("--angle-weight")?,
             "--window" => o.window = Some(count("--window")?),
+            "--reference" => {
+                o.settings.reference = value
+                    .parse::<ReferenceShape>()
+                    .map_err(|e| format!("--reference: {e}"))?;
+            }
             other => return Err(format!("unknown option '{other}'")),
         }
     }
@@ -389,6 +401,13 @@ fn run(mut o: Options) -> Result<(), Failure> {
     println!(
         "mapping: max skip {}, window {} segments",
         o.settings.params.max_skip, o.settings.window
+    );
+    println!(
+        "reference read as: {}",
+        match o.settings.reference {
+            ReferenceShape::Straight => "straight moves between the points",
+            ReferenceShape::Smooth => "a smooth curve through the points",
+        }
     );
     println!("time: {:.2} s", started.elapsed().as_secs_f64());
     Ok(())

@@ -405,3 +405,156 @@ fn bad_inputs_fail_naming_the_cause_and_write_nothing() {
     assert!(ref_file.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--reference`: on CL points every 0.05 rad of a circle of radius 5 mm, a run 0.3 mm
+/// outside it. Read as straight moves the tip error is the distance to the chord
+/// (0.3 mm plus up to the 1.56 µm sagitta) and the axis is slerped at the chord
+/// projection; read as a smooth curve the tip error is the 0.3 mm to the circle (the
+/// curve keeps to it within 2.4e-7 mm). Straight is the default.
+#[test]
+fn the_reference_is_read_as_straight_moves_unless_smooth_is_asked_for() {
+    let dir = scratch("shape");
+    let (radius, step, outside) = (5.0, 0.05, 5.3);
+    // The tool leans in the x–z plane by 0.3 + 0.5·φ: a great circle, so slerping
+    // between two points turns it linearly in φ.
+    let lean = |phi: f64| 0.3 + 0.5 * phi;
+    let axis = |phi: f64| V3::new(lean(phi).sin(), 0.0, lean(phi).cos());
+    let mut cl = String::from("PARTNO/ARC\n");
+    for i in 0..=16 {
+        let phi = step * i as f64;
+        let o = axis(phi);
+        writeln!(
+            cl,
+            "GOTO/{},{},0,{},{},{}",
+            radius * phi.cos(),
+            radius * phi.sin(),
+            o[0],
+            o[1],
+            o[2]
+        )
+        .unwrap();
+    }
+    // 240 samples from φ = 0.2 to 0.6 (chords 4 … 11), the tool leaning as the curve's.
+    let machine = TableTiltingAc::default();
+    let mut csv = String::from("time,X,Y,Z,A,C\n");
+    let mut expected = Vec::new();
+    let mut c = 0.0;
+    for k in 0..240 {
+        let phi = 0.2 + 0.4 * k as f64 / 239.0;
+        let tip = V3::new(phi.cos(), phi.sin(), 0.0) * outside;
+        let q = machine
+            .inverse(
+                &Pose {
+                    tip,
+                    axis: axis(phi),
+                },
+                c,
+            )
+            .unwrap();
+        c = q[4];
+        writeln!(
+            csv,
+            "{},{},{},{},{},{}",
+            k as f64 * 1e-3,
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4]
+        )
+        .unwrap();
+        // The straight reading by hand: the nearest point over all chords (projections
+        // clamped to them; outside a vertex that is the vertex).
+        let (distance, orientation) = (0..16)
+            .map(|i| {
+                let (a, b) = (step * i as f64, step * (i + 1) as f64);
+                let (pa, pb) = (
+                    V3::new(a.cos(), a.sin(), 0.0) * radius,
+                    V3::new(b.cos(), b.sin(), 0.0) * radius,
+                );
+                let f = ((tip - pa).dot(&(pb - pa)) / (pb - pa).norm_squared()).clamp(0.0, 1.0);
+                let distance = geometry::norm(&(pa + (pb - pa) * f - tip));
+                (distance, 0.5 * (phi - (a + f * step)).abs())
+            })
+            .min_by(|x, y| x.0.total_cmp(&y.0))
+            .unwrap();
+        expected.push((distance, orientation));
+    }
+    let (part, run) = (dir.join("arc.cl"), dir.join("run.csv"));
+    std::fs::write(&part, cl).unwrap();
+    std::fs::write(&run, csv).unwrap();
+    let evaluate = |name: &str, extra: &[&str]| {
+        let out = dir.join(name);
+        let mut args = vec!["--path", s(&part), "--measured", s(&run), "--out", s(&out)];
+        args.extend(extra);
+        let done = contour_eval(&args);
+        let stdout = String::from_utf8_lossy(&done.stdout).into_owned();
+        assert!(
+            done.status.success(),
+            "{}",
+            String::from_utf8_lossy(&done.stderr)
+        );
+        let values: Vec<(f64, f64)> = rows(&out)[1..]
+            .iter()
+            .map(|r| (r[2].parse().unwrap(), r[3].parse().unwrap()))
+            .collect();
+        (std::fs::read_to_string(&out).unwrap(), values, stdout)
+    };
+    let (default_text, _, stdout) = evaluate("default.csv", &[]);
+    assert!(
+        stdout.contains("reference read as: straight moves between the points"),
+        "{stdout}"
+    );
+    let (straight_text, straight, _) = evaluate("straight.csv", &["--reference", "straight"]);
+    assert_eq!(default_text, straight_text);
+    let (_, smooth, stdout) = evaluate("smooth.csv", &["--reference", "smooth"]);
+    assert!(
+        stdout.contains("reference read as: a smooth curve through the points"),
+        "{stdout}"
+    );
+    let mut apart: f64 = 0.0;
+    for (k, ((st, so), (&(tip, orientation), (mt, mo)))) in straight
+        .iter()
+        .zip(expected.iter().zip(&smooth))
+        .enumerate()
+    {
+        assert!(
+            (st - tip).abs() < 1e-12,
+            "sample {k}: straight tip {st} vs {tip}"
+        );
+        assert!(
+            (so - orientation).abs() < 1e-12,
+            "sample {k}: straight orientation {so} vs {orientation}"
+        );
+        assert!((mt - 0.3).abs() < 3e-7, "sample {k}: smooth tip {mt}");
+        // The smooth curve's parameter runs within 0.1 % of the angle: the axis is
+        // within 0.5·0.05·1e-3 rad of the tool's.
+        assert!(*mo < 2.5e-5, "sample {k}: smooth orientation {mo}");
+        apart = apart.max(st - mt);
+    }
+    // Near the chords' middles the readings are a sagitta (1.56 µm) apart.
+    let sagitta = radius * (1.0 - (step / 2.0).cos());
+    assert!(
+        apart > 0.99 * sagitta && apart < sagitta + 3e-7,
+        "{apart} vs {sagitta}"
+    );
+    // An unknown reading is a command-line mistake.
+    let done = contour_eval(&[
+        "--path",
+        s(&part),
+        "--measured",
+        s(&run),
+        "--out",
+        s(&dir.join("x.csv")),
+        "--reference",
+        "curved",
+    ]);
+    let stderr = String::from_utf8_lossy(&done.stderr);
+    assert_eq!(done.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr
+            .contains("--reference: unknown reference shape 'curved': expected straight or smooth"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -32,7 +32,7 @@ fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
         let _ = path.pose_at(u);
     }
     // The vertices themselves: no sampling for a pose path.
-    assert_eq!(path.poses(0.01).len(), cl.poses.len());
+    assert_eq!(path.poses(0.01).map(|p| p.len()), Ok(cl.poses.len()));
     let feed = (tips.length() / (SAMPLES as f64 * 1e-3)).clamp(1e-3, 1e6);
     if let Ok(mut reference) = JointReference::new(path, TableTiltingAc::default(), feed, 1e-3) {
         for _ in 0..SAMPLES {

@@ -310,7 +310,13 @@ impl Model for PathInterpolator5X {
             ts,
             &name,
         )
-        .map_err(|e| format!("parameter 'path': {e}"))?;
+        // The file read, but its path cannot be followed: say which file.
+        .map_err(|e| match e {
+            contour_core::path::PathError::Invalid(m) => {
+                format!("parameter 'path': {}: {m}", PATH.get(values).trim())
+            }
+            other => format!("parameter 'path': {other}"),
+        })?;
         self.warnings = programmed
             .warnings
             .into_iter()

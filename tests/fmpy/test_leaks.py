@@ -1,12 +1,8 @@
-"""Every model's whole life cycle through the C ABI under valgrind's leak checker:
+"""Every model's whole life cycle through the C ABI under valgrind's full memcheck:
 instantiate, initialise, step, get / serialise / free / deserialise / set / free the FMU
 state, terminate, free (examples/lifecycle.rs). A short run here; the long one (10 000
-cycles) is `make leak-check`.
-
-Leaks only (`--undef-value-errors=no`): on the optimised build memcheck reports a
-conditional jump on uninitialised bytes inside FiveAxisController::sample that the debug
-build does not show (LLVM comparing an enum's padding); uninitialised reads are the
-sanitizers' business."""
+cycles) is `make leak-check`. Leaks and uninitialised values both count: any memcheck
+error fails the run (docs/design/testing.md §6)."""
 
 import shutil
 import subprocess
@@ -25,8 +21,8 @@ def test_life_cycles_of_every_model_leak_nothing():
     program = target_dir() / "release" / "examples" / "lifecycle"
     done = subprocess.run(
         ["valgrind", "--leak-check=full", "--show-leak-kinds=definite,indirect,possible",
-         "--errors-for-leak-kinds=definite,indirect,possible", "--undef-value-errors=no",
-         "--error-exitcode=1", str(program), str(CYCLES)],
+         "--errors-for-leak-kinds=definite,indirect,possible", "--undef-value-errors=yes",
+         "--track-origins=yes", "--error-exitcode=1", str(program), str(CYCLES)],
         capture_output=True, text=True, timeout=900)
     assert done.returncode == 0, done.stderr[-4000:]
     assert "ERROR SUMMARY: 0 errors" in done.stderr, done.stderr[-2000:]

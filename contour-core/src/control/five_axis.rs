@@ -226,7 +226,52 @@ pub struct FiveAxisController {
     mapper: OnlineMapper,
     evaluation: OnlineEvaluation,
     /// The last reference pose given to the mapper.
-    last_reference: Option<Pose>,
+    last_reference: LastReference,
+}
+
+/// The last reference pose given to the mapper, if any; saved as an `Option<Pose>`.
+///
+/// Not held as an `Option<Pose>`: the optimised `last != Some(wanted)` compares the
+/// payload before the tag, and the payload of a `None` is uninitialised bytes, so the
+/// first sample branched on them (valgrind's memcheck reported it). Here every byte
+/// compared is written.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(from = "Option<Pose>", into = "Option<Pose>")]
+struct LastReference {
+    /// Zero while `held` is false.
+    pose: Pose,
+    held: bool,
+}
+
+impl LastReference {
+    fn none() -> Self {
+        LastReference {
+            pose: Pose {
+                tip: Vector::zeros(),
+                axis: Vector::zeros(),
+            },
+            held: false,
+        }
+    }
+
+    fn get(&self) -> Option<&Pose> {
+        self.held.then_some(&self.pose)
+    }
+}
+
+impl From<Option<Pose>> for LastReference {
+    fn from(pose: Option<Pose>) -> Self {
+        pose.map_or_else(LastReference::none, |pose| LastReference {
+            pose,
+            held: true,
+        })
+    }
+}
+
+impl From<LastReference> for Option<Pose> {
+    fn from(last: LastReference) -> Self {
+        last.get().copied()
+    }
 }
 
 impl FiveAxisController {
@@ -243,7 +288,7 @@ impl FiveAxisController {
                 .map_err(|e| e.with_parameter(Parameter::orientation(e.parameter)))?,
             mapper: mapper(&config),
             evaluation: OnlineEvaluation::new(config.hmm.max_skip, config.lag),
-            last_reference: None,
+            last_reference: LastReference::none(),
             config,
         })
     }
@@ -280,9 +325,9 @@ impl FiveAxisController {
         // A reference that stands still (before the start, after the end, in a dwell)
         // adds no segment: zero-length segments would crowd the band and pull the
         // mapping onto the standing point.
-        if self.last_reference != Some(wanted) {
+        if self.last_reference.get() != Some(&wanted) {
             self.mapper.push_reference(wanted.tip, wanted.axis);
-            self.last_reference = Some(wanted);
+            self.last_reference = Some(wanted).into();
         }
         let pose = machine.forward(actual);
         let segment = self.mapper.push_sample(pose.tip, pose.axis);
@@ -371,7 +416,7 @@ impl FiveAxisController {
         self.evaluation
             .check(c.hmm.max_skip, c.lag)
             .map_err(|e| format!("evaluation: {e}"))?;
-        if let Some(p) = &self.last_reference {
+        if let Some(p) = self.last_reference.get() {
             if !(geometry::is_finite(&p.tip) && geometry::is_finite(&p.axis)) {
                 return Err("the last reference pose is not finite".into());
             }
@@ -387,6 +432,6 @@ impl FiveAxisController {
         self.orientation.reset();
         self.mapper = mapper(&self.config);
         self.evaluation = OnlineEvaluation::new(self.config.hmm.max_skip, self.config.lag);
-        self.last_reference = None;
+        self.last_reference = LastReference::none();
     }
 }

@@ -49,6 +49,7 @@ impl FiveAxisReference {
         ts: f64,
         name: &dyn Fn(usize) -> String,
     ) -> Result<Self, PathError> {
+        super::joint_reference::check_length(&path)?;
         if limits.accel > 0.0 {
             let inputs = PlanInputs {
                 path,

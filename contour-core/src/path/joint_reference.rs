@@ -45,6 +45,22 @@ pub struct JointReference {
     joints: Joints,
 }
 
+/// Refuses a path whose tip length overflows (control points or CL records near ±1e308):
+/// the interpolator would crawl along it for ever at outputs of 1e308 mm.
+pub(crate) fn check_length(path: &ToolPath) -> Result<(), PathError> {
+    let length = match path {
+        ToolPath::Curves { tip, .. } => tip.length(),
+        ToolPath::Poses { tips, .. } => tips.length(),
+    };
+    if length.is_finite() {
+        Ok(())
+    } else {
+        Err(PathError::invalid(format!(
+            "the tip's path is {length} mm long: no feed follows it (a point near ±1e308?)"
+        )))
+    }
+}
+
 impl JointReference {
     /// Starts at the path's start with `feed` (mm/s, ≥ 0) every `ts` seconds; the start
     /// C is the one nearest 0.
@@ -54,6 +70,7 @@ impl JointReference {
         feed: f64,
         ts: f64,
     ) -> Result<Self, PathError> {
+        check_length(&path)?;
         let tip = match &path {
             ToolPath::Curves { tip, .. } => {
                 TipInterpolator::Curve(Interpolator::new(tip.clone(), feed, ts)?)
@@ -251,6 +268,7 @@ impl JointReference {
             RestoredPath::Builtin(name) => (ToolPath::builtin(&name)?, Some(name)),
             RestoredPath::Data(path) => (path, None),
         };
+        check_length(&path)?;
         let tip = match (saved.tip, &path) {
             (TipProgress::Curve(p), ToolPath::Curves { tip, .. }) => {
                 TipInterpolator::Curve(Interpolator::resume(tip.clone(), p)?)

@@ -19,6 +19,12 @@ use crate::kinematics::Pose;
 /// the curve at 0.3 mm off the tightest bend (the truth for the five-axis tests).
 const SAMPLES_PER_TURN: usize = 40_000;
 
+/// The most poses a curve pair is sampled into ([`ToolPath::poses`]): 2^24, 0.8 GB of
+/// poses, a 168 m path at `contour-eval`'s 0.01 mm chords. A longer one is a typo in a
+/// path file (a control point at 1e308 made the count overflow), refused with a message
+/// rather than a failed allocation.
+pub const MAX_SAMPLED_POSES: usize = 1 << 24;
+
 /// A five-axis reference. Serialised (FMU state) through [`ToolPathData`], so bytes from
 /// elsewhere are validated like a file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -188,8 +194,41 @@ pub fn load_poses(spec: &str, chord: f64) -> Result<(Vec<Pose>, Vec<String>), Pa
             let data = super::cl_data::load_cl(file)?;
             Ok((data.poses, data.warnings))
         }
-        _ => Ok((ToolPath::load(spec)?.0.poses(chord), Vec::new())),
+        Source::Json(file) => {
+            let (path, _) = ToolPath::load(spec)?;
+            let poses = path.poses(chord).map_err(|e| PathError::File {
+                file: file.to_string(),
+                line: 0,
+                column: 0,
+                message: match e {
+                    PathError::Invalid(m) => m,
+                    other => other.to_string(),
+                },
+            })?;
+            Ok((poses, Vec::new()))
+        }
+        Source::Builtin(_) => Ok((ToolPath::load(spec)?.0.poses(chord)?, Vec::new())),
     }
+}
+
+/// The pieces a tip curve of `length` mm is first sampled into at chords of at most
+/// `chord` mm: one a chord of its length, refused when the poses would pass `budget`
+/// (also for a length that overflowed to infinity).
+fn first_pieces(length: f64, chord: f64, budget: usize) -> Result<usize, PathError> {
+    if !(chord.is_finite() && chord > 0.0) {
+        return Err(PathError::invalid(format!(
+            "the sampling chord must be finite and > 0 mm, got {chord}"
+        )));
+    }
+    let pieces = (length / chord).ceil();
+    // n pieces are n + 1 poses; NaN fails too.
+    if pieces.is_nan() || pieces >= budget as f64 {
+        return Err(PathError::invalid(format!(
+            "the tip curve is {length:e} mm long: at chords of at most {chord} mm that takes \
+             {pieces:e} poses, more than the {budget} a path may be sampled into"
+        )));
+    }
+    Ok((pieces as usize).max(1))
 }
 
 impl ToolPath {
@@ -232,18 +271,25 @@ impl ToolPath {
 
     /// The reference as poses: the vertices of a pose path; a curve pair sampled
     /// uniformly in its parameter, doubling the count until no tip chord exceeds `chord`
-    /// mm (> 0).
-    pub fn poses(&self, chord: f64) -> Vec<Pose> {
+    /// mm (finite, > 0). A curve pair that needs more than [`MAX_SAMPLED_POSES`] poses
+    /// for that (a tip curve too long, or too unevenly parametrised) is refused before
+    /// anything is allocated for it.
+    pub fn poses(&self, chord: f64) -> Result<Vec<Pose>, PathError> {
+        self.poses_within(chord, MAX_SAMPLED_POSES)
+    }
+
+    /// [`Self::poses`] with at most `budget` poses.
+    fn poses_within(&self, chord: f64, budget: usize) -> Result<Vec<Pose>, PathError> {
         match self {
-            ToolPath::Poses { tips, axes } => tips
+            ToolPath::Poses { tips, axes } => Ok(tips
                 .points()
                 .iter()
                 .zip(axes.iter())
                 .map(|(&tip, &axis)| Pose { tip, axis })
-                .collect(),
+                .collect()),
             ToolPath::Curves { tip, .. } => {
+                let mut n = first_pieces(tip.length(), chord, budget)?;
                 let (u0, u1) = tip.param_range();
-                let mut n = ((tip.length() / chord).ceil() as usize).max(1);
                 loop {
                     let poses: Vec<Pose> = (0..=n)
                         .map(|i| self.pose_at(u0 + (u1 - u0) * i as f64 / n as f64))
@@ -252,8 +298,18 @@ impl ToolPath {
                         .windows(2)
                         .map(|w| geometry::dist(&w[0].tip, &w[1].tip))
                         .fold(0.0, f64::max);
-                    if longest <= chord || n > 1 << 26 {
-                        return poses;
+                    if longest <= chord {
+                        return Ok(poses);
+                    }
+                    if 2 * n >= budget {
+                        return Err(PathError::invalid(format!(
+                            "the tip curve's chords are still up to {longest:.3e} mm at {} \
+                             poses, over {chord} mm: doubling again would pass the {} a \
+                             path may be sampled into (a curve that runs far faster in \
+                             parts of its parameter range than in others)",
+                            n + 1,
+                            budget
+                        )));
                     }
                     n *= 2;
                 }
@@ -511,6 +567,84 @@ mod tests {
             "{e}"
         );
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A two-curve file whose tip runs from −1e308 to 1e308 along x (its length
+    /// overflows): sampling it used to ask for usize::MAX poses and abort on the capacity
+    /// overflow; now it is refused, naming the file, before anything is allocated.
+    #[test]
+    fn a_path_too_long_to_sample_is_refused_before_allocating() {
+        let text = r#"{
+            "tip": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[-1e308, 0, 0], [1e308, 0, 0]]},
+            "second": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[-1e308, 0, 100], [1e308, 0, 100]]},
+            "length": 100
+        }"#;
+        let path = ToolPath::parse_json(text, "far.json").unwrap();
+        let e = path.poses(0.01).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "invalid path: the tip curve is inf mm long: at chords of at most 0.01 mm that \
+             takes inf poses, more than the 16777216 a path may be sampled into"
+        );
+        let dir = std::env::temp_dir().join(format!("tool-path-far-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("far.json");
+        std::fs::write(&file, text).unwrap();
+        let spec = file.to_str().unwrap();
+        let e = load_poses(spec, 0.01).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            format!(
+                "{spec}: the tip curve is inf mm long: at chords of at most 0.01 mm that \
+                 takes inf poses, more than the 16777216 a path may be sampled into"
+            )
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+        // 1e5 mm is 1e7 poses at 0.01 mm, inside the budget; 1e6 mm is not.
+        let line = |x: f64| {
+            ToolPath::parse_json(&text.replace("1e308", &x.to_string()), "line.json").unwrap()
+        };
+        let e = line(5e5).poses(0.01).unwrap_err().to_string();
+        assert!(
+            e.contains("is 1e6 mm long") && e.contains("takes 1e8 poses"),
+            "{e}"
+        );
+        assert_eq!(line(1.0).poses(0.25).map(|p| p.len()), Ok(9));
+        assert_eq!(MAX_SAMPLED_POSES, 1 << 24);
+    }
+
+    #[test]
+    fn the_pose_budget_counts_poses_not_pieces() {
+        // n pieces are n + 1 poses: a budget of 2^24 takes at most 2^24 − 1 pieces.
+        let budget = MAX_SAMPLED_POSES;
+        assert_eq!(
+            first_pieces((budget - 1) as f64, 1.0, budget),
+            Ok(budget - 1)
+        );
+        assert!(first_pieces(budget as f64, 1.0, budget).is_err());
+        assert_eq!(first_pieces(0.0, 0.01, budget), Ok(1));
+        for (length, chord) in [(1.0, 0.0), (1.0, -1.0), (1.0, f64::NAN), (f64::NAN, 1.0)] {
+            assert!(
+                first_pieces(length, chord, budget).is_err(),
+                "{length} {chord}"
+            );
+        }
+        // A tip that covers 999 of its 1000 mm in the last millionth of its parameter:
+        // uniform samples need about 10^9 pieces for chords of 1 mm, so doubling stops at
+        // the budget (here 4096 poses) with the chord it reached.
+        let text = r#"{
+            "tip": {"degree": 1, "knots": [0, 0, 0.999999, 1, 1], "control_points": [[0, 0, 0], [1, 0, 0], [1000, 0, 0]]},
+            "second": {"degree": 1, "knots": [0, 0, 0.999999, 1, 1], "control_points": [[0, 0, 100], [1, 0, 100], [1000, 0, 100]]},
+            "length": 100
+        }"#;
+        let path = ToolPath::parse_json(text, "fast.json").unwrap();
+        let e = path.poses_within(1.0, 4096).unwrap_err().to_string();
+        // 1000 pieces, 2000, 4000: chords of 999 mm still (the fast part between two
+        // samples), and 8001 poses would pass 4096.
+        assert!(
+            e.contains("chords are still up to 9.990e2 mm at 4001 poses, over 1 mm"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -583,7 +583,7 @@ fn state_bytes_of(model: &'static ModelInfo) -> Vec<u8> {
 // Path files
 
 fn write_path_files() {
-    let files: [(&str, &str); 11] = [
+    let files: [(&str, &str); 13] = [
         (
             "syntax.json",
             "{\n  \"degree\": 1,\n  \"knots\": [0, 0,, 1, 1],\n  \"control_points\": [[0, 0], [3, 4]]\n}\n",
@@ -616,6 +616,13 @@ fn write_path_files() {
             "long_axis.cl",
             "GOTO/0,0,0,0,0,1\nGOTO/10,0,0,0,0,2\nGOTO/20,0,0,0,0,1\n",
         ),
+        (
+            "far.json",
+            r#"{"tip": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[-1e308, 0, 0], [1e308, 0, 0]]},
+                "second": {"degree": 1, "knots": [0, 0, 1, 1], "control_points": [[-1e308, 0, 100], [1e308, 0, 100]]},
+                "length": 100}"#,
+        ),
+        ("far.cl", "GOTO/-1e308,0,0,0,0,1\nGOTO/1e308,0,0,0,0,1\n"),
     ];
     std::fs::create_dir_all(folder()).unwrap();
     for (name, text) in files {

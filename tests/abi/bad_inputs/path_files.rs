@@ -105,6 +105,25 @@ pub(super) static CASES: &[Case] = &[
         Corrected,
     ),
     case(
+        "a two-curve file whose tip runs from -1e308 to 1e308 (its length overflows)",
+        P5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_string("path", "far.json")),
+        ERROR,
+        Some("far.json: the tip's path is inf mm long: no feed follows it"),
+        Corrected,
+    )
+    .with(Resources::Folder),
+    case(
+        "a CL file from -1e308 to 1e308 (its length overflows)",
+        P5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_string("path", &s.file("far.cl"))),
+        ERROR,
+        Some("far.cl: the tip's path is inf mm long: no feed follows it"),
+        Corrected,
+    ),
+    case(
         "a CL tool axis that is not a unit vector (normalised, with a warning)",
         P5,
         Initialization,

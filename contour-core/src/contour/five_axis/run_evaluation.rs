@@ -18,7 +18,7 @@ use std::fmt;
 
 use super::evaluation::{self, Evaluation};
 use super::hmm::{state_cost, HmmParams, ReferencePolyline};
-use super::pose_error::{foot_point_error_between, nearest_segment_near};
+use super::reference_shape::{foot_error, ReferenceShape};
 use super::viterbi::{self, BackTable};
 use crate::geometry::slerp;
 use crate::geometry::{self, Vector};
@@ -235,12 +235,15 @@ pub struct RunSettings {
     pub tool_length: f64,
     /// Candidate segments per sample of the mapping.
     pub window: usize,
+    /// What the per-sample errors are measured against: the points' straight moves or a
+    /// smooth curve through them.
+    pub reference: ReferenceShape,
 }
 
 impl Default for RunSettings {
     /// K = 4 (a reference sampled up to 4× finer than the measurement), w = 0.1 mm/rad
     /// (the motion direction only breaks near-ties: measured motion per sample is µm
-    /// and its direction is noisy), L = 100 mm, 64 candidate segments.
+    /// and its direction is noisy), L = 100 mm, 64 candidate segments, straight moves.
     fn default() -> Self {
         RunSettings {
             params: HmmParams {
@@ -249,11 +252,12 @@ impl Default for RunSettings {
             },
             tool_length: 100.0,
             window: 64,
+            reference: ReferenceShape::Straight,
         }
     }
 }
 
-/// Errors of one measured sample against its mapped segment.
+/// Errors of one measured sample against the reference near its mapped segment.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SampleContourError {
     /// Mapped segment [R_j, R_j+1].
@@ -386,13 +390,9 @@ pub fn evaluate_run(
     let mut samples = Vec::with_capacity(n);
     for (k, (q, &j)) in measured.iter().zip(&mapping).enumerate() {
         let pose = machine.forward(q);
-        // The mapping picks the branch; the foot is on the segment under the tip next to
-        // it, placed by the swept normal plane (docs/design/five-axis.md §5.3).
-        let segment = |i: usize| (i + 1 < points).then(|| (reference[i], reference[i + 1]));
-        let f = nearest_segment_near(segment, j, &pose.tip);
-        let before = f.checked_sub(1).map(|i| &reference[i]);
-        let after = reference.get(f + 2);
-        let e = foot_point_error_between(before, &reference[f], &reference[f + 1], after, &pose)
+        // The mapping picks the branch; the foot is the nearest point of the reference
+        // (as settings.reference reads it) near there, the axis taken at the same point.
+        let e = foot_error(settings.reference, &reference, j, &pose)
             .expect("checked: finite poses, no opposite axes");
         samples.push(SampleContourError {
             segment: j,

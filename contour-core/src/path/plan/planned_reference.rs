@@ -658,7 +658,7 @@ pub fn plan_for(
             return Ok(plan);
         }
     }
-    let poses = inputs.path.poses(PLAN_CHORD);
+    let poses = inputs.path.poses(PLAN_CHORD)?;
     let plan = Arc::new(Plan::new(
         &poses,
         inputs.machine,
