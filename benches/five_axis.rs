@@ -9,6 +9,9 @@
 //! 1 000 and of 100 000 distinct points (a helix, the tool trailing by 35 samples), the
 //! controller having run through all the points before them — the ratio of the two shows
 //! whether the cost per sample grows with the path.
+//!
+//! `five_axis/plan_1k` and `five_axis/plan_100k`: planning the reference of a hemisphere
+//! raster of 1 000 and of 100 000 CL points (docs/design/five-axis.md §5.3b).
 
 use std::hint::black_box;
 
@@ -92,5 +95,38 @@ fn bench_path_length(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_modes, bench_path_length);
+/// Planning a reference from a 100 000-point CL file: a hemisphere raster at 0.25 mm CL
+/// steps and 0.1 mm step-over (25 m of path, tool normal to the surface, over the apex),
+/// within the default limits; and, for the ratio, the same raster at 1 000 points.
+fn bench_planning(c: &mut Criterion) {
+    use contour_core::kinematics::TableTiltingAc;
+    use contour_core::limits::{JointLimits, PathLimits};
+    use contour_core::path::cam_examples::dome_raster;
+    use contour_core::path::plan::Plan;
+    let mut group = c.benchmark_group("five_axis");
+    group.sample_size(10);
+    for (name, stepover, passes) in [("plan_1k", 5.0, 2), ("plan_100k", 0.1, 282)] {
+        let poses = dome_raster(40.0, stepover, passes, 0.25, 45f64.to_radians(), 0.0);
+        eprintln!("{name}: {} CL points", poses.len());
+        group.throughput(Throughput::Elements(poses.len() as u64));
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                Plan::new(
+                    black_box(&poses),
+                    TableTiltingAc::default(),
+                    &JointLimits::default(),
+                    &PathLimits::at_feed(50.0),
+                    1e-3,
+                    &|i| format!("pose {i}"),
+                )
+                .unwrap()
+                .report()
+                .duration
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_modes, bench_path_length, bench_planning);
 criterion_main!(benches);

@@ -119,6 +119,20 @@ impl PathLimits {
                 return Err(format!("{name} must be finite and >= 0 (got {v})"));
             }
         }
+        if self.accel > 0.0 && self.jerk > 0.0 && self.tolerance == 0.0 {
+            return Err(
+                "tolerance must be > 0 with a jerk limit: the jerk filter rounds \
+                        every corner of the path by up to the tolerance"
+                    .into(),
+            );
+        }
+        if self.accel > 0.0 && self.orientation_tolerance == 0.0 {
+            return Err(
+                "orientationTolerance must be > 0 for a plan: near the C axis the \
+                        tool axis can only be kept within a tolerance of the programmed one"
+                    .into(),
+            );
+        }
         if self.pole_cone >= std::f64::consts::FRAC_PI_2 {
             return Err(format!(
                 "poleCone must be below pi/2 rad (got {})",

@@ -1,8 +1,11 @@
 """The five-axis part of the demo: PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant
-through the fmpy master, without and with the five-axis CCC, on the two built-in paths and
+through the fmpy master, without and with the five-axis CCC, on the two built-in paths,
 the example CL part (examples/cl/blade.cl, which PathInterpolator5X carries in its
-resources as blade.cl), with the true contour errors computed in
-Python (contour_fmu.five_axis_truth).
+resources as blade.cl) and a hemisphere finishing raster with the tool normal to the
+surface, over the apex and beside it (contour_fmu.cam_paths, written to OUT), with the
+true contour errors computed in Python (contour_fmu.five_axis_truth). The reference is
+planned within the machine's default limits (docs/design/five-axis.md §5.3b); for the
+domes a plot shows every joint's speed and acceleration against its limit.
 
 Writes to OUT: one CSV per run (joints, commands, estimates, true errors), one PNG per
 path (the tool-tip path with tool-axis glyphs, tip and orientation error against time)
@@ -13,6 +16,7 @@ need the plots extra (matplotlib).
 
 import numpy as np
 
+from . import cam_paths
 from .extras import needs
 from .five_axis_truth import contour_errors, forward
 from .master import Master, Unit, five_axis_closed_loop
@@ -34,9 +38,15 @@ CROSS_CHECK_OUTPUTS = [f"u.{j}" for j in FIVE_AXIS_JOINTS] + [
     "contourError.tip", "contourError.orientation"]
 
 
-# (label, the interpolator's path parameter)
-PATHS = [("tilted_helix", "tilted_helix"), ("figure_eight", "figure_eight"),
-         ("blade.cl", "blade.cl")]
+# (label, the interpolator's path parameter; CL text written to OUT under that name)
+PATHS = [("tilted_helix", "tilted_helix", None), ("figure_eight", "figure_eight", None),
+         ("blade.cl", "blade.cl", None),
+         ("dome_apex.cl", "dome_apex.cl", cam_paths.dome_raster()),
+         ("dome_beside.cl", "dome_beside.cl", cam_paths.dome_raster(offset=1.0))]
+
+# PathInterpolator5X's default joint limits (X Y Z A C; docs/design/five-axis.md §5.3b).
+JOINT_VMAX = np.array([500.0, 500.0, 500.0, 3.0, 5.0])
+JOINT_AMAX = np.array([5000.0, 5000.0, 5000.0, 20.0, 30.0])
 
 
 def reference_duration(fmu_dir, path, feed):
@@ -111,11 +121,39 @@ def plot(out, label, runs):
     plt.close(fig)
 
 
+def plot_limits(out, label, before):
+    """Every joint's speed and acceleration of the reference, as a share of its limit."""
+    with needs("plots"):
+        import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ref = np.column_stack([before[f"interpolator.ref.{j}"] for j in FIVE_AXIS_JOINTS])
+    t = before["time"]
+    speed = np.abs(np.diff(ref, axis=0)) / STEP / JOINT_VMAX
+    accel = np.abs(np.diff(ref, 2, axis=0)) / STEP ** 2 / JOINT_AMAX
+    fig, (v_ax, a_ax) = plt.subplots(1, 2, figsize=(12, 4))
+    for i, j in enumerate(FIVE_AXIS_JOINTS):
+        v_ax.plot(t[1:], speed[:, i], lw=0.8, label=j)
+        a_ax.plot(t[2:], accel[:, i], lw=0.8, label=j)
+    for ax, what in ((v_ax, "speed / vmax"), (a_ax, "acceleration / amax")):
+        ax.axhline(1.0, color="k", ls="--", lw=0.8, label="limit")
+        ax.set_xlabel("time (s)"), ax.set_ylabel(what), ax.set_ylim(0, 1.1)
+        ax.legend(fontsize=7, ncol=3), ax.set_title(f"{label}: joints against their limits")
+    fig.tight_layout()
+    fig.savefig(out / f"five_axis_{label.replace('.', '_')}_limits.png", dpi=120)
+    plt.close(fig)
+
+
 def main(fmu_dir, out):
     """Runs every path and variant; returns rows (path, feed, variant, max tip, mean tip,
     max orientation, mean orientation, reductions of the four against no CCC)."""
     rows = []
-    for label, path in PATHS:
+    for label, path, text in PATHS:
+        if text is not None:
+            path = str(out / path)
+            (out / label).write_text(text)
         stop = round(reference_duration(fmu_dir, path, FEED) + SETTLE, 9)
         runs = []
         for name, controller in VARIANTS:
@@ -127,6 +165,8 @@ def main(fmu_dir, out):
                 write_cross_check(out, "ContourCCC5X", before, after, CROSS_CHECK_INPUTS,
                                   CROSS_CHECK_OUTPUTS, STEP)
         plot(out, label, runs)
+        if text is not None:
+            plot_limits(out, label, runs[0][1])
         base = runs[0]
         for name, _, tip, orientation in runs:
             figures = (tip.max(), tip.mean(), orientation.max(), orientation.mean())

@@ -8,6 +8,7 @@
 
 mod arc;
 pub mod builtin;
+pub mod cam_examples;
 pub mod cl_data;
 pub mod file;
 mod five_axis_reference;

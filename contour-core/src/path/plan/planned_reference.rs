@@ -27,7 +27,7 @@ use crate::path::{PathError, ToolPath};
 /// The jerk filter's quantum (mm or rad): the samples' differences are exact to it.
 pub const QUANTUM: f64 = 1.0 / (1u64 << 30) as f64;
 /// Rounds of plan, measure, slow down.
-const ROUNDS: usize = 20;
+const ROUNDS: usize = 30;
 /// The most samples a plan may have (a day at 1 ms would be 8.6e7).
 pub const SAMPLE_BUDGET: u64 = 1 << 28;
 
@@ -560,19 +560,22 @@ impl Plan {
                     }
                 }
             }
+            // A kink's deviation grows with v, a curve's with v²: slow as for a kink
+            // (convergence in a round or two; a curve gives up a little more speed).
             if sample.tip_deviation > limits.tolerance {
-                speed_factor = speed_factor.min(limits.tolerance / sample.tip_deviation);
+                let r = limits.tolerance / sample.tip_deviation;
+                speed_factor = speed_factor.min(r * r);
             }
             if sample.orientation_deviation > limits.orientation_tolerance {
-                speed_factor =
-                    speed_factor.min(limits.orientation_tolerance / sample.orientation_deviation);
+                let r = limits.orientation_tolerance / sample.orientation_deviation;
+                speed_factor = speed_factor.min(r * r);
             }
             if speed_factor < 1.0 || accel_factor < 1.0 {
                 // Every raw sample this one averaged: the nodes from the oldest interval
                 // to the newest.
                 let (first, last) = (intervals[0], cursor.interval + 1);
                 for n in first..=last.min(self.path.s.len() - 1) {
-                    slow.push((n, 0.97 * speed_factor, 0.97 * accel_factor));
+                    slow.push((n, 0.9 * speed_factor, 0.95 * accel_factor));
                 }
             }
             history = [Some((cursor.joints, tip)), history[0], history[1]];
