@@ -16,6 +16,9 @@
 //! recorded five-axis closed loop on the figure-eight (as benches/five_axis.rs does in
 //! process), from the freshly initialized instance each time (10 inputs, 7 outputs);
 //! `fmu_abi/pass_through_5x_round`: the same rows and value counts on `PassThrough`.
+//! `fmu_abi/contour_ccc_5x_dome`: the same on the recorded closed loop over a hemisphere
+//! raster's apex (CL data, the reference planned within the machine's limits; 11 062
+//! samples).
 //!
 //! `fmu_abi/path_1k` and `fmu_abi/path_100k`: the last 500 samples of a helix reference of
 //! 1 000 and of 100 000 distinct points, the tool trailing by 35 samples (the paths of
@@ -453,6 +456,30 @@ fn two_axis() -> Vec<Round> {
     ]
 }
 
+/// The recorded closed loop on the dome raster (CL data over a hemisphere's apex, the
+/// reference planned within the machine's limits), replayed on ContourCCC5X.
+fn dome() -> Round {
+    use contour_core::path::{cam_examples::dome_raster, ToolPath};
+    let poses = dome_raster(40.0, 2.0, 2, 0.5, 45f64.to_radians(), 0.0);
+    let config = FiveAxisSimConfig::new(ToolPath::from_poses(&poses).unwrap(), 50.0);
+    let (_, records) = simulate_five_axis(&config, true).unwrap();
+    let rows: Vec<[f64; 10]> = records
+        .iter()
+        .map(|r| {
+            std::array::from_fn(|i| {
+                if i < 5 {
+                    r.reference[i]
+                } else {
+                    r.actual[i - 5]
+                }
+            })
+        })
+        .collect();
+    let mut ccc = Fmu::new("ContourCCC5X", &CCC_INPUTS, &CCC_OUTPUTS);
+    let fresh = ccc.save();
+    Round::new("contour_ccc_5x_dome", ccc, fresh, 0, rows)
+}
+
 /// The recorded closed loop on the figure-eight, replayed on ContourCCC5X, with the same
 /// values on PassThrough, and with its velocity commands on FiveAxisPlant.
 fn five_axis() -> Vec<Round> {
@@ -535,6 +562,7 @@ fn main() {
     let mut summary = Summary::default();
     let mut rounds = two_axis();
     rounds.extend(five_axis());
+    rounds.push(dome());
     rounds.extend(path_lengths());
     let mut group = c.benchmark_group("fmu_abi");
     // Each run is milliseconds long: the same number of runs per sample (criterion's

@@ -281,3 +281,33 @@ fn a_straight_tilting_pass_takes_the_trapezoid_time_plus_the_filter() {
     let own = plan.report().unfiltered_duration;
     assert!((own / optimum - 1.0).abs() < 0.02, "{own}");
 }
+
+#[test]
+fn a_path_too_long_for_the_sample_budget_is_refused_before_any_planning() {
+    // 10 km at 50 mm/s: 2·10⁸ samples at 1 ms, beyond the 2²⁶ a plan may have: refused
+    // from the length before any node is made (they alone would be 1.3 GB).
+    let far = [
+        Pose {
+            tip: V3::zeros(),
+            axis: V3::z(),
+        },
+        Pose {
+            tip: V3::new(1e7, 0.0, 0.0),
+            axis: V3::z(),
+        },
+    ];
+    let e = Plan::new(
+        &far,
+        TableTiltingAc::default(),
+        &JointLimits::default(),
+        &PathLimits::at_feed(50.0),
+        TS,
+        &name,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("more than the 67108864 samples a plan may have"),
+        "{e}"
+    );
+}

@@ -7,9 +7,9 @@
 
 use contour_core::kinematics::TableTiltingAc;
 use contour_core::path::cl_data::parse_cl;
+use contour_core::path::Curve;
 use contour_core::path::JointReference;
 use contour_core::path::ToolPath;
-use contour_core::path::Curve;
 use contour_fmu_fuzz::install_panic_hook;
 use libfuzzer_sys::fuzz_target;
 

@@ -27,9 +27,9 @@ use std::ptr;
 use contour_fmu::fmi2::bindings::{
     fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Status, fmi2String,
 };
-use contour_fmu::models;
 use contour_fmu::framework::model::{Environment, ModelInfo};
 use contour_fmu::framework::variables::{Values, VarType};
+use contour_fmu::models;
 use contour_fmu_fuzz::envelope::{self, Mode, Snapshot};
 use contour_fmu_fuzz::*;
 use libfuzzer_sys::fuzz_target;
@@ -219,6 +219,9 @@ fn write_seeds(dir: &std::path::Path) {
 fuzz_target!(
     init: {
         install_panic_hook();
+        // A restored five-axis state plans again: within the 10 s a fuzz input may take
+        // (FUZZ_SAMPLE_BUDGET), a longer plan refused.
+        contour_core::path::plan::set_sample_budget(FUZZ_SAMPLE_BUDGET);
         check_envelope();
         if let Some(dir) = std::env::var_os("CONTOUR_FUZZ_SEEDS") {
             write_seeds(std::path::Path::new(&dir));

@@ -23,9 +23,9 @@ use contour_fmu::fmi2::bindings::{
     fmi2Boolean, fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Integer, fmi2Real,
     fmi2Status, fmi2String, fmi2ValueReference,
 };
-use contour_fmu::models;
 use contour_fmu::framework::model::ModelInfo;
 use contour_fmu::framework::variables::VarType;
+use contour_fmu::models;
 use contour_fmu_fuzz::*;
 use libfuzzer_sys::fuzz_target;
 
@@ -1373,7 +1373,12 @@ impl Session {
 }
 
 fuzz_target!(
-    init: install_panic_hook(),
+    init: {
+        install_panic_hook();
+        // Plans within the 10 s a fuzz input may take (FUZZ_SAMPLE_BUDGET): a longer
+        // one is refused like any other.
+        contour_core::path::plan::set_sample_budget(FUZZ_SAMPLE_BUDGET);
+    },
     |input: Input| {
         let mut session = Session::new();
         for call in input.calls.iter().take(MAX_CALLS) {

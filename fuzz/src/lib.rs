@@ -116,6 +116,11 @@ extern "C" {
     ) -> fmi2Status;
 }
 
+/// The most samples a five-axis plan may have under the fuzzer (20 s of motion at 1 ms):
+/// planning costs microseconds a sample and round, ten times that under
+/// AddressSanitizer, up to 30 rounds, and no input may take 10 s.
+pub const FUZZ_SAMPLE_BUDGET: u64 = 20_000;
+
 /// The message of FaultProbe's `panic` input (src/models/fault_probe.rs).
 pub const INJECTED_PANIC: &str = "FaultProbe: injected panic";
 

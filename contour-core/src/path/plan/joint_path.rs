@@ -26,8 +26,9 @@ use std::f64::consts::PI;
 const AXIS_STEP: f64 = 5e-3;
 /// …and in C (rad), so that joints interpolated linearly between nodes stay on the path.
 const C_STEP: f64 = 2e-2;
-/// The most nodes a path may have (the planner's memory: about 100 bytes each).
-pub const NODE_BUDGET: usize = 1 << 24;
+/// The most nodes a path may have (the planner's memory: about 150 bytes each, 1.3 GB at
+/// the budget; a 100 000-point CL raster of 25 m has 630 000).
+pub const NODE_BUDGET: usize = 1 << 23;
 /// The share of its band C is held in near the pole (see `through_cone`).
 const BAND_SHARE: f64 = 0.9;
 /// Rounds of refinement inside the cones before the plan gives up.
@@ -140,6 +141,18 @@ fn nodes(
     cone: f64,
     fine: f64,
 ) -> Result<Vec<Node>, PathError> {
+    // The pieces the spacing alone asks for, before any is made.
+    let length: f64 = all
+        .windows(2)
+        .map(|w| geometry::dist(&w[0].tip, &w[1].tip))
+        .sum();
+    let pieces = length / spacing;
+    if pieces.is_nan() || pieces > NODE_BUDGET as f64 {
+        return Err(PathError::invalid(format!(
+            "the path is {length:.6e} mm long: at nodes {spacing} mm apart that is more than \
+             the {NODE_BUDGET} planning nodes a path may have"
+        )));
+    }
     let keep = kept(all, spacing, skip);
     let poses: Vec<Pose> = keep.iter().map(|&k| all[k]).collect();
     let mut out = Vec::with_capacity(poses.len());

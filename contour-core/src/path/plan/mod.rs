@@ -11,6 +11,6 @@ pub use feed::{FeedConstraints, FeedPoint, FeedProfile};
 pub use jerk_filter::JerkFilter;
 pub use joint_path::{plan_joints, JointPath, NODE_BUDGET};
 pub use planned_reference::{
-    plan_for, Cursor, Plan, PlanInputs, PlanReport, PlannedReference, PlannedSample, QUANTUM,
-    SAMPLE_BUDGET,
+    plan_for, set_sample_budget, Cursor, Plan, PlanInputs, PlanReport, PlannedReference,
+    PlannedSample, QUANTUM, SAMPLE_BUDGET,
 };

@@ -28,8 +28,24 @@ use crate::path::{PathError, ToolPath};
 pub const QUANTUM: f64 = 1.0 / (1u64 << 30) as f64;
 /// Rounds of plan, measure, slow down.
 const ROUNDS: usize = 30;
-/// The most samples a plan may have (a day at 1 ms would be 8.6e7).
-pub const SAMPLE_BUDGET: u64 = 1 << 28;
+/// The most samples a plan may have by default: 2²⁶, 18.6 hours at 1 ms. Planning costs
+/// a few microseconds per sample and round, so this also bounds the time a restored
+/// state may spend planning again.
+pub const SAMPLE_BUDGET: u64 = 1 << 26;
+
+static SAMPLE_LIMIT: std::sync::atomic::AtomicU64 =
+    std::sync::atomic::AtomicU64::new(SAMPLE_BUDGET);
+
+/// Sets the most samples a plan may have in this process (at least 1; [`SAMPLE_BUDGET`]
+/// by default): a host that must answer within a time (a fuzzer's timeout) lowers it, and
+/// a longer plan is refused like any other.
+pub fn set_sample_budget(samples: u64) {
+    SAMPLE_LIMIT.store(samples.max(1), std::sync::atomic::Ordering::Relaxed);
+}
+
+fn sample_budget() -> u64 {
+    SAMPLE_LIMIT.load(std::sync::atomic::Ordering::Relaxed)
+}
 
 /// What a plan measured on its own samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -299,6 +315,21 @@ impl Plan {
             .clamp(5e-3, 0.5)
             .min(limits.feed * ts)
             .max(1e-4);
+        // At the feed throughout the path would take this many samples at least: refuse
+        // before any work what the budget cannot hold.
+        let length: f64 = poses
+            .windows(2)
+            .map(|w| geometry::dist(&w[0].tip, &w[1].tip))
+            .sum();
+        let least = length / (limits.feed * ts);
+        if least.is_nan() || least > sample_budget() as f64 {
+            return Err(PathError::invalid(format!(
+                "the path is {length:.6e} mm long: at {} mm/s that is more than the {} \
+                 samples a plan may have",
+                limits.feed,
+                sample_budget()
+            )));
+        }
         let path = plan_joints(poses, &machine, joints, limits, spacing, name)?;
         let filter = if limits.jerk > 0.0 {
             // A step of the full acceleration becomes a ramp at the jerk limit; the
@@ -330,9 +361,11 @@ impl Plan {
                 (&speed_scale, &accel_scale),
             ))?;
             let raw = (feed.duration() / ts).ceil();
-            if raw.is_nan() || raw + (filter.0 + filter.1) as f64 > SAMPLE_BUDGET as f64 {
+            let budget = sample_budget();
+            if raw.is_nan() || raw + (filter.0 + filter.1) as f64 > budget as f64 {
                 return Err(PathError::invalid(format!(
-                    "the planned reference takes {:.0} s: more than {SAMPLE_BUDGET} samples",
+                    "the planned reference takes {:.0} s: more than the {budget} samples a \
+                     plan may have",
                     feed.duration()
                 )));
             }
