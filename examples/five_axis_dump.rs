@@ -19,9 +19,10 @@
 //!   and saturates, Z is a sine, A steps up and back, C is a ramp plus a sine. Output:
 //!   the axis parameters, the start, the command of every step and the positions and
 //!   velocities after every step (row k is after step k + 1).
-//! - `five_axis_dump closed_loop PATH MODE [FEED]`: the in-process five-axis closed loop
-//!   (`contour_core::sim::simulate_five_axis`) on a built-in path or a CL/JSON file, CCC `off`,
-//!   `fixed` or `fuzzy`, at FEED mm/s (default 50): the metrics and every sample's record
+//! - `five_axis_dump closed_loop PATH MODE [FEED [unplanned]]`: the in-process five-axis
+//!   closed loop (`contour_core::sim::simulate_five_axis`) on a built-in path or a CL/JSON
+//!   file, CCC `off`, `fixed` or `fuzzy`, at FEED mm/s (default 50), the reference planned
+//!   (or at constant feed with `unplanned`): the metrics and every sample's record
 //!   (time, reference and actual joints, command, true and estimated errors), for the
 //!   FMU closed loop to reproduce (tests/fmpy/test_five_axis_fmus.py).
 
@@ -151,7 +152,7 @@ fn plant(steps: usize, dt: f64) -> Value {
     })
 }
 
-fn closed_loop(path: &str, mode: &str, feed: f64) -> Value {
+fn closed_loop(path: &str, mode: &str, feed: f64, unplanned: bool) -> Value {
     let mode = match mode {
         "off" => CccMode::Off,
         "fixed" => CccMode::Fixed,
@@ -160,6 +161,9 @@ fn closed_loop(path: &str, mode: &str, feed: f64) -> Value {
     };
     let (tool_path, _) = ToolPath::load(path).unwrap_or_else(|e| fail(e));
     let mut config = FiveAxisSimConfig::new(tool_path, feed).with_mode(mode);
+    if unplanned {
+        config = config.unplanned();
+    }
     config.settle = 0.1;
     let (metrics, records) = simulate_five_axis(&config, true).unwrap_or_else(|e| fail(e));
     json!({
@@ -206,10 +210,11 @@ fn main() {
                 .unwrap_or("50")
                 .parse()
                 .unwrap_or_else(|e| fail(format!("FEED: {e}"))),
+            arg(4) == Some("unplanned"),
         ),
         _ => fail(
             "usage: five_axis_dump kinematics SEED N | five_axis_dump plant STEPS DT | \
-             five_axis_dump closed_loop PATH MODE [FEED]",
+             five_axis_dump closed_loop PATH MODE [FEED [unplanned]]",
         ),
     };
     println!("{out}");

@@ -106,8 +106,10 @@ variable_table! {
 pub static INFO: ModelInfo = ModelInfo {
     identifier: "PathInterpolator5X",
     description: "Five-axis reference trajectory: a tool-tip path with its tool axis \
-                  (built-in, JSON or APT CL data) sampled every Ts at a constant tip feed, \
-                  mapped to X Y Z A C by the inverse kinematics of an A-C trunnion table",
+                  (built-in, JSON or APT CL data) on an A-C trunnion table, planned within \
+                  the machine's travel, velocity, acceleration and jerk limits (branch of \
+                  A and C chosen over the whole path) and sampled every Ts; accel = 0: at \
+                  constant tip feed",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment {
         start_time: 0.0,
