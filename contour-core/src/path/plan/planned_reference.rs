@@ -626,8 +626,8 @@ impl Plan {
 /// (or finds the plan in [`plan_for`]'s cache).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PlanInputs {
-    /// The programmed path, unless it is the built-in `builtin`.
-    #[serde(with = "saved_path")]
+    /// The programmed path (saved by name when it is the built-in `builtin`, see
+    /// `SavedInputs`).
     pub path: ToolPath,
     /// The built-in's name when the path is one.
     pub builtin: Option<String>,
@@ -639,20 +639,6 @@ pub struct PlanInputs {
     pub limits: PathLimits,
     /// The sample period, s.
     pub ts: f64,
-}
-
-/// A built-in path is saved by its name (80 001 poses would be 6 MB).
-mod saved_path {
-    use crate::path::ToolPath;
-    use serde::{Deserialize, Deserializer, Serialize, Serializer};
-
-    pub fn serialize<S: Serializer>(path: &ToolPath, serializer: S) -> Result<S::Ok, S::Error> {
-        path.serialize(serializer)
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<ToolPath, D::Error> {
-        ToolPath::deserialize(deserializer)
-    }
 }
 
 /// The plans alive in this process, by a fingerprint of their inputs: instances on the
