@@ -456,28 +456,49 @@ fn two_axis() -> Vec<Round> {
     ]
 }
 
-/// The recorded closed loop on the dome raster (CL data over a hemisphere's apex, the
-/// reference planned within the machine's limits), replayed on ContourCCC5X.
-fn dome() -> Round {
-    use contour_core::path::{cam_examples::dome_raster, ToolPath};
-    let poses = dome_raster(40.0, 2.0, 2, 0.5, 45f64.to_radians(), 0.0);
-    let config = FiveAxisSimConfig::new(ToolPath::from_poses(&poses).unwrap(), 50.0);
-    let (_, records) = simulate_five_axis(&config, true).unwrap();
-    let rows: Vec<[f64; 10]> = records
-        .iter()
-        .map(|r| {
-            std::array::from_fn(|i| {
-                if i < 5 {
-                    r.reference[i]
-                } else {
-                    r.actual[i - 5]
-                }
+/// The recorded closed loops replayed on ContourCCC5X on CL data: the dome raster (over a
+/// hemisphere's apex, the reference planned within the machine's limits), and the pass
+/// through vertical at constant feed (C flips by π at the pole: the correction stands
+/// aside and the mapping restarts every sample while the machine catches up).
+fn cam_paths() -> Vec<Round> {
+    use contour_core::path::cam_examples::{dome_raster, tilting_pass};
+    use contour_core::path::ToolPath;
+    let replay = |name: &'static str, poses: Vec<contour_core::kinematics::Pose>, planned: bool| {
+        let mut config = FiveAxisSimConfig::new(ToolPath::from_poses(&poses).unwrap(), 50.0);
+        if !planned {
+            config = config.unplanned();
+            config.abort_tip_error = f64::INFINITY;
+        }
+        let (_, records) = simulate_five_axis(&config, true).unwrap();
+        let rows: Vec<[f64; 10]> = records
+            .iter()
+            .map(|r| {
+                std::array::from_fn(|i| {
+                    if i < 5 {
+                        r.reference[i]
+                    } else {
+                        r.actual[i - 5]
+                    }
+                })
             })
-        })
-        .collect();
-    let mut ccc = Fmu::new("ContourCCC5X", &CCC_INPUTS, &CCC_OUTPUTS);
-    let fresh = ccc.save();
-    Round::new("contour_ccc_5x_dome", ccc, fresh, 0, rows)
+            .collect();
+        let mut ccc = Fmu::new("ContourCCC5X", &CCC_INPUTS, &CCC_OUTPUTS);
+        let fresh = ccc.save();
+        Round::new(name, ccc, fresh, 0, rows)
+    };
+    let degree = 1f64.to_radians();
+    vec![
+        replay(
+            "contour_ccc_5x_dome",
+            dome_raster(40.0, 2.0, 2, 0.5, 45.0 * degree, 0.0),
+            true,
+        ),
+        replay(
+            "contour_ccc_5x_pole_at_constant_feed",
+            tilting_pass(0.0, 60.0, 0.5, 30.0 * degree),
+            false,
+        ),
+    ]
 }
 
 /// The recorded closed loop on the figure-eight, replayed on ContourCCC5X, with the same
@@ -562,7 +583,7 @@ fn main() {
     let mut summary = Summary::default();
     let mut rounds = two_axis();
     rounds.extend(five_axis());
-    rounds.push(dome());
+    rounds.extend(cam_paths());
     rounds.extend(path_lengths());
     let mut group = c.benchmark_group("fmu_abi");
     // Each run is milliseconds long: the same number of runs per sample (criterion's

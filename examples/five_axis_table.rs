@@ -3,9 +3,11 @@
 //! planned reference's own deviation from the path (docs/design/five-axis.md §5.3b).
 //!
 //! `cargo run --release --example five_axis_table [--unplanned] [PATH …]`
-//! (`--unplanned`: the reference at constant feed, as before machine limits).
+//! (`--unplanned`: the reference at constant feed and a controller without limits, as
+//! before machine limits).
 
 use contour_core::control::CccMode;
+use contour_core::limits::JointLimits;
 use contour_core::path::BUILTIN_TOOL_PATHS;
 use contour_core::sim::{simulate_five_axis, FiveAxisSimConfig};
 
@@ -42,7 +44,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for mode in [CccMode::Off, CccMode::Fixed, CccMode::Fuzzy] {
             let mut config = FiveAxisSimConfig::builtin(name)?.with_mode(mode);
             if unplanned {
+                // The loop before limits: the reference at constant feed, a controller
+                // that knows no limit.
                 config = config.unplanned();
+                config.controller.limits = JointLimits::UNLIMITED;
             }
             let (m, _) = simulate_five_axis(&config, false)?;
             println!(

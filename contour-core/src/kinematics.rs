@@ -172,7 +172,20 @@ impl TableTiltingAc {
 /// one is positive definite wherever J has full rank. `None` when Cholesky fails (μ = 0
 /// at a singular pose).
 pub fn damped_least_squares(jacobian: &Jacobian, e: &Vector<6>, mu: f64) -> Option<Joints> {
-    let system = jacobian.transpose() * jacobian + SMatrix::<f64, 5, 5>::identity() * (mu * mu);
+    damped_least_squares_per_joint(jacobian, e, &Joints::repeat(mu))
+}
+
+/// [`damped_least_squares`] with a damping of its own for each joint, (JᵀJ + D²)⁻¹·Jᵀ·e
+/// with D = diag(`mu`): a joint whose motion alone grows without bound near a
+/// singularity (C at A = 0) is damped there without slowing the others. |Δq| ≤
+/// |e|/min μᵢ (Δq = 0 costs |e|², so μ²_min·|Δq|² cannot exceed it).
+pub fn damped_least_squares_per_joint(
+    jacobian: &Jacobian,
+    e: &Vector<6>,
+    mu: &Joints,
+) -> Option<Joints> {
+    let damping = SMatrix::<f64, 5, 5>::from_diagonal(&mu.component_mul(mu));
+    let system = jacobian.transpose() * jacobian + damping;
     Some(system.cholesky()?.solve(&(jacobian.transpose() * e)))
 }
 

@@ -30,14 +30,27 @@ pub struct JointLimits {
 /// An unlimited travel, as LinuxCNC writes one: far beyond any part.
 pub const ENDLESS: f64 = 1e9;
 
+impl JointLimits {
+    /// The defaults of the module docs.
+    pub const DEFAULT: JointLimits = JointLimits {
+        min: Joints::new(-ENDLESS, -ENDLESS, -ENDLESS, -35.0 * PI / 180.0, -ENDLESS),
+        max: Joints::new(ENDLESS, ENDLESS, ENDLESS, 110.0 * PI / 180.0, ENDLESS),
+        velocity: Joints::new(500.0, 500.0, 500.0, 3.0, 5.0),
+        acceleration: Joints::new(5000.0, 5000.0, 5000.0, 20.0, 30.0),
+    };
+
+    /// No limit anywhere (every value `ENDLESS`): the machine of the loops before limits.
+    pub const UNLIMITED: JointLimits = JointLimits {
+        min: Joints::new(-ENDLESS, -ENDLESS, -ENDLESS, -ENDLESS, -ENDLESS),
+        max: Joints::new(ENDLESS, ENDLESS, ENDLESS, ENDLESS, ENDLESS),
+        velocity: Joints::new(ENDLESS, ENDLESS, ENDLESS, ENDLESS, ENDLESS),
+        acceleration: Joints::new(ENDLESS, ENDLESS, ENDLESS, ENDLESS, ENDLESS),
+    };
+}
+
 impl Default for JointLimits {
     fn default() -> Self {
-        JointLimits {
-            min: Joints::new(-ENDLESS, -ENDLESS, -ENDLESS, -35.0 * PI / 180.0, -ENDLESS),
-            max: Joints::new(ENDLESS, ENDLESS, ENDLESS, 110.0 * PI / 180.0, ENDLESS),
-            velocity: Joints::new(500.0, 500.0, 500.0, 3.0, 5.0),
-            acceleration: Joints::new(5000.0, 5000.0, 5000.0, 20.0, 30.0),
-        }
+        Self::DEFAULT
     }
 }
 

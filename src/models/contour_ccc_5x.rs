@@ -8,7 +8,7 @@
 
 use super::axis_variables::{COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_IN};
 use super::controller_parameters::{self, axis_gain, nonnegative};
-use super::kinematics_parameters;
+use super::{joint_limits_parameters, kinematics_parameters};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
 use crate::framework::state_codec::{SavedState, StateLayout};
@@ -193,6 +193,42 @@ variable_table! {
          law does not use, about 40 % of a sample's cost",
     );
     MACHINE: Reals<{ kinematics_parameters::COUNT }> = kinematics_parameters::VARIABLES;
+    LIMITS: Reals<{ joint_limits_parameters::COUNT }> = joint_limits_parameters::VARIABLES;
+    CORRECTION_SHARE: Real = Variable::parameter(
+        "correctionShare",
+        Start::Real(DEFAULT.correction_share),
+        "Largest share of each joint's speed (<axis>.vmax) the correction may use, in (0, 1]",
+    )
+    .min(0.0)
+    .max(1.0);
+    RECOVERY: Real = Variable::parameter(
+        "recovery",
+        Start::Real(DEFAULT.recovery),
+        "Time the correction takes to come back to full weight once the machine follows \
+         its reference again (>= 0)",
+    )
+    .unit("s")
+    .min(0.0);
+    POLE_DAMPING: Real = Variable::parameter(
+        "poleDamping",
+        Start::Real(DEFAULT.pole_damping),
+        "Growth of the damping on the C axis: within poleCone of it, damping^2 + \
+         poleDamping^2 * (1 - sin^2 A / sin^2 poleCone) (>= 0)",
+    )
+    .min(0.0);
+    POLE_CONE: Real = Variable::parameter(
+        "poleCone",
+        Start::Real(DEFAULT.pole_cone),
+        "Half-angle of the cone about the C axis within which the damping grows",
+    )
+    .unit("rad")
+    .min(0.0);
+    WEIGHT: Real = Variable::output(
+        "ccc.weight",
+        "Weight of the correction this sample: 1 at full weight, 0 while it stands aside \
+         (a reference beyond the joints' limits, a position loop far beyond its joint's \
+         speed, a mapping that lost the tool), rising over `recovery` when none holds",
+    );
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -213,10 +249,11 @@ pub static INFO: ModelInfo = ModelInfo {
     create: |_: &Environment| Box::new(ContourCCC5X { state: None }),
 };
 
-/// Version 1: `Option<State>` as below.
+/// Version 1: `Option<State>` as below. Version 2: the controller carries the machine's
+/// limits and the guard of its correction.
 const LAYOUT: StateLayout = StateLayout {
     model: "ContourCCC5X",
-    version: 1,
+    version: 2,
 };
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
@@ -281,18 +318,22 @@ fn law(mode: CccMode, values: [f64; 9]) -> CccConfig {
     }
 }
 
-fn config(values: &Values) -> FiveAxisConfig {
+fn config(values: &Values) -> Result<FiveAxisConfig, String> {
     let mode = controller_parameters::mode(CCC_ENABLE.get(values), FUZZY_ENABLE.get(values));
     let g = AXIS_GAINS.get(values);
     // Integer parameters are within their bounds (checked on every set), so ≥ 0.
     let whole = |v: Int| v.get(values).max(0) as usize;
-    FiveAxisConfig {
+    Ok(FiveAxisConfig {
         ts: TS.get(values),
         axis: std::array::from_fn(|i| PidGains::new(g[3 * i], g[3 * i + 1], g[3 * i + 2])),
-        axis_limit: None,
+        limits: joint_limits_parameters::joint_limits(values, LIMITS)?,
+        correction_share: CORRECTION_SHARE.get(values),
+        recovery: RECOVERY.get(values),
         tip: law(mode, TIP_LAW.get(values)),
         orientation: law(mode, ORIENTATION_LAW.get(values)),
         damping: DAMPING.get(values),
+        pole_damping: POLE_DAMPING.get(values),
+        pole_cone: POLE_CONE.get(values),
         tool_length: TOOL_LENGTH.get(values),
         hmm: HmmParams {
             max_skip: whole(MAX_SKIP),
@@ -303,7 +344,7 @@ fn config(values: &Values) -> FiveAxisConfig {
         beam: BEAM.get(values),
         evaluate: EVALUATION_ENABLE.get(values),
         machine: kinematics_parameters::machine(values, MACHINE),
-    }
+    })
 }
 
 /// The variable that sets a configuration value, if one does.
@@ -336,6 +377,16 @@ fn variable_of(parameter: Parameter) -> Option<&'static Variable> {
         Parameter::Pivot(0, 2) => MACHINE.at(1).vr(),
         Parameter::Pivot(1, 0) => MACHINE.at(2).vr(),
         Parameter::Pivot(1, 1) => MACHINE.at(3).vr(),
+        Parameter::TravelMin(3) => LIMITS.at(0).vr(),
+        Parameter::TravelMax(3) => LIMITS.at(1).vr(),
+        Parameter::TravelMin(4) => LIMITS.at(2).vr(),
+        Parameter::TravelMax(4) => LIMITS.at(3).vr(),
+        Parameter::JointSpeed(i) => LIMITS.at(4 + i).vr(),
+        Parameter::JointAcceleration(i) => LIMITS.at(9 + i).vr(),
+        Parameter::CorrectionShare => CORRECTION_SHARE.vr(),
+        Parameter::Recovery => RECOVERY.vr(),
+        Parameter::PoleDamping => POLE_DAMPING.vr(),
+        Parameter::PoleCone => POLE_CONE.vr(),
         // The axis limit and the pivots' coordinates along their own axes: no variable.
         _ => return None,
     };
@@ -360,6 +411,7 @@ impl ContourCCC5X {
             EVAL_TIP,
             EVAL_ORIENTATION,
             EVAL_DELAY,
+            WEIGHT,
         ] {
             output.set(values, 0.0);
         }
@@ -369,7 +421,7 @@ impl ContourCCC5X {
 impl Model for ContourCCC5X {
     fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult {
         check_period("Ts", TS.get(values))?;
-        let config = config(values);
+        let config = config(values)?;
         let controller = FiveAxisController::new(config).map_err(config_message)?;
         self.state = Some(State {
             controller,
@@ -386,9 +438,10 @@ impl Model for ContourCCC5X {
         let ts = state.controller.config().ts;
         while state.clock.take_before(time + step) {
             // Inputs are finite (fmi2SetReal refuses others), so a sample cannot fail.
+            // The inputs were set at this communication point and are held over it.
             let out = state
                 .controller
-                .sample(&reference, &actual)
+                .sample_held(&reference, time, &actual)
                 .map_err(|e| format!("sample at t = {time}: {e}"))?;
             U.set(values, &out.u);
             ERR.set(values, &out.following_error);
@@ -396,6 +449,7 @@ impl Model for ContourCCC5X {
                 (contour_core::geometry::norm(&e.tip), e.orientation)
             });
             TIP_ERROR.set(values, tip);
+            WEIGHT.set(values, out.weight);
             ORIENTATION_ERROR.set(values, orientation);
             if let Some(e) = out.evaluation {
                 EVAL_TIP.set(values, e.tip);
@@ -417,25 +471,25 @@ mod tests {
     #[test]
     fn start_values_are_the_controller_library_defaults() {
         let values = Values::from_table(&VARIABLES);
-        assert_eq!(config(&values), FiveAxisConfig::DEFAULT);
+        assert_eq!(config(&values).unwrap(), FiveAxisConfig::DEFAULT);
     }
 
     #[test]
     fn configuration_errors_use_the_fmu_parameter_names() {
         let mut values = Values::from_table(&VARIABLES);
         values.set_real(AXIS_GAINS.at(13).vr(), -1.0);
-        let e = FiveAxisController::new(config(&values)).unwrap_err();
+        let e = FiveAxisController::new(config(&values).unwrap()).unwrap_err();
         assert_eq!(
             config_message(e),
             "parameter axis.C.Ki = -1 is invalid: must be finite and >= 0"
         );
         let mut values = Values::from_table(&VARIABLES);
         values.set_real(ORIENTATION_LAW.at(7).vr(), -2.0);
-        let e = config(&values).validate().unwrap_err();
+        let e = config(&values).unwrap().validate().unwrap_err();
         assert!(config_message(e).starts_with("parameter orientation.fuzzy.ki = -2"));
         let mut values = Values::from_table(&VARIABLES);
         values.set_real(DAMPING.vr(), 0.0);
-        let e = config(&values).validate().unwrap_err();
+        let e = config(&values).unwrap().validate().unwrap_err();
         assert!(config_message(e).starts_with("parameter damping = 0"));
     }
 }

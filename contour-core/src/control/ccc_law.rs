@@ -116,13 +116,18 @@ impl CccLaw {
     /// correction: a broken estimate must not poison the integrator for the rest of the
     /// run (the caller still sees the bad estimate it passed in).
     pub fn update(&mut self, error: f64) -> CccStep {
+        self.update_with(error, true)
+    }
+
+    /// [`CccLaw::update`], integrating only if `integrate` (anti-windup from outside).
+    pub fn update_with(&mut self, error: f64, integrate: bool) -> CccStep {
         if self.config.mode == CccMode::Off || !error.is_finite() {
             return CccStep::default();
         }
         let (gains, fuzzy) = self.schedule(error, self.pid.difference(error));
         self.pid.set_gains(gains);
         CccStep {
-            correction: self.pid.update(error),
+            correction: self.pid.update_with(error, integrate),
             gains,
             fuzzy,
         }
@@ -181,7 +186,18 @@ impl<const D: usize> VectorLaw<D> {
     /// Off mode, or a non-finite size or vector, gives a zero correction and leaves the
     /// component integrals untouched.
     pub fn update(&mut self, size: f64, error: &Vector<D>) -> (Vector<D>, CccStep) {
-        let step = self.law.update(size);
+        self.update_with(size, error, true)
+    }
+
+    /// [`VectorLaw::update`], integrating only if `integrate`: the caller holds the
+    /// integrals while what it does with the correction saturates (anti-windup).
+    pub fn update_with(
+        &mut self,
+        size: f64,
+        error: &Vector<D>,
+        integrate: bool,
+    ) -> (Vector<D>, CccStep) {
+        let step = self.law.update_with(size, integrate);
         if self.law.config().mode == CccMode::Off
             || !size.is_finite()
             || !geometry::is_finite(error)
@@ -191,12 +207,12 @@ impl<const D: usize> VectorLaw<D> {
         let components = &mut self.components;
         let correction = Vector::from_fn(|i, _| {
             components[i].set_gains(step.gains);
-            components[i].update(error[i])
+            components[i].update_with(error[i], integrate)
         });
         (correction, step)
     }
 
-    /// [`VectorLaw::update`] with the integrals held in the plane normal to the unit
+    /// [`VectorLaw::update_with`] with the integrals held in the plane normal to the unit
     /// vector `along` (the path's tangent for a tip error, the tool axis for an
     /// orientation error): before the update their component along it is removed.
     ///
@@ -210,6 +226,7 @@ impl<const D: usize> VectorLaw<D> {
         size: f64,
         error: &Vector<D>,
         along: &Vector<D>,
+        integrate: bool,
     ) -> (Vector<D>, CccStep) {
         if geometry::is_finite(along) {
             let integral = Vector::<D>::from_fn(|i, _| self.components[i].integral());
@@ -218,7 +235,7 @@ impl<const D: usize> VectorLaw<D> {
                 pid.set_integral(*value);
             }
         }
-        self.update(size, error)
+        self.update_with(size, error, integrate)
     }
 
     /// Forgets integrals and previous errors.

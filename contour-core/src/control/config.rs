@@ -194,6 +194,22 @@ pub enum Parameter {
     Beam,
     /// Five-axis: coordinate `.1` (x, y, z) of pivot `.0` (0 = A axis, 1 = C axis).
     Pivot(usize, usize),
+    /// Five-axis: the least position of joint `.0` (X Y Z A C).
+    TravelMin(usize),
+    /// Five-axis: the greatest position of joint `.0`.
+    TravelMax(usize),
+    /// Five-axis: the greatest speed of joint `.0`.
+    JointSpeed(usize),
+    /// Five-axis: the greatest acceleration of joint `.0`.
+    JointAcceleration(usize),
+    /// Five-axis: the correction's share of each joint's speed.
+    CorrectionShare,
+    /// Five-axis: the correction's recovery time.
+    Recovery,
+    /// Five-axis: the damping's growth at the singular pose.
+    PoleDamping,
+    /// Five-axis: the cone where the damping grows.
+    PoleCone,
 }
 
 impl Parameter {
@@ -242,6 +258,14 @@ impl fmt::Display for Parameter {
             Parameter::Pivot(i, k) => {
                 write!(f, "{}_pivot.{}", ["a", "c"][*i], ["x", "y", "z"][*k])
             }
+            Parameter::TravelMin(i) => write!(f, "limits.min[{i}]"),
+            Parameter::TravelMax(i) => write!(f, "limits.max[{i}]"),
+            Parameter::JointSpeed(i) => write!(f, "limits.velocity[{i}]"),
+            Parameter::JointAcceleration(i) => write!(f, "limits.acceleration[{i}]"),
+            Parameter::CorrectionShare => write!(f, "correction_share"),
+            Parameter::Recovery => write!(f, "recovery"),
+            Parameter::PoleDamping => write!(f, "pole_damping"),
+            Parameter::PoleCone => write!(f, "pole_cone"),
         }
     }
 }

@@ -4,6 +4,7 @@
 
 mod ccc_law;
 mod config;
+mod correction_guard;
 mod cross_coupled;
 mod five_axis;
 mod fuzzy;
@@ -14,6 +15,7 @@ pub use ccc_law::{folded_inputs, CccLaw, CccStep, VectorLaw};
 pub use config::{
     CccConfig, CccMode, ConfigError, ControllerConfig, FuzzyFactor, FuzzyFactors, Gain, Parameter,
 };
+pub use correction_guard::{CorrectionGuard, Hold, LIMIT_SLACK};
 pub use cross_coupled::{ControlOutput, CrossCoupledController};
 pub use five_axis::{FiveAxisConfig, FiveAxisController, FiveAxisOutput, SampleError};
 pub use fuzzy::{centroid, evaluate_table, membership, FuzzyEngine, FuzzyOutput, UNIVERSE};

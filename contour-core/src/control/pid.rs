@@ -128,26 +128,40 @@ impl Pid {
 
     /// Advances one sample with error `error` and returns the (clamped) output.
     pub fn update(&mut self, error: f64) -> f64 {
+        self.update_with(error, true)
+    }
+
+    /// [`Pid::update`], integrating only if `integrate` (and the anti-windup allows it):
+    /// a caller that knows the output cannot act (its own consumer saturates) holds the
+    /// integral.
+    pub fn update_with(&mut self, error: f64, integrate: bool) -> f64 {
+        self.update_unclamped(error, integrate).0
+    }
+
+    /// [`Pid::update_with`], returning the output and what it was before the clamp (how
+    /// far beyond its limit the loop asks to go).
+    pub fn update_unclamped(&mut self, error: f64, integrate: bool) -> (f64, f64) {
         let g = self.gains;
         let p = g.kp * error;
         let d = g.kd * self.difference(error) / self.ts;
         let candidate = self.integral + error * self.ts;
-        let integrate = match self.limit {
-            None => true,
-            Some(l) => {
-                let unclamped = p + g.ki * candidate + d;
-                let push = g.ki * error;
-                !((unclamped > l && push > 0.0) || (unclamped < -l && push < 0.0))
-            }
-        };
+        let integrate = integrate
+            && match self.limit {
+                None => true,
+                Some(l) => {
+                    let unclamped = p + g.ki * candidate + d;
+                    let push = g.ki * error;
+                    !((unclamped > l && push > 0.0) || (unclamped < -l && push < 0.0))
+                }
+            };
         if integrate {
             self.integral = candidate;
         }
         self.prev_error = Some(error);
         let u = p + g.ki * self.integral + d;
         match self.limit {
-            Some(l) => u.clamp(-l, l),
-            None => u,
+            Some(l) => (u.clamp(-l, l), u),
+            None => (u, u),
         }
     }
 

@@ -22,7 +22,7 @@ use super::config::SimError;
 use super::metrics::{Divergence, DivergenceKind};
 use crate::contour::five_axis::evaluation_online::PointEvaluation;
 use crate::contour::five_axis::hmm::segment_fraction;
-use crate::control::{CccMode, FiveAxisConfig, FiveAxisController};
+use crate::control::{CccMode, FiveAxisConfig, FiveAxisController, Hold};
 use crate::geometry::angle_between;
 use crate::geometry::{self, Vector};
 use crate::kinematics::Joints;
@@ -35,9 +35,6 @@ use crate::plant::{ServoAxes, ServoAxesParams};
 /// 35 samples, up to 65 through the figure-eight's tightest bends; 150 leaves room and
 /// stays far from the other branch through the crossing (about 1800 samples away).
 const TRUTH_WINDOW: usize = 150;
-
-/// A run stops when the true tip error exceeds this, mm.
-const ABORT_TIP_ERROR: f64 = 10.0;
 
 /// A five-axis closed-loop run.
 #[derive(Clone, Debug)]
@@ -57,6 +54,8 @@ pub struct FiveAxisSimConfig {
     pub plant: ServoAxesParams<5>,
     /// Seconds simulated after the reference is done.
     pub settle: f64,
+    /// The run stops when the true tip error exceeds this, mm. Default 10 mm.
+    pub abort_tip_error: f64,
 }
 
 impl FiveAxisSimConfig {
@@ -71,6 +70,7 @@ impl FiveAxisSimConfig {
             controller: FiveAxisConfig::DEFAULT,
             plant: ServoAxesParams::<5>::TRUNNION,
             settle: 0.1,
+            abort_tip_error: 10.0,
         }
     }
 
@@ -122,6 +122,11 @@ pub struct FiveAxisRecord {
     pub reference_u: f64,
     /// The controller's newest evaluation-function estimate.
     pub evaluation: Option<PointEvaluation>,
+    /// The correction's weight (1 full, 0 stood aside).
+    pub weight: f64,
+    /// Why it stood aside.
+    #[serde(skip)]
+    pub hold: Hold,
 }
 
 /// Summary of a five-axis run (true errors).
@@ -255,7 +260,7 @@ pub fn simulate_five_axis(
         let pose = machine.forward(&actual);
         let lo = window[(k + 1) % TRUTH_WINDOW].min(sample.u);
         let (foot, tip) = nearest_on_branch(&config.path, &pose.tip, lo, sample.u);
-        if tip > ABORT_TIP_ERROR {
+        if tip > config.abort_tip_error {
             metrics.divergence = Some(diverged(tip, DivergenceKind::ErrorLimit));
             break;
         }
@@ -295,6 +300,8 @@ pub fn simulate_five_axis(
                 segment: out.segment,
                 reference_u: sample.u,
                 evaluation: out.evaluation,
+                weight: out.weight,
+                hold: out.hold,
             });
         }
         if sample.done {

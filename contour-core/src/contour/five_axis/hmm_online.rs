@@ -298,6 +298,27 @@ impl OnlineMapper {
         Some(self.best())
     }
 
+    /// The oldest segment still held (the band's first): a mapping there, once the band
+    /// is full, has the tool at or behind the band's tail, where the segment it is on may
+    /// have left the band.
+    pub fn oldest_segment(&self) -> usize {
+        self.references.saturating_sub(1).saturating_sub(self.band)
+    }
+
+    /// Whether every segment the band can hold is held (the reference has more than
+    /// `band` segments).
+    pub fn band_is_full(&self) -> bool {
+        self.references > self.band + 1
+    }
+
+    /// Forgets the path of costs: the next sample is mapped afresh, to its own least-cost
+    /// segment in the band, as the first one is. For a mapping that has lost the tool, or
+    /// may (left behind the band, or outrun by a tool faster than `max_skip` segments per
+    /// sample): the recursion alone would need many samples to come back, if it does.
+    pub fn restart(&mut self) {
+        self.valid = (0, 0);
+    }
+
     /// The segment of least cost for the newest sample (ties to the lower segment).
     fn best(&self) -> usize {
         let (lo, hi) = self.valid;

@@ -715,9 +715,19 @@ fn choose(
             .map_or(Some(off.len() - 1), |k| k.checked_sub(1))
             .map(|k| ends[k].1);
         let c_out = k_after.map(|k| ends[k].0);
+        // The search above passed every cone between its states, so this one passes too;
+        // should it not, the path is refused at the cone rather than refined for ever.
         let (path, _) = planner
             .through_cone(nodes, *run, c_in, c_out)
-            .map_err(|_| Choice::Refine(Vec::new()))?;
+            .map_err(|failure| match failure {
+                ConeFailure::Refine(at) if !at.is_empty() => Choice::Refine(at),
+                _ => unreachable(
+                    nodes,
+                    run.start,
+                    name,
+                    "C cannot turn through the pole between the branches on either side",
+                ),
+            })?;
         rotary[run.start..=run.end].copy_from_slice(&path);
     }
     Ok(rotary)
