@@ -83,11 +83,6 @@ impl CorrectionGuard {
         (self.limits, self.ts, self.rise)
     }
 
-    /// The weight of the latest sample.
-    pub fn weight(&self) -> f64 {
-        self.weight
-    }
-
     /// Whether reference sample `reference`, set at `time` (s), is beyond the limits:
     /// outside a travel, or (when it differs from the last) faster than allowed over the
     /// time since the last one came (at least a sample period).
