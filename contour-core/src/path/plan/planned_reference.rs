@@ -6,14 +6,17 @@
 //! once, at planning; a sample then costs O(1) whatever the path's length.
 //!
 //! The limits are mapped onto s node by node, with the joints linear between nodes: a
-//! joint's speed is its slope times the path speed, its acceleration slope·s̈ + curvature·ṡ².
-//! A change of slope at a node (a kink of the CL polyline, or of a joint's path) is spread
-//! by the filter over its first average, so its acceleration is the lesser of
-//! v·Δslope/T and v²·Δslope/h. What the mapping leaves approximate (the tip seen through
-//! the rotary axes, the filter's deviation from the path) is measured on the samples
-//! themselves: where a sample exceeds a limit, the speed where it was planned is lowered
-//! by the excess and the plan made again, until every sample keeps every limit.
+//! joint's speed is its slope times the path speed; its acceleration is the tangential
+//! slope·s̈ plus what the filter makes of the path's bends at that speed, the second
+//! difference of the joint over the filter's two averages (see [`Constraints`]), which
+//! sees a smooth curve, a lone kink and a jog of two kinks alike. What the mapping
+//! leaves approximate (the tip seen through the rotary axes, a speed that changes within
+//! the filter's window, the filter's deviation from the path) is measured on the
+//! samples themselves: where a sample exceeds a limit, the speed where it was planned
+//! is lowered by the excess and the plan made again, until every sample keeps every
+//! limit.
 
+use std::cell::Cell;
 use std::sync::{Arc, Mutex, Weak};
 
 use super::feed::{FeedConstraints, FeedProfile};
@@ -52,9 +55,14 @@ fn sample_budget() -> u64 {
 pub struct PlanReport {
     /// From the first sample to the one at rest at the end, s.
     pub duration: f64,
-    /// The same path's duration under the velocity and acceleration limits alone (the
-    /// plan before the jerk filter and before any slowing down for the samples), s.
-    pub unfiltered_duration: f64,
+    /// The velocity-and-acceleration time optimum of the programmed path: no jerk
+    /// limit, no filter, so no blending; every limit judged on the samples every Ts (a
+    /// kink of angle θ passed at v·2·sin(θ/2)/Ts ≤ the acceleration), s.
+    pub optimum: f64,
+    /// A lower bound of `optimum` that ignores the tolerances: the same with every
+    /// acceleration averaged over the filter's first average T1 (a kink passed T1/Ts
+    /// times faster), s.
+    pub relaxed_optimum: f64,
     /// Largest distance of a planned tip from the programmed tip path, mm.
     pub tip_deviation: f64,
     /// Largest angle between a planned and the programmed tool axis, rad.
@@ -82,28 +90,46 @@ pub struct Plan {
 
 /// The limits of the feed plan at the nodes of a joint path.
 ///
-/// Between nodes every joint moves linearly in s, so a joint's acceleration comes from
-/// the changes of its slope at the nodes. The samples see those changes averaged over
-/// the filter's first average (T, or Ts without a filter), a stretch of v·T of path: the
-/// acceleration at a node is v·Δg/T with Δg the change of slope across that stretch,
-/// which is v²·q'' on a smooth path and the spread spike of a lone kink. The tip's
-/// centripetal acceleration is the same with the change of its direction.
+/// Between nodes every joint moves linearly in s. A sample's acceleration after the two
+/// moving averages (T1 = m1·Ts, then T2 = m2·Ts) is exactly
+/// [(r_k − r_{k−m2})/T2 − (r_{k−m1} − r_{k−m1−m2})/T2]/T1 of the raw samples r: the
+/// change, over T1, of the raw velocity averaged over T2. At a speed v that is the
+/// second difference of the joint's path over the stretches ℓ1 = v·T1 and ℓ2 = v·T2,
+/// times v²/(ℓ1·ℓ2): v²·q'' on a smooth path, v·Δg/T1 at a lone kink, and at a jog
+/// shorter than ℓ2 (two kinks close together, which a difference of slopes across ℓ1
+/// does not see) v·δ/(T1·T2). That difference is piecewise linear in the window's
+/// place, so its extremes are where a window's edge meets a node: each node is judged
+/// at the places where its own kink meets an edge. The tip's acceleration is the same
+/// vector difference of its positions. Without the filter (the optimum the plan is
+/// compared with) T2 is the samples' own Ts.
 struct Constraints<'a> {
     path: &'a JointPath,
     joints: &'a JointLimits,
     limits: &'a PathLimits,
-    /// The filter's first average, s (Ts without a filter).
+    /// The filter's first average T1, s (Ts without a filter).
     spread: f64,
+    /// The filter's second average T2, s (Ts without it).
+    spread2: f64,
     /// The sum of the two averages' lengths squared, s² (0 without a filter): a curve
     /// of curvature κ is drawn in by v²·κ·Σ T²/24.
     smoothing2: f64,
-    /// Per piece between nodes: each joint's slope, and the tip's direction.
+    /// How far, as a time, the filter's samples reach on average beyond a corner
+    /// (E|τ| of its kernel: T1/4 + T2²/(12·T1); 0 without a filter): at speed v a
+    /// lone kink of angle θ is cut by v·E|τ|·sin θ/2.
+    corner_reach: f64,
+    /// Per node: the sine of the tip path's turn there.
+    kink: Vec<f64>,
+    /// Per piece between nodes: each joint's slope.
     slope: Vec<Joints>,
-    direction: Vec<Vector<3>>,
     /// Per node: how much of the speed squared and of the acceleration the samples
     /// allowed.
     speed_scale: &'a [f64],
     accel_scale: &'a [f64],
+    /// Per node: the largest speed at its acceleration scale, once found (NaN before);
+    /// kept from round to round, since a round changes few nodes' scales.
+    top_speed: &'a [Cell<f64>],
+    /// The last node, speed and bends found.
+    last_bends: Cell<Option<(usize, f64, Bends)>>,
 }
 
 impl<'a> Constraints<'a> {
@@ -113,6 +139,7 @@ impl<'a> Constraints<'a> {
         limits: &'a PathLimits,
         filter: (usize, usize, f64),
         scales: (&'a [f64], &'a [f64]),
+        top_speed: &'a [Cell<f64>],
     ) -> Self {
         let (m1, m2, ts) = filter;
         let count = path.s.len();
@@ -121,70 +148,160 @@ impl<'a> Constraints<'a> {
             joints,
             limits,
             spread: m1 as f64 * ts,
+            spread2: m2.max(1) as f64 * ts,
             // m2 = 0: the same spread without the filter's deviation.
             smoothing2: if m2 > 0 && m1 + m2 > 2 {
                 ((m1 * m1 + m2 * m2) as f64) * ts * ts
             } else {
                 0.0
             },
+            corner_reach: if m2 > 0 && m1 + m2 > 2 {
+                let (t1, t2) = (m1 as f64 * ts, m2 as f64 * ts);
+                t1 / 4.0 + t2 * t2 / (12.0 * t1)
+            } else {
+                0.0
+            },
+            kink: (0..count)
+                .map(|n| {
+                    if n == 0 || n + 1 == count {
+                        return 0.0;
+                    }
+                    let poses = &path.poses;
+                    let before = geometry::unit(&(poses[n].tip - poses[n - 1].tip));
+                    let after = geometry::unit(&(poses[n + 1].tip - poses[n].tip));
+                    match (before, after) {
+                        (Some(b), Some(a)) => geometry::norm(&b.cross(&a)),
+                        _ => 0.0,
+                    }
+                })
+                .collect(),
             slope: (0..count - 1)
                 .map(|n| (path.joints[n + 1] - path.joints[n]) / (path.s[n + 1] - path.s[n]))
                 .collect(),
-            direction: (0..count - 1)
-                .map(|n| {
-                    geometry::unit(&(path.poses[n + 1].tip - path.poses[n].tip))
-                        .unwrap_or_else(Vector::z)
-                })
-                .collect(),
             speed_scale: scales.0,
             accel_scale: scales.1,
+            top_speed,
+            last_bends: Cell::new(None),
         }
     }
 
-    /// The pieces before and after the stretch of `length` mm centred on node `n`.
-    fn stretch(&self, n: usize, length: f64) -> (usize, usize) {
-        let s = &self.path.s;
-        let last = s.len() - 2;
-        let half = 0.5 * length;
-        let before = if half <= 0.0 || n == 0 {
-            n.saturating_sub(1)
+    /// The joints and the tip at `s` (mm along the path), linear between nodes and
+    /// beyond the ends: a window reaching past an end sees no kink there (the speed,
+    /// not the path, comes to rest, and the tangential term holds the acceleration).
+    /// Searched outwards from node `near`: a window is a few nodes wide, so this costs
+    /// O(log of the nodes it spans) however long the path.
+    fn at(&self, s: f64, near: usize) -> (Joints, Vector<3>) {
+        let nodes = &self.path.s;
+        let last = nodes.len() - 1;
+        let near = near.min(last);
+        // The last node at or before s (0 before the path).
+        let below = if nodes[near] <= s {
+            let (mut lo, mut step) = (near, 1);
+            loop {
+                let hi = (lo + step).min(last);
+                if hi == lo || nodes[hi] > s {
+                    break lo + nodes[lo..=hi].partition_point(|&x| x <= s) - 1;
+                }
+                lo = hi;
+                step *= 2;
+            }
         } else {
-            s.partition_point(|&x| x < s[n] - half)
-                .saturating_sub(1)
-                .min(n - 1)
+            let (mut hi, mut step) = (near, 1);
+            loop {
+                let lo = hi.saturating_sub(step);
+                if lo == hi || nodes[lo] <= s {
+                    break (lo + nodes[lo..=hi].partition_point(|&x| x <= s)).saturating_sub(1);
+                }
+                hi = lo;
+                step *= 2;
+            }
         };
-        let after = if half <= 0.0 {
-            n.min(last)
-        } else {
-            s.partition_point(|&x| x <= s[n] + half)
-                .saturating_sub(1)
-                .clamp(n.min(last), last)
-        };
-        (before, after)
+        let m = below.min(last - 1);
+        let (joints, poses) = (&self.path.joints, &self.path.poses);
+        let f = (s - nodes[m]) / (nodes[m + 1] - nodes[m]);
+        (
+            joints[m] + (joints[m + 1] - joints[m]) * f,
+            poses[m].tip + (poses[m + 1].tip - poses[m].tip) * f,
+        )
     }
 
     /// At node `n` and speed `v`: each joint's slope (the larger of the pieces beside
-    /// it), its acceleration per speed squared (Δg/(v·T)), and the tip's curvature seen
-    /// the same way (none at rest).
-    fn bends(&self, n: usize, v: f64) -> (Joints, Joints, f64) {
+    /// it); the least and greatest of its accelerations per speed squared over the
+    /// windows that meet the node (see the type's text); and the largest such
+    /// acceleration of the tip, its curvature as the samples see it (none at rest).
+    fn bends(&self, n: usize, v: f64) -> Bends {
+        // The feed planner asks a node again at the speed it just settled on.
+        if let Some((m, w, bends)) = self.last_bends.get() {
+            if (m, w) == (n, v) {
+                return bends;
+            }
+        }
+        let bends = self.bends_now(n, v);
+        self.last_bends.set(Some((n, v, bends)));
+        bends
+    }
+
+    fn bends_now(&self, n: usize, v: f64) -> Bends {
         let last = self.slope.len() - 1;
         let (g_in, g_out) = (
             self.slope[n.saturating_sub(1).min(last)],
             self.slope[n.min(last)],
         );
         let slope = g_in.zip_map(&g_out, |a, b| if a.abs() > b.abs() { a } else { b });
-        let length = v * self.spread;
-        if n == 0 || n > last || length.is_nan() || length <= 0.0 {
-            return (slope, Joints::zeros(), 0.0);
+        let (l1, l2) = (v * self.spread, v * self.spread2);
+        let mut bends = Bends {
+            slope,
+            least: Joints::zeros(),
+            greatest: Joints::zeros(),
+            curvature: 0.0,
+        };
+        if n == 0 || n > last || l1.is_nan() || l1 <= 0.0 || l2 <= 0.0 {
+            return bends;
         }
-        // The stretch holds at least the pieces beside the node: a kink is crossed
-        // within T however far its neighbours are.
-        let (before, after) = self.stretch(n, length);
-        let bend = (self.slope[after] - self.slope[before]) / length;
-        // The chord between the unit directions, 2·sin(θ/2): the turn to 1 % up to 30°,
-        // without an arctangent (this runs in every node's search of its speed).
-        let turn = geometry::norm(&(self.direction[after] - self.direction[before])) / length;
-        (slope, bend, turn)
+        let (a, b) = (0.5 * l1, 0.5 * l2);
+        let centre = self.path.s[n];
+        for place in [0.0, a - b, b - a, a + b, -a - b] {
+            let c = centre + place;
+            let (q1, t1) = self.at(c + a + b, n);
+            let (q2, t2) = self.at(c + a - b, n);
+            let (q3, t3) = self.at(c - a + b, n);
+            let (q4, t4) = self.at(c - a - b, n);
+            let area = l1 * l2;
+            let bend = (q1 - q2 - q3 + q4) / area;
+            bends.least = bends.least.inf(&bend);
+            bends.greatest = bends.greatest.sup(&bend);
+            let tip = (t1 - t2 - t3 + t4) / area;
+            bends.curvature = bends.curvature.max(geometry::norm(&tip));
+        }
+        bends
+    }
+
+    /// The largest speed at node `n` (mm/s) its limits allow at zero path acceleration.
+    fn top_speed_at(&self, n: usize) -> f64 {
+        let mut top = self.limits.feed;
+        // The slopes on both sides: the speed is the same at the node.
+        let slope = self.bends(n, 0.0).slope;
+        for i in 0..5 {
+            if slope[i] != 0.0 {
+                top = top.min(self.joints.velocity[i] / slope[i].abs());
+            }
+        }
+        let scale = self.accel_scale[n];
+        let accel = self.limits.accel * scale;
+        let tolerance = self.limits.tolerance;
+        Self::largest_speed(top, |v| {
+            let bends = self.bends(n, v);
+            let x = v * v;
+            let joints_ok = (0..5).all(|i| {
+                let bend = bends.least[i].abs().max(bends.greatest[i].abs());
+                bend * x <= self.joints.acceleration[i] * scale
+            });
+            let turn = bends.curvature;
+            // A curve drawn in, or a corner cut.
+            let deviation =
+                (x * turn * self.smoothing2 / 24.0).max(v * self.corner_reach * self.kink[n] / 2.0);
+            joints_ok && turn * x <= accel && deviation <= tolerance
+        })
     }
 
     /// The largest speed at node `n` (mm/s) at which `limit(v) ≥ 0` holds, by bisection
@@ -213,49 +330,50 @@ impl FeedConstraints for Constraints<'_> {
     }
 
     fn speed2_max(&self, n: usize) -> f64 {
-        let mut top = self.limits.feed;
-        // The slopes on both sides: the speed is the same at the node.
-        let (slope, _, _) = self.bends(n, 0.0);
-        for i in 0..5 {
-            if slope[i] != 0.0 {
-                top = top.min(self.joints.velocity[i] / slope[i].abs());
-            }
-        }
-        let scale = self.accel_scale[n];
-        let accel = self.limits.accel * scale;
-        let tolerance = self.limits.tolerance;
-        let v = Self::largest_speed(top, |v| {
-            let (_, bend, turn) = self.bends(n, v);
-            let x = v * v;
-            let joints_ok =
-                (0..5).all(|i| bend[i].abs() * x <= self.joints.acceleration[i] * scale);
-            let deviation = x * turn * self.smoothing2 / 24.0;
-            joints_ok && turn * x <= accel && deviation <= tolerance
-        });
+        let known = self.top_speed[n].get();
+        let v = if known.is_nan() {
+            let v = self.top_speed_at(n);
+            self.top_speed[n].set(v);
+            v
+        } else {
+            known
+        };
         v * v * self.speed_scale[n]
     }
 
     fn accel_range(&self, n: usize, x: f64) -> (f64, f64) {
         let v = x.max(0.0).sqrt();
-        let (slope, bend, turn) = self.bends(n, v);
+        let bends = self.bends(n, v);
         let scale = self.accel_scale[n];
         let accel = self.limits.accel * scale;
-        let normal = turn * x;
+        let normal = bends.curvature * x;
         let tangential = (accel * accel - normal * normal).max(0.0).sqrt();
         let (mut lo, mut hi) = (-tangential, tangential);
         for i in 0..5 {
-            let g = slope[i];
+            let g = bends.slope[i];
             if g.abs() < 1e-12 {
                 continue;
             }
             let amax = self.joints.acceleration[i] * scale;
-            let centripetal = bend[i] * x;
-            let (a, b) = ((-amax - centripetal) / g, (amax - centripetal) / g);
+            // g·s̈ + bend·x within ±amax for every bend the windows saw.
+            let (a, b) = (
+                (-amax - bends.least[i] * x) / g,
+                (amax - bends.greatest[i] * x) / g,
+            );
             lo = lo.max(a.min(b));
             hi = hi.min(a.max(b));
         }
         (lo, hi)
     }
+}
+
+/// What [`Constraints::bends`] finds at a node.
+#[derive(Clone, Copy)]
+struct Bends {
+    slope: Joints,
+    least: Joints,
+    greatest: Joints,
+    curvature: f64,
 }
 
 /// Where a reference stands among its samples; what an FMU saves of it.
@@ -331,6 +449,17 @@ impl Plan {
             )));
         }
         let path = plan_joints(poses, &machine, joints, limits, spacing, name)?;
+        // Planning costs a few tens of microseconds per node and round: a path with far
+        // more nodes than the samples it may have is refused too (a fuzzed path of tiny
+        // moves that the joints' refinement multiplies).
+        let nodes = path.s.len() as u64;
+        if nodes > 2 * sample_budget() {
+            return Err(PathError::invalid(format!(
+                "the path needs {nodes} planning nodes: more than twice the {} samples a \
+                 plan may have",
+                sample_budget()
+            )));
+        }
         let filter = if limits.jerk > 0.0 {
             // A step of the full acceleration becomes a ramp at the jerk limit; the
             // second, shorter average smooths the ramp's corners and a kink's spike.
@@ -342,16 +471,22 @@ impl Plan {
         let mut path = path;
         let mut speed_scale = vec![1.0; path.s.len()];
         let mut accel_scale = vec![1.0; path.s.len()];
-        // The velocity-and-acceleration optimum: the same limits with the accelerations
-        // seen over the same T, no jerk limit, no tolerance.
-        let unfiltered = FeedProfile::plan(&Constraints::new(
-            &path,
-            joints,
-            limits,
-            (filter.0, 0, ts),
-            (&speed_scale, &accel_scale),
-        ))?
-        .duration();
+        let unknown = || vec![Cell::new(f64::NAN); path.s.len()];
+        let optimum_with = |first: usize| -> Result<f64, PathError> {
+            let top_speed = unknown();
+            let constraints = Constraints::new(
+                &path,
+                joints,
+                limits,
+                (first, 0, ts),
+                (&speed_scale, &accel_scale),
+                &top_speed,
+            );
+            Ok(FeedProfile::plan(&constraints)?.duration())
+        };
+        let optimum = optimum_with(1)?;
+        let relaxed_optimum = optimum_with(filter.0)?;
+        let top_speed = unknown();
         for round in 1..=ROUNDS {
             let feed = FeedProfile::plan(&Constraints::new(
                 &path,
@@ -359,6 +494,7 @@ impl Plan {
                 limits,
                 (filter.0, filter.1, ts),
                 (&speed_scale, &accel_scale),
+                &top_speed,
             ))?;
             let raw = (feed.duration() / ts).ceil();
             let budget = sample_budget();
@@ -383,7 +519,8 @@ impl Plan {
             if slow.is_empty() {
                 plan.report = PlanReport {
                     rounds: round,
-                    unfiltered_duration: unfiltered,
+                    optimum,
+                    relaxed_optimum,
                     nodes: plan.path.s.len(),
                     ..report
                 };
@@ -398,7 +535,10 @@ impl Plan {
             }
             for n in 0..speed_scale.len() {
                 speed_scale[n] *= round_speed[n];
-                accel_scale[n] *= round_accel[n];
+                if round_accel[n] < 1.0 {
+                    accel_scale[n] *= round_accel[n];
+                    top_speed[n].set(f64::NAN);
+                }
             }
             path = plan.path;
         }
@@ -528,6 +668,25 @@ impl Plan {
         (n, distance, geometry::angle_between(&axis, &pose.axis))
     }
 
+    /// The node in `first..=last` where the tip's path turns most.
+    fn sharpest_turn(&self, first: usize, last: usize) -> usize {
+        let poses = &self.path.poses;
+        let turn = |n: usize| {
+            if n == 0 || n + 1 >= poses.len() {
+                return 0.0;
+            }
+            let before = geometry::unit(&(poses[n].tip - poses[n - 1].tip));
+            let after = geometry::unit(&(poses[n + 1].tip - poses[n].tip));
+            match (before, after) {
+                (Some(b), Some(a)) => geometry::norm(&(a - b)),
+                _ => 0.0,
+            }
+        };
+        (first..=last)
+            .max_by(|&m, &n| turn(m).total_cmp(&turn(n)))
+            .unwrap_or(first)
+    }
+
     /// Runs every sample and measures it against the limits: the report, and for every
     /// node where a sample exceeded one, the factors its speed squared and acceleration
     /// must be scaled by.
@@ -593,22 +752,36 @@ impl Plan {
                     }
                 }
             }
-            // A kink's deviation grows with v, a curve's with v²: slow as for a kink
-            // (convergence in a round or two; a curve gives up a little more speed).
+            // Every raw sample this one averaged: the nodes from the oldest interval to
+            // the newest.
+            let (first, last) = (
+                intervals[0],
+                (cursor.interval + 1).min(self.path.s.len() - 1),
+            );
+            if speed_factor < 1.0 || accel_factor < 1.0 {
+                let accel = if accel_factor < 1.0 {
+                    0.95 * accel_factor
+                } else {
+                    1.0
+                };
+                for n in first..=last {
+                    slow.push((n, 0.9 * speed_factor, accel));
+                }
+            }
+            // The tip leaves the path where it turns most among those nodes (a corner):
+            // slow there alone, as for a kink, whose deviation grows with v (a curve's
+            // grows with v²: it gives up a little more speed).
             if sample.tip_deviation > limits.tolerance {
                 let r = limits.tolerance / sample.tip_deviation;
-                speed_factor = speed_factor.min(r * r);
+                let corner = self.sharpest_turn(first, last);
+                for n in corner.saturating_sub(1)..=(corner + 1).min(last) {
+                    slow.push((n, 0.9 * r * r, 1.0));
+                }
             }
             if sample.orientation_deviation > limits.orientation_tolerance {
                 let r = limits.orientation_tolerance / sample.orientation_deviation;
-                speed_factor = speed_factor.min(r * r);
-            }
-            if speed_factor < 1.0 || accel_factor < 1.0 {
-                // Every raw sample this one averaged: the nodes from the oldest interval
-                // to the newest.
-                let (first, last) = (intervals[0], cursor.interval + 1);
-                for n in first..=last.min(self.path.s.len() - 1) {
-                    slow.push((n, 0.9 * speed_factor, 0.95 * accel_factor));
+                for n in first..=last {
+                    slow.push((n, 0.9 * r * r, 1.0));
                 }
             }
             history = [Some((cursor.joints, tip)), history[0], history[1]];
