@@ -85,11 +85,18 @@ lint:
 	$(CARGO) fmt --all -- --check
 	$(CARGO) clippy --workspace --all-targets --features contour-fmu/test-hooks -- -D warnings
 
+# Each stage prints the time it starts, and pytest its slowest tests: where the
+# 35 minutes go is in every CI log.
 test: setup lint
+	@date '+%T cargo test'
 	$(CARGO) test --workspace --features contour-fmu/test-hooks
+	@date '+%T asan'
 	$(MAKE) --no-print-directory asan
+	@date '+%T fuzz smoke'
 	fuzz/smoke.sh 30
-	$(PYTHON) -m pytest -q tests/fmpy tests/reference
+	@date '+%T pytest'
+	$(PYTHON) -m pytest -q --durations=15 tests/fmpy tests/reference
+	@date '+%T done'
 
 # Every fuzz target (fuzz/README.md) for 30 s each (about 2 min once built), or 10 M
 # executions each (about 6 h for fmi_calls and deserialize_state on 2 loaded cores;
