@@ -113,7 +113,7 @@ def _skfuzzy_chunk(pairs, points=UNIVERSE_POINTS):
 def skfuzzy_grid(grid):
     ee, cc = np.meshgrid(grid, grid, indexing="ij")
     pairs = np.column_stack([ee.ravel(), cc.ravel()])
-    # About 25 ms per point in scikit-fuzzy: split the 3721 points over the cores.
+    # About 25 ms per point in scikit-fuzzy: split the points over the cores.
     workers = max(1, min(4, os.cpu_count() or 1))
     chunks = np.array_split(pairs, 4 * workers)
     with ProcessPoolExecutor(max_workers=workers) as pool:
@@ -153,12 +153,15 @@ def test_hand_computed_points(rust_grid):
 
 
 def test_engine_matches_skfuzzy_on_grid(rust_grid):
-    grid = rust_grid["grid"]
+    # Every other point of the 0.1 grid (961 of scikit-fuzzy's 25 ms points instead of
+    # 3721: 70 s of the test run): the 0.2 grid still puts five points on every slope of
+    # every set, and the test below compares single points of the full grid.
+    grid = rust_grid["grid"][::2]
     reference = skfuzzy_grid(grid)
     worst = {}
     for name in OUTPUTS:
-        ours, theirs = rust_grid[name], reference[name]
-        assert ours.shape == theirs.shape == (GRID, GRID)
+        ours, theirs = rust_grid[name][::2, ::2], reference[name]
+        assert ours.shape == theirs.shape == (len(grid), len(grid)) == (31, 31)
         # A flat or constant surface would mean a broken system on either side.
         assert theirs.max() - theirs.min() > 4.0
         dev = np.abs(ours - theirs)
