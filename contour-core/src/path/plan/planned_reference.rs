@@ -143,37 +143,28 @@ impl<'a> Constraints<'a> {
     ) -> Self {
         let (m1, m2, ts) = filter;
         let count = path.s.len();
+        // m2 = 0: the same spread without the filter's deviation (and a 1 + 1 filter is
+        // no filter).
+        let smooths = m2 > 0 && m1 + m2 > 2;
+        let (t1, t2) = (m1 as f64 * ts, m2 as f64 * ts);
         Constraints {
             path,
             joints,
             limits,
             spread: m1 as f64 * ts,
             spread2: m2.max(1) as f64 * ts,
-            // m2 = 0: the same spread without the filter's deviation.
-            smoothing2: if m2 > 0 && m1 + m2 > 2 {
+            smoothing2: if smooths {
                 ((m1 * m1 + m2 * m2) as f64) * ts * ts
             } else {
                 0.0
             },
-            corner_reach: if m2 > 0 && m1 + m2 > 2 {
-                let (t1, t2) = (m1 as f64 * ts, m2 as f64 * ts);
+            corner_reach: if smooths {
                 t1 / 4.0 + t2 * t2 / (12.0 * t1)
             } else {
                 0.0
             },
             kink: (0..count)
-                .map(|n| {
-                    if n == 0 || n + 1 == count {
-                        return 0.0;
-                    }
-                    let poses = &path.poses;
-                    let before = geometry::unit(&(poses[n].tip - poses[n - 1].tip));
-                    let after = geometry::unit(&(poses[n + 1].tip - poses[n].tip));
-                    match (before, after) {
-                        (Some(b), Some(a)) => geometry::norm(&b.cross(&a)),
-                        _ => 0.0,
-                    }
-                })
+                .map(|n| tip_turn(path, n).map_or(0.0, |(b, a)| geometry::norm(&b.cross(&a))))
                 .collect(),
             slope: (0..count - 1)
                 .map(|n| (path.joints[n + 1] - path.joints[n]) / (path.s[n + 1] - path.s[n]))
@@ -241,6 +232,7 @@ impl<'a> Constraints<'a> {
         bends
     }
 
+    /// [`Constraints::bends`] without the cache.
     fn bends_now(&self, n: usize, v: f64) -> Bends {
         let last = self.slope.len() - 1;
         let (g_in, g_out) = (
@@ -259,14 +251,13 @@ impl<'a> Constraints<'a> {
             return bends;
         }
         let (a, b) = (0.5 * l1, 0.5 * l2);
-        let centre = self.path.s[n];
+        let (centre, area) = (self.path.s[n], l1 * l2);
         for place in [0.0, a - b, b - a, a + b, -a - b] {
             let c = centre + place;
             let (q1, t1) = self.at(c + a + b, n);
             let (q2, t2) = self.at(c + a - b, n);
             let (q3, t3) = self.at(c - a + b, n);
             let (q4, t4) = self.at(c - a - b, n);
-            let area = l1 * l2;
             let bend = (q1 - q2 - q3 + q4) / area;
             bends.least = bends.least.inf(&bend);
             bends.greatest = bends.greatest.sup(&bend);
@@ -365,6 +356,18 @@ impl FeedConstraints for Constraints<'_> {
         }
         (lo, hi)
     }
+}
+
+/// The tip's unit directions before and after node `n` (none at the ends or beside a
+/// zero-length piece).
+fn tip_turn(path: &JointPath, n: usize) -> Option<(Vector<3>, Vector<3>)> {
+    let poses = &path.poses;
+    if n == 0 || n + 1 >= poses.len() {
+        return None;
+    }
+    let before = geometry::unit(&(poses[n].tip - poses[n - 1].tip))?;
+    let after = geometry::unit(&(poses[n + 1].tip - poses[n].tip))?;
+    Some((before, after))
 }
 
 /// What [`Constraints::bends`] finds at a node.
@@ -670,18 +673,10 @@ impl Plan {
 
     /// The node in `first..=last` where the tip's path turns most.
     fn sharpest_turn(&self, first: usize, last: usize) -> usize {
-        let poses = &self.path.poses;
-        let turn = |n: usize| {
-            if n == 0 || n + 1 >= poses.len() {
-                return 0.0;
-            }
-            let before = geometry::unit(&(poses[n].tip - poses[n - 1].tip));
-            let after = geometry::unit(&(poses[n + 1].tip - poses[n].tip));
-            match (before, after) {
-                (Some(b), Some(a)) => geometry::norm(&(a - b)),
-                _ => 0.0,
-            }
-        };
+        // The chord between the directions: it grows up to a reversal (a sine would fall
+        // back to 0 there).
+        let turn =
+            |n: usize| tip_turn(&self.path, n).map_or(0.0, |(b, a)| geometry::norm(&(a - b)));
         (first..=last)
             .max_by(|&m, &n| turn(m).total_cmp(&turn(n)))
             .unwrap_or(first)
