@@ -5,7 +5,7 @@
 # The machine has one stable toolchain: RUSTC_BOOTSTRAP=1 lets cargo-fuzz pass its
 # nightly-only flags to it (the sanitizer runtimes ship with stable's standard library).
 
-TARGETS=(fmi_calls deserialize_state nurbs_json apt_cl)
+TARGETS=(fmi_calls deserialize_state nurbs_json apt_cl gcode_program)
 FUZZ_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 BIN="$FUZZ_DIR/target/x86_64-unknown-linux-gnu/release"
 export RUSTC_BOOTSTRAP=1

@@ -10,7 +10,8 @@
 //! `Path::mirrored`, which is checked against them.
 
 use contour_core::control::{CccMode, FuzzyFactors};
-use contour_core::path::{builtin, CircularArc, Line, Nurbs, Path};
+use contour_core::path::program::{self, Move, Shape};
+use contour_core::path::{builtin, CircularArc, Line, Nurbs, Path, Program};
 use contour_core::plant::XyTableParams;
 use contour_core::sim::{simulate, SimConfig};
 
@@ -40,8 +41,28 @@ fn mirror_by_definition(path: &Path) -> Path {
                 .unwrap(),
             )
         }
+        Path::Program(p) => {
+            let moves = p.moves().iter().map(|m| {
+                let shape = match &m.shape {
+                    Shape::Line(l) => match mirror_by_definition(&Path::Line(l.clone())) {
+                        Path::Line(l) => Shape::Line(l),
+                        _ => unreachable!(),
+                    },
+                    Shape::Arc(a) => match mirror_by_definition(&Path::Arc(a.clone())) {
+                        Path::Arc(a) => Shape::Arc(a),
+                        _ => unreachable!(),
+                    },
+                };
+                Move { shape, ..m.clone() }
+            });
+            Path::Program(Program::new(moves.collect()).unwrap())
+        }
     }
 }
+
+/// A part with corners, a tangent arc, a 1 mm radius and a clockwise arc.
+const PART: &str =
+    "G1 X10 F600\nG3 X15 Y5 R5\nG1 Y8\nG2 X17 Y10 I2 J0\nG1 X18\nG3 X18 Y12 R1\nG1 X0 Y12\nG1 Y0\n";
 
 /// A tuned-looking set that leans hard on the fuzzy Kp increment, where an asymmetric
 /// schedule shows most (the defect this test guards against was worst there).
@@ -87,42 +108,68 @@ fn mirrored_paths_give_mirrored_runs() {
                 };
                 let path = builtin::by_name(name).unwrap();
                 let mirror = mirror_by_definition(&path);
-                let a = simulate(config(path)).unwrap();
-                let b = simulate(config(mirror)).unwrap();
                 let case = format!("{name}, {plant_name} plant, CCC {mode_name}");
-                assert!(a.metrics.is_stable(), "{case}: {:?}", a.metrics);
-                assert_eq!(a.trace.len(), b.trace.len(), "{case}");
-                let (ta, tb) = (&a.trace, &b.trace);
-                for k in 0..ta.len() {
-                    let deviations = [
-                        ta.true_error[k] + tb.true_error[k],
-                        ta.estimated_error[k] + tb.estimated_error[k],
-                        ta.actual[k][0] - tb.actual[k][0],
-                        ta.actual[k][1] + tb.actual[k][1],
-                        ta.reference[k][0] - tb.reference[k][0],
-                        ta.reference[k][1] + tb.reference[k][1],
-                    ];
-                    for d in deviations {
-                        assert!(
-                            d.abs() <= TOLERANCE_MM,
-                            "{case}: sample {k} deviates by {d:e} mm: {:?} vs {:?}",
-                            (ta.true_error[k], ta.estimated_error[k], ta.actual[k]),
-                            (tb.true_error[k], tb.estimated_error[k], tb.actual[k]),
-                        );
-                    }
-                    for j in 0..3 {
-                        let (ga, gb) = (ta.gains[k][j], tb.gains[k][j]);
-                        assert!(
-                            (ga - gb).abs() <= 1e-9 * ga.abs().max(1.0),
-                            "{case}: sample {k} gain {j}: {ga} vs {gb}"
-                        );
-                    }
-                }
-                let peak = ta.true_error.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
-                eprintln!("{case}: peak |true contour error| {:.4} um", peak * 1e3);
+                assert_mirrored_runs(&case, config(path), config(mirror));
                 compared += 1;
             }
         }
     }
     assert_eq!(compared, builtin::NAMES.len() * 2 * 4);
+}
+
+#[test]
+fn a_part_program_and_its_mirror_give_mirrored_runs() {
+    let part = Path::Program(program::parse_program(PART, "part.ngc").unwrap());
+    assert_eq!(part.mirrored(), mirror_by_definition(&part));
+    assert_eq!(part.mirrored().mirrored(), part);
+    for (mode_name, mode) in [("off", CccMode::Off), ("fuzzy", CccMode::Fuzzy)] {
+        let config = |path: Path| {
+            let mut c = SimConfig::builtin("circle").unwrap();
+            c.path = path;
+            c.controller.ccc.mode = mode;
+            c
+        };
+        let mirror = mirror_by_definition(&part);
+        assert_mirrored_runs(
+            &format!("part, CCC {mode_name}"),
+            config(part.clone()),
+            config(mirror),
+        );
+    }
+}
+
+/// Runs both configurations and checks the second is the mirror image of the first.
+fn assert_mirrored_runs(case: &str, original: SimConfig, mirrored: SimConfig) {
+    let a = simulate(original).unwrap();
+    let b = simulate(mirrored).unwrap();
+    assert!(a.metrics.is_stable(), "{case}: {:?}", a.metrics);
+    assert_eq!(a.trace.len(), b.trace.len(), "{case}");
+    let (ta, tb) = (&a.trace, &b.trace);
+    for k in 0..ta.len() {
+        let deviations = [
+            ta.true_error[k] + tb.true_error[k],
+            ta.estimated_error[k] + tb.estimated_error[k],
+            ta.actual[k][0] - tb.actual[k][0],
+            ta.actual[k][1] + tb.actual[k][1],
+            ta.reference[k][0] - tb.reference[k][0],
+            ta.reference[k][1] + tb.reference[k][1],
+        ];
+        for d in deviations {
+            assert!(
+                d.abs() <= TOLERANCE_MM,
+                "{case}: sample {k} deviates by {d:e} mm: {:?} vs {:?}",
+                (ta.true_error[k], ta.estimated_error[k], ta.actual[k]),
+                (tb.true_error[k], tb.estimated_error[k], tb.actual[k]),
+            );
+        }
+        for j in 0..3 {
+            let (ga, gb) = (ta.gains[k][j], tb.gains[k][j]);
+            assert!(
+                (ga - gb).abs() <= 1e-9 * ga.abs().max(1.0),
+                "{case}: sample {k} gain {j}: {ga} vs {gb}"
+            );
+        }
+    }
+    let peak = ta.true_error.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
+    eprintln!("{case}: peak |true contour error| {:.4} um", peak * 1e3);
 }

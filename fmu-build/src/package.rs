@@ -32,9 +32,10 @@ impl Resource {
     /// A resource for `model` from the file `source`, stored under its own file name.
     ///
     /// Refused, with a message naming the file or the model: an unknown model, a file
-    /// that does not exist or is not a regular file, and a `.json` file for
-    /// `PathInterpolator2D` that is not a valid NURBS path file (the FMU would otherwise
-    /// only fail when an importer initializes it).
+    /// that does not exist or is not a regular file, and a `.json` or G-code file
+    /// (`.ngc`, `.nc`, `.gcode`, `.tap`) for `PathInterpolator2D` that is not a valid
+    /// NURBS path file or program (the FMU would otherwise only fail when an importer
+    /// initializes it).
     pub fn new(model: &str, source: impl Into<PathBuf>) -> Result<Self, String> {
         let source = source.into();
         let known: Vec<&str> = models::all().iter().map(|m| m.identifier).collect();
@@ -67,10 +68,20 @@ impl Resource {
                 )
             })?
             .to_string();
-        if model == PATH_MODEL && name.to_ascii_lowercase().ends_with(".json") {
-            contour_core::path::file::load_nurbs::<2>(&source)
-                .map_err(|e| format!("--resource {model}={}: {e}", source.display()))?;
-        }
+        let lower = name.to_ascii_lowercase();
+        let is_program = contour_core::path::program::PROGRAM_EXTENSIONS
+            .iter()
+            .any(|x| lower.ends_with(&format!(".{x}")));
+        let checked = if model != PATH_MODEL {
+            Ok(())
+        } else if lower.ends_with(".json") {
+            contour_core::path::file::load_nurbs::<2>(&source).map(drop)
+        } else if is_program {
+            contour_core::path::program::load_program(&source).map(drop)
+        } else {
+            Ok(())
+        };
+        checked.map_err(|e| format!("--resource {model}={}: {e}", source.display()))?;
         Ok(Resource {
             model: model.to_string(),
             source,

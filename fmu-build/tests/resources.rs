@@ -123,6 +123,12 @@ fn bad_resource_requests_are_refused_with_a_clear_message() {
     std::fs::write(&broken, "{\n \"degree\": 3,\n \"knots\": [0, 0,, 1]\n}").unwrap();
     let e = Resource::new("PathInterpolator2D", &broken).unwrap_err();
     assert!(e.contains("broken.json:3:"), "{e}");
+    let program = dir.join("part.NGC");
+    std::fs::write(&program, "G21\nG1 X10 F600\nG18\n").unwrap();
+    let e = Resource::new("PathInterpolator2D", &program).unwrap_err();
+    assert!(e.contains("part.NGC:3:1: only the XY plane"), "{e}");
+    std::fs::write(&program, "G21\nG1 X10 F600\nG2 X0 R5\n").unwrap();
+    assert!(Resource::new("PathInterpolator2D", &program).is_ok());
 
     // Two files that would land on the same name.
     let other = dir.join("sub");

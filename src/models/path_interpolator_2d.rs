@@ -26,7 +26,8 @@ variable_table! {
         "path",
         Start::String("circle"),
         "circle (the paper's), line or arc (from the line.*/arc.* parameters), infinity, \
-         trident, or a NURBS JSON file: absolute, or relative to the FMU's resources folder",
+         trident, a NURBS JSON file or a G-code program (.ngc, .nc, .gcode, .tap): absolute, \
+         or relative to the FMU's resources folder",
     );
     FEED: Real = Variable::parameter(
         "feed",
@@ -84,6 +85,7 @@ pub static INFO: ModelInfo = ModelInfo {
         Box::new(PathInterpolator2D {
             environment: environment.clone(),
             state: None,
+            warnings: Vec::new(),
         })
     },
 };
@@ -126,7 +128,8 @@ impl SavedState for State {
             Path::Arc(a) => CircularArc::new(a.center(), a.radius(), a.start_angle(), a.sweep())
                 .map(drop)
                 .map_err(|e| format!("interpolator path: {e}"))?,
-            Path::Nurbs(_) => {}
+            // Both decoders check their paths as their constructors do.
+            Path::Nurbs(_) | Path::Program(_) => {}
         }
         state_check::all_finite(self)?;
         let (u0, u1) = it.path().param_range();
@@ -144,6 +147,8 @@ pub struct PathInterpolator2D {
     environment: Environment,
     /// `None` until initialized.
     state: Option<State>,
+    /// The path reader's warnings of the last initialization.
+    warnings: Vec<String>,
 }
 
 fn positive(values: &Values, variable: Real) -> Result<f64, String> {
@@ -198,14 +203,30 @@ impl Model for PathInterpolator2D {
     fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult {
         let feed = positive(values, FEED)?;
         let ts = check_period("Ts", TS.get(values))?;
-        let interpolator = Interpolator::new(path(values, &self.environment)?, feed, ts)
-            .map_err(|e| e.to_string())?;
+        let mut path = path(values, &self.environment)?;
+        self.warnings = match &mut path {
+            Path::Program(program) => std::mem::take(&mut program.warnings)
+                .into_iter()
+                .chain(std::iter::once(
+                    "the program runs at the constant 'feed': its F words, rapids and corner \
+                     modes are read but not yet planned"
+                        .to_string(),
+                ))
+                .map(|w| format!("parameter 'path': {w}"))
+                .collect(),
+            _ => Vec::new(),
+        };
+        let interpolator = Interpolator::new(path, feed, ts).map_err(|e| e.to_string())?;
         self.state = Some(State {
             interpolator,
             clock: SampleClock::new(start_time, ts),
         });
         self.write_outputs(values);
         Ok(())
+    }
+
+    fn take_warnings(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.warnings)
     }
 
     fn do_step(&mut self, values: &mut Values, time: f64, step: f64) -> ModelResult {

@@ -351,3 +351,35 @@ def test_a_path_file_in_the_fmus_resources_folder_is_found_by_its_relative_name(
     assert np.allclose(interpolator.reals(["ref.x", "ref.y"]), [1.0, 1.0])
     interpolator.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.5)
     assert np.allclose(interpolator.reals(["ref.x", "ref.y"]), [4.0, 5.0], atol=1e-9)
+
+
+def test_a_gcode_part_runs_at_constant_feed_with_its_preamble_warned_about(interpolator, tmp_path):
+    # A 20 mm square with a 2 mm round in its third corner, in inches and incremental
+    # moves after the preamble a CAM system writes; the part is independent of the reader:
+    # its corners are the test's own numbers.
+    part = tmp_path / "square.NGC"
+    part.write_text(
+        "%\n(square)\nG20 G17 G40 G49 G80 G90 G94\nT1 M6\nS10000 M3\nG0 Z0.2\nG0 X0 Y0\n"
+        "G1 Z-0.04 F10\nG1 X0.787402 F30\nG91 Y0.787402\nG90 X0.078740\n"
+        "G3 X0 Y0.708661 I0 J-0.078740\nG1 Y0\nG0 Z0.2\nM30\n%\n")
+    interpolator.fmu.setDebugLogging(True, ["logStatusWarning"])
+    interpolator.set(path=str(part), feed=10.0)
+    interpolator.fmu.exitInitializationMode()
+    warnings = interpolator.log.warnings()
+    for kind in ["G40", "T (tool number)", "S (spindle speed)", "Z-only", "constant 'feed'"]:
+        assert any(kind in w for w in warnings), (kind, warnings)
+    assert np.allclose(interpolator.reals(["ref.x", "ref.y"]), [0.0, 0.0])
+    length = 20.0 + 20.0 + 18.0 + np.pi + 18.0
+    # At 10 mm/s: 10 mm along the first side, 5 mm up the second, 1.4 mm into the round.
+    # A chord across a corner is one feed step long and so covers up to (sqrt 2 - 1) of
+    # a step more of the part: the samples after a corner run up to 4.2 um ahead.
+    along = {1.0: ([10.0, 0.0], 2e-5), 2.5: ([20.0, 5.0], 5e-3),
+             5.94: ([2.0 - 2.0 * np.sin(0.7), 18.0 + 2.0 * np.cos(0.7)], 9e-3)}
+    time = 0.0
+    for t, (want, tolerance) in along.items():
+        interpolator.fmu.doStep(currentCommunicationPoint=time, communicationStepSize=t - time)
+        time = t
+        assert np.allclose(interpolator.reals(["ref.x", "ref.y"]), want, atol=tolerance), t
+    interpolator.fmu.doStep(currentCommunicationPoint=time, communicationStepSize=length / 10.0 - time + 0.01)
+    assert np.allclose(interpolator.reals(["ref.x", "ref.y"]), [0.0, 0.0], atol=1e-9)
+    assert interpolator.fmu.getBoolean([interpolator.vr["done"]])[0]

@@ -90,6 +90,13 @@ impl CircularArc {
         self.sweep.abs() >= 2.0 * PI * (1.0 - 1e-12)
     }
 
+    /// The mirror image about the x axis (y → −y): the sense of travel reverses.
+    pub fn mirrored(&self) -> CircularArc {
+        let c = Vector2::new(self.center[0], -self.center[1]);
+        CircularArc::new(c, self.radius, -self.start_angle, -self.sweep)
+            .expect("the mirror image of a valid arc is valid")
+    }
+
     /// Parameter of the point of the arc at polar angle `phi` about the centre, if that
     /// angle lies within the sweep (used by the exact-distance code).
     pub fn param_of_angle(&self, phi: f64) -> Option<f64> {

@@ -53,15 +53,7 @@ pub fn parse_nurbs<const D: usize>(text: &str, name: &str) -> Result<Nurbs<D>, P
             _ => format!("wrong NURBS file content: {e}"),
         },
     })?;
-    Nurbs::try_from(data).map_err(|e| PathError::File {
-        file: name.to_string(),
-        line: 0,
-        column: 0,
-        message: match e {
-            PathError::Invalid(m) => m,
-            other => other.to_string(),
-        },
-    })
+    Nurbs::try_from(data).map_err(|e| e.in_file(name))
 }
 
 #[cfg(test)]

@@ -57,6 +57,14 @@ impl Line<2> {
     }
 }
 
+impl Line<2> {
+    /// The mirror image about the x axis (y → −y), travelled the mirrored way.
+    pub fn mirrored(&self) -> Line {
+        let flip = |p: Vector<2>| Vector::<2>::new(p[0], -p[1]);
+        Line::new(flip(self.a), flip(self.b)).expect("the mirror image of a valid line is valid")
+    }
+}
+
 impl<const D: usize> Curve<D> for Line<D> {
     fn param_range(&self) -> (f64, f64) {
         (0.0, 1.0)

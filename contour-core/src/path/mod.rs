@@ -18,6 +18,7 @@ mod line;
 mod nurbs;
 pub mod plan;
 mod polyline;
+pub mod program;
 mod tool_path;
 
 pub use arc::CircularArc;
@@ -27,6 +28,7 @@ pub use joint_reference::{JointReference, JointSample};
 pub use line::Line;
 pub use nurbs::{clamped_uniform_knots, Nurbs, NurbsData, MAX_DEGREE};
 pub use polyline::Polyline;
+pub use program::Program;
 pub use tool_path::{load_poses, ToolPath, ToolPathData, BUILTIN_TOOL_PATHS};
 
 use std::fmt;
@@ -59,6 +61,20 @@ impl PathError {
     pub(crate) fn invalid(msg: impl Into<String>) -> Self {
         PathError::Invalid(msg.into())
     }
+
+    /// The error as one of the file `file` (a file's content that no path can be made of:
+    /// the message names the file, without a line).
+    pub(crate) fn in_file(self, file: &str) -> Self {
+        PathError::File {
+            file: file.to_string(),
+            line: 0,
+            column: 0,
+            message: match self {
+                PathError::Invalid(m) => m,
+                other => other.to_string(),
+            },
+        }
+    }
 }
 
 impl fmt::Display for PathError {
@@ -67,7 +83,7 @@ impl fmt::Display for PathError {
             PathError::Invalid(m) => write!(f, "invalid path: {m}"),
             PathError::UnknownName(n) => write!(
                 f,
-                "unknown path '{n}': expected circle, line, arc, infinity, trident or a NURBS JSON file"
+                "unknown path '{n}': expected circle, line, arc, infinity, trident, a NURBS JSON file or a G-code program (.ngc, .nc, .gcode, .tap)"
             ),
             PathError::File {
                 file,
@@ -159,6 +175,8 @@ pub enum Path {
     Arc(CircularArc),
     /// NURBS curve of any degree up to [`MAX_DEGREE`].
     Nurbs(Nurbs),
+    /// A G-code part program: line and arc moves end to end.
+    Program(Program),
 }
 
 impl Path {
@@ -175,7 +193,13 @@ impl Path {
                 };
                 // Something that looks like a file gets the file's own error (naming it).
                 let looks_like_file = spec.ends_with(".json") || spec.contains(['/', '\\']);
-                if full.is_file() || looks_like_file {
+                let extension = fs.extension().and_then(|e| e.to_str()).unwrap_or("");
+                let is_program = program::PROGRAM_EXTENSIONS
+                    .iter()
+                    .any(|x| x.eq_ignore_ascii_case(extension));
+                if is_program {
+                    program::load_program(&full).map(Path::Program)
+                } else if full.is_file() || looks_like_file {
                     file::load_nurbs(&full).map(Path::Nurbs)
                 } else {
                     Err(PathError::UnknownName(spec.to_string()))
@@ -202,11 +226,8 @@ impl Path {
     pub fn mirrored(&self) -> Path {
         let flip = |p: Vector2| Vector2::new(p[0], -p[1]);
         let rebuilt = match self {
-            Path::Line(l) => Line::new(flip(l.start()), flip(l.end())).map(Path::Line),
-            Path::Arc(a) => {
-                CircularArc::new(flip(a.center()), a.radius(), -a.start_angle(), -a.sweep())
-                    .map(Path::Arc)
-            }
+            Path::Line(l) => Ok(Path::Line(l.mirrored())),
+            Path::Arc(a) => Ok(Path::Arc(a.mirrored())),
             Path::Nurbs(n) => Nurbs::new(
                 n.degree(),
                 n.knots().to_vec(),
@@ -214,6 +235,7 @@ impl Path {
                 Some(n.weights().to_vec()),
             )
             .map(Path::Nurbs),
+            Path::Program(p) => Ok(Path::Program(p.mirrored())),
         };
         // Mirroring keeps every property the constructors check.
         rebuilt.expect("the mirror image of a valid path is valid")
@@ -226,6 +248,7 @@ impl Curve for Path {
             Path::Line(c) => c.param_range(),
             Path::Arc(c) => c.param_range(),
             Path::Nurbs(c) => c.param_range(),
+            Path::Program(c) => c.param_range(),
         }
     }
     fn eval(&self, u: f64) -> CurvePoint {
@@ -233,6 +256,7 @@ impl Curve for Path {
             Path::Line(c) => c.eval(u),
             Path::Arc(c) => c.eval(u),
             Path::Nurbs(c) => c.eval(u),
+            Path::Program(c) => c.eval(u),
         }
     }
     fn point(&self, u: f64) -> Vector2 {
@@ -240,6 +264,7 @@ impl Curve for Path {
             Path::Line(c) => c.point(u),
             Path::Arc(c) => c.point(u),
             Path::Nurbs(c) => c.point(u),
+            Path::Program(c) => c.point(u),
         }
     }
     fn length_between(&self, u0: f64, u1: f64) -> f64 {
@@ -247,6 +272,7 @@ impl Curve for Path {
             Path::Line(c) => c.length_between(u0, u1),
             Path::Arc(c) => c.length_between(u0, u1),
             Path::Nurbs(c) => c.length_between(u0, u1),
+            Path::Program(c) => c.length_between(u0, u1),
         }
     }
     fn breakpoints(&self) -> Vec<f64> {
@@ -254,6 +280,7 @@ impl Curve for Path {
             Path::Line(c) => c.breakpoints(),
             Path::Arc(c) => c.breakpoints(),
             Path::Nurbs(c) => c.breakpoints(),
+            Path::Program(c) => c.breakpoints(),
         }
     }
 }
@@ -266,6 +293,11 @@ impl From<Line> for Path {
 impl From<CircularArc> for Path {
     fn from(c: CircularArc) -> Self {
         Path::Arc(c)
+    }
+}
+impl From<Program> for Path {
+    fn from(c: Program) -> Self {
+        Path::Program(c)
     }
 }
 impl From<Nurbs> for Path {

@@ -196,15 +196,7 @@ pub fn load_poses(spec: &str, chord: f64) -> Result<(Vec<Pose>, Vec<String>), Pa
         }
         Source::Json(file) => {
             let (path, _) = ToolPath::load(spec)?;
-            let poses = path.poses(chord).map_err(|e| PathError::File {
-                file: file.to_string(),
-                line: 0,
-                column: 0,
-                message: match e {
-                    PathError::Invalid(m) => m,
-                    other => other.to_string(),
-                },
-            })?;
+            let poses = path.poses(chord).map_err(|e| e.in_file(file))?;
             Ok((poses, Vec::new()))
         }
         Source::Builtin(_) => Ok((ToolPath::load(spec)?.0.poses(chord)?, Vec::new())),

@@ -583,7 +583,7 @@ fn state_bytes_of(model: &'static ModelInfo) -> Vec<u8> {
 // Path files
 
 fn write_path_files() {
-    let files: [(&str, &str); 13] = [
+    let files: [(&str, &str); 17] = [
         (
             "syntax.json",
             "{\n  \"degree\": 1,\n  \"knots\": [0, 0,, 1, 1],\n  \"control_points\": [[0, 0], [3, 4]]\n}\n",
@@ -623,6 +623,10 @@ fn write_path_files() {
                 "length": 100}"#,
         ),
         ("far.cl", "GOTO/-1e308,0,0,0,0,1\nGOTO/1e308,0,0,0,0,1\n"),
+        ("plane.ngc", "G21 G90\nG1 X10 F600\nG18 G2 X0 Z10 I-5\n"),
+        ("off_circle.ngc", "G1 X10 F600\nG2 X0 Y10 I0 J5\n"),
+        ("helix.ngc", "G0 Z5\nG1 X10 F600\nG1 X20 Z-1\n"),
+        ("expression.ngc", "G21\nG1 X[1+2] F600\n"),
     ];
     std::fs::create_dir_all(folder()).unwrap();
     for (name, text) in files {

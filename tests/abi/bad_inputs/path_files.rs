@@ -4,6 +4,42 @@ use super::*;
 
 pub(super) static CASES: &[Case] = &[
     case(
+        "a G-code program in the XZ plane",
+        P2,
+        Initialization,
+        |s| s.exit_with(|s| s.set_string("path", &s.file("plane.ngc"))),
+        ERROR,
+        Some("plane.ngc:3:1: only the XY plane (G17) is supported"),
+        Corrected,
+    ),
+    case(
+        "a G-code arc whose end is not on its circle",
+        P2,
+        Initialization,
+        |s| s.exit_with(|s| s.set_string("path", &s.file("off_circle.ngc"))),
+        ERROR,
+        Some("off_circle.ngc:2:1: the arc's end is not on its circle"),
+        Corrected,
+    ),
+    case(
+        "a G-code move of X together with Z",
+        P2,
+        Initialization,
+        |s| s.exit_with(|s| s.set_string("path", &s.file("helix.ngc"))),
+        ERROR,
+        Some("helix.ngc:3:8: a move of X or Y together with Z"),
+        Corrected,
+    ),
+    case(
+        "a G-code program with an expression (not in the subset read)",
+        P2,
+        Initialization,
+        |s| s.exit_with(|s| s.set_string("path", &s.file("expression.ngc"))),
+        ERROR,
+        Some("expression.ngc:2:5: G-code syntax"),
+        Corrected,
+    ),
+    case(
         "a NURBS file with a JSON syntax error",
         P2,
         Initialization,

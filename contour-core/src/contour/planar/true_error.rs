@@ -20,7 +20,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::contour::ContourEstimate;
 use crate::geometry::{self, Vector, Vector2};
-use crate::path::{CircularArc, Curve, Line, Path};
+use crate::path::program::Shape;
+use crate::path::{CircularArc, Curve, Line, Path, Program};
 
 /// Exact contour error of one point.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -53,6 +54,45 @@ pub fn true_error(path: &Path, p: Vector2) -> TrueError {
         Path::Line(l) => line_true_error(l, p),
         Path::Arc(a) => arc_true_error(a, p),
         Path::Nurbs(n) => curve_true_error(n, p),
+        Path::Program(program) => (0..program.moves().len())
+            .map(|i| move_true_error(program, i, p))
+            .fold(None, |best: Option<TrueError>, e| match best {
+                Some(b) if b.error.abs() <= e.error.abs() => Some(b),
+                _ => Some(e),
+            })
+            .expect("a program has a move"),
+    }
+}
+
+/// Exact distance to move `i` of a program, its foot parameter the path position s.
+fn move_true_error(program: &Program, i: usize, p: Vector2) -> TrueError {
+    let mut e = match &program.moves()[i].shape {
+        Shape::Line(l) => line_true_error(l, p),
+        Shape::Arc(a) => arc_true_error(a, p),
+    };
+    e.u = program.position(i, e.u);
+    e
+}
+
+/// The box of move `i` of a program: its end points, and on an arc the extreme points
+/// of its circle that the sweep passes.
+fn move_box(program: &Program, i: usize) -> BBox {
+    let point = |q: Vector2| [q[0], q[1], q[0], q[1]];
+    match &program.moves()[i].shape {
+        Shape::Line(l) => union(&point(l.start()), &point(l.end())),
+        Shape::Arc(a) => {
+            let mut b = union(&point(a.point(0.0)), &point(a.point(1.0)));
+            for k in 0..4 {
+                let phi = k as f64 * std::f64::consts::FRAC_PI_2;
+                if a.param_of_angle(phi).is_some() {
+                    let (s, c) = phi.sin_cos();
+                    b = union(&b, &point(a.center() + Vector2::new(c, s) * a.radius()));
+                }
+            }
+            // Rounding in the extreme points' sines: a nanometre of margin.
+            let m = 1e-9 * (1.0 + a.radius());
+            [b[0] - m, b[1] - m, b[2] + m, b[3] + m]
+        }
     }
 }
 
@@ -293,6 +333,16 @@ impl TrueErrorIndex {
                 }
             }
         }
+        if let Path::Program(program) = path {
+            // One chunk a move, solved exactly.
+            for i in 0..program.moves().len() {
+                chunks.push(Chunk {
+                    u0: program.start_of(i),
+                    u1: program.start_of(i + 1),
+                });
+                boxes.push(move_box(program, i));
+            }
+        }
         let leaves = chunks.len().max(1).next_power_of_two();
         let mut tree = vec![EMPTY; 2 * leaves];
         for (i, b) in boxes.into_iter().enumerate() {
@@ -325,10 +375,11 @@ impl TrueErrorIndex {
         match &self.path {
             Path::Line(l) => return line_true_error(l, p),
             Path::Arc(a) => return arc_true_error(a, p),
-            Path::Nurbs(_) => {}
+            Path::Nurbs(_) | Path::Program(_) => {}
         }
         let first = self.locate(hint);
         let mut best = self.chunk_min(first, p);
+        let mut best_chunk = first;
         let mut best2 = best.0 * best.0;
         // Depth-first branch and bound; a stack of depth ≤ 2·log2(leaves) suffices.
         let mut stack = [0usize; 128];
@@ -344,9 +395,10 @@ impl TrueErrorIndex {
                 let i = node - self.leaves;
                 if i != first && i < self.chunks.len() {
                     let r = self.chunk_min(i, p);
-                    if r.0 < best.0 {
+                    if r.0 < best.0 || r.0 == best.0 && i < best_chunk {
                         best = r;
                         best2 = r.0 * r.0;
+                        best_chunk = i;
                     }
                 }
             } else if top + 2 <= stack.len() {
@@ -362,7 +414,10 @@ impl TrueErrorIndex {
                 top += 2;
             }
         }
-        finish(&self.path, p, best.1)
+        match &self.path {
+            Path::Program(program) => move_true_error(program, best_chunk, p),
+            _ => finish(&self.path, p, best.1),
+        }
     }
 
     /// Chunk containing parameter `u` (clamped).
@@ -377,6 +432,10 @@ impl TrueErrorIndex {
 
     /// Minimum distance over chunk `i`: best of its samples, then Newton in the bracket.
     fn chunk_min(&self, i: usize, p: Vector2) -> (f64, f64) {
+        if let Path::Program(program) = &self.path {
+            let e = move_true_error(program, i, p);
+            return (e.error.abs(), e.u);
+        }
         let Chunk { u0, u1 } = self.chunks[i];
         let h = (u1 - u0) / CHUNK_SUB as f64;
         let mut bi = 0;

@@ -1,0 +1,165 @@
+//! The circle of a G2/G3 block from its words (docs/design/two-axis.md §4.7): the start,
+//! the programmed end and either the centre (I, J) or the radius R (negative: the arc
+//! over 180°). A centre that is not equally far from both ends, beyond [`END_TOLERANCE`],
+//! is refused, as LinuxCNC refuses it; within it, the centre moves to the nearest point
+//! equally far from both, so the arc ends exactly at the programmed end and the next
+//! move starts there.
+
+use std::f64::consts::PI;
+
+use crate::geometry::{self, Vector2};
+use crate::path::CircularArc;
+
+/// How far (mm) the programmed end may lie off the circle through the start:
+/// max(0.002 mm, 10⁻⁴ of the radius). CAM systems round coordinates to 3 or 4 decimals,
+/// which puts ends up to 0.0007 mm off; more than that is a wrong program.
+pub fn end_tolerance(radius: f64) -> f64 {
+    END_TOLERANCE.max(1e-4 * radius)
+}
+
+/// The absolute part of [`end_tolerance`], mm.
+pub const END_TOLERANCE: f64 = 0.002;
+
+/// How the circle was given.
+#[derive(Clone, Copy, Debug)]
+pub enum Circle {
+    /// The centre (absolute, mm).
+    Centre(Vector2),
+    /// R, mm: > 0 for the arc up to 180°, < 0 for the one beyond.
+    Radius(f64),
+}
+
+/// The arc from `start` to `end` about `circle`, clockwise when `clockwise` (G2);
+/// `start == end` with a centre is a full circle. The error says what is wrong.
+pub fn arc(
+    start: Vector2,
+    end: Vector2,
+    circle: Circle,
+    clockwise: bool,
+) -> Result<CircularArc, String> {
+    let centre = match circle {
+        Circle::Centre(c) => fit_centre(start, end, c)?,
+        Circle::Radius(r) => radius_centre(start, end, r, clockwise)?,
+    };
+    let radius = geometry::dist(&start, &centre);
+    let angle = |p: Vector2| (p[1] - centre[1]).atan2(p[0] - centre[0]);
+    let (a0, a1) = (angle(start), angle(end));
+    let turn = if clockwise { a0 - a1 } else { a1 - a0 };
+    let mut sweep = turn.rem_euclid(2.0 * PI);
+    if start == end || sweep == 0.0 {
+        sweep = 2.0 * PI;
+    }
+    let sweep = if clockwise { -sweep } else { sweep };
+    CircularArc::new(centre, radius, a0, sweep).map_err(|e| e.to_string())
+}
+
+/// The centre nearest `c` that is equally far from `start` and `end` (refused when `c`
+/// is not within the tolerance of that).
+fn fit_centre(start: Vector2, end: Vector2, c: Vector2) -> Result<Vector2, String> {
+    let (r0, r1) = (geometry::dist(&start, &c), geometry::dist(&end, &c));
+    if r0 == 0.0 {
+        return Err("the arc's centre is its start point (radius 0)".into());
+    }
+    if (r1 - r0).abs() > end_tolerance(r0) || r1.is_nan() {
+        return Err(format!(
+            "the arc's end is not on its circle: {r0:.6} mm from the centre at the start, \
+             {r1:.6} mm at the end (tolerance {:.4} mm)",
+            end_tolerance(r0)
+        ));
+    }
+    let chord = end - start;
+    let length2 = chord.dot(&chord);
+    if length2 == 0.0 {
+        return Ok(c);
+    }
+    // Onto the perpendicular bisector of the chord.
+    let middle = (start + end) * 0.5;
+    Ok(c - chord * ((c - middle).dot(&chord) / length2))
+}
+
+/// The centre of the circle of radius |r| through `start` and `end` on the side R's sign
+/// and the direction choose.
+fn radius_centre(start: Vector2, end: Vector2, r: f64, clockwise: bool) -> Result<Vector2, String> {
+    let chord = end - start;
+    let length = geometry::norm(&chord);
+    if length == 0.0 {
+        return Err(
+            "an arc given by R must end elsewhere than it starts (a full circle takes I and J)"
+                .into(),
+        );
+    }
+    let half = 0.5 * length;
+    let radius = r.abs();
+    if radius == 0.0 || radius < half - end_tolerance(half) || radius.is_nan() {
+        return Err(format!(
+            "R = {r} mm is too small for an arc whose ends are {length:.6} mm apart"
+        ));
+    }
+    let rise = (radius * radius - half * half).max(0.0).sqrt();
+    // Up to 180°, a counter-clockwise arc has its centre left of the chord, a clockwise
+    // one right; beyond 180° (R < 0), the other side.
+    let left = clockwise == (r < 0.0);
+    let normal = geometry::perp(&(chord / length));
+    let side = if left { 1.0 } else { -1.0 };
+    Ok((start + end) * 0.5 + normal * (side * rise))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::path::Curve;
+
+    fn close(a: Vector2, b: Vector2) -> bool {
+        (a - b).amax() < 1e-12
+    }
+
+    #[test]
+    fn quarter_circles_by_centre_and_by_radius() {
+        let (s, e) = (Vector2::new(10.0, 0.0), Vector2::new(0.0, 10.0));
+        // G3 from (10, 0) to (0, 10) about the origin: a quarter, counter-clockwise.
+        let a = arc(s, e, Circle::Centre(Vector2::zeros()), false).unwrap();
+        assert!((a.sweep() - PI / 2.0).abs() < 1e-15 && a.radius() == 10.0);
+        // G2 the same way round is the three-quarter circle.
+        let b = arc(s, e, Circle::Centre(Vector2::zeros()), true).unwrap();
+        assert!((b.sweep() + 1.5 * PI).abs() < 1e-14);
+        // R 10: the short arcs; R −10: the long ones, about (10, 10).
+        let c = arc(s, e, Circle::Radius(10.0), false).unwrap();
+        assert!(close(c.center(), Vector2::zeros()));
+        let d = arc(s, e, Circle::Radius(-10.0), false).unwrap();
+        assert!(close(d.center(), Vector2::new(10.0, 10.0)));
+        assert!((d.sweep() - 1.5 * PI).abs() < 1e-14);
+        let f = arc(s, e, Circle::Radius(10.0), true).unwrap();
+        assert!(
+            close(f.center(), Vector2::new(10.0, 10.0)) && (f.sweep() + PI / 2.0).abs() < 1e-14
+        );
+        for x in [a, b, c, d, f] {
+            assert!(close(x.point(0.0), s) && close(x.point(1.0), e));
+        }
+    }
+
+    #[test]
+    fn full_circles_and_rounded_ends() {
+        let s = Vector2::new(5.0, 0.0);
+        let full = arc(s, s, Circle::Centre(Vector2::zeros()), true).unwrap();
+        assert_eq!(full.sweep(), -2.0 * PI);
+        // An end rounded to 3 decimals: 0.0005 mm off the circle, accepted; the centre
+        // moves so that the arc ends exactly there.
+        let e = Vector2::new(0.0005, 5.0);
+        let a = arc(s, e, Circle::Centre(Vector2::zeros()), false).unwrap();
+        assert!(close(a.point(1.0), e) && close(a.point(0.0), s));
+        assert!(geometry::norm(&a.center()) < 1e-3);
+        // 0.01 mm off: refused.
+        let e = arc(
+            s,
+            Vector2::new(0.0, 5.01),
+            Circle::Centre(Vector2::zeros()),
+            false,
+        );
+        assert!(e.unwrap_err().contains("not on its circle"));
+        assert!(arc(s, s, Circle::Radius(5.0), false).is_err());
+        assert!(arc(s, -s, Circle::Radius(4.0), false)
+            .unwrap_err()
+            .contains("too small"));
+        assert!(arc(s, s, Circle::Centre(s), false).is_err());
+    }
+}

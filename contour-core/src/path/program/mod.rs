@@ -1,0 +1,321 @@
+//! A part program on the XY table: the line and arc moves a G-code program describes, in
+//! mm, each with the speed it was programmed at and the corner mode at its end
+//! (docs/design/two-axis.md §4.7). Read from G-code by [`reader`].
+//!
+//! As a [`Curve`] a program is parameterised by arc length s ∈ [0, L]: move i covers
+//! [sᵢ, sᵢ₊₁], and its own parameter is (s − sᵢ)/ℓᵢ. A query finds its move by binary
+//! search over the starts (O(log n), no allocation).
+
+mod arc_words;
+pub mod reader;
+
+use serde::{Deserialize, Serialize};
+
+use super::{clamp_param, CircularArc, Curve, CurvePoint, Line, PathError};
+use crate::geometry::Vector2;
+
+pub use reader::{load_program, parse_program, PROGRAM_EXTENSIONS};
+
+/// The geometry of one move.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Shape {
+    /// G0 or G1.
+    Line(Line),
+    /// G2 (clockwise, sweep < 0) or G3 (counter-clockwise, sweep > 0).
+    Arc(CircularArc),
+}
+
+impl Shape {
+    fn curve(&self) -> &dyn Curve {
+        match self {
+            Shape::Line(l) => l,
+            Shape::Arc(a) => a,
+        }
+    }
+
+    /// The mirror image about the x axis (y → −y).
+    fn mirrored(&self) -> Shape {
+        match self {
+            Shape::Line(l) => Shape::Line(l.mirrored()),
+            Shape::Arc(a) => Shape::Arc(a.mirrored()),
+        }
+    }
+}
+
+/// The speed a move was programmed at.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Speed {
+    /// G0: the machine's rapid.
+    Rapid,
+    /// G1–G3 before the program's first F word: the interpolator's `feed` parameter.
+    Default,
+    /// G1–G3 after an F word, mm/s.
+    Feed(f64),
+}
+
+/// What the machine does at the end of a move, where the next one begins.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Corner {
+    /// G61 (or G61.1), or the end of XY motion for a Z-only move: stop exactly.
+    ExactStop,
+    /// G64 P…: blend within this many mm of the programmed corner.
+    Blend(f64),
+    /// Bare G64: blend within the interpolator's `tolerance` parameter.
+    BlendDefault,
+}
+
+/// One move of a program.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Move {
+    /// The programmed geometry.
+    pub shape: Shape,
+    /// The programmed speed.
+    pub speed: Speed,
+    /// The corner mode in force at the move's end.
+    pub corner: Corner,
+    /// 1-based line of the program that made the move.
+    pub line: usize,
+}
+
+/// The moves of a program end to end, with their starts along the path. It serialises
+/// as its moves alone, and bytes from elsewhere (a restored FMU state) go through the
+/// same checks as [`Program::new`]'s.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(into = "ProgramData", try_from = "ProgramData")]
+pub struct Program {
+    moves: Vec<Move>,
+    /// sᵢ of every move, then L: `moves.len() + 1` entries, increasing.
+    starts: Vec<f64>,
+    /// What the reader skipped, one line per kind (for the importer's log; not saved).
+    pub warnings: Vec<String>,
+}
+
+impl Program {
+    /// The program of `moves`, each starting where the one before ends (within 1e-9 mm
+    /// plus 1e-12 of the coordinates: a reader's arithmetic, not a gap in the program).
+    pub fn new(moves: Vec<Move>) -> Result<Self, PathError> {
+        if moves.is_empty() {
+            return Err(PathError::invalid("the program has no XY motion"));
+        }
+        let mut starts = Vec::with_capacity(moves.len() + 1);
+        let mut s = 0.0;
+        starts.push(s);
+        for pair in moves.windows(2) {
+            let (end, start) = (
+                pair[0].shape.curve().point(1.0),
+                pair[1].shape.curve().point(0.0),
+            );
+            let gap = (end - start).amax();
+            if gap > 1e-9 + 1e-12 * end.amax() || gap.is_nan() {
+                return Err(PathError::invalid(format!(
+                    "the move of line {} does not start where the move of line {} ends \
+                     ({gap:e} mm apart)",
+                    pair[1].line, pair[0].line
+                )));
+            }
+        }
+        for m in &moves {
+            s += m.shape.curve().length();
+            starts.push(s);
+        }
+        if !s.is_finite() {
+            return Err(PathError::invalid("the program's length is not finite"));
+        }
+        Ok(Program {
+            moves,
+            starts,
+            warnings: Vec::new(),
+        })
+    }
+
+    /// The moves, in program order.
+    pub fn moves(&self) -> &[Move] {
+        &self.moves
+    }
+
+    /// Where move `i` starts along the path, mm (`i = moves().len()`: the length).
+    pub fn start_of(&self, i: usize) -> f64 {
+        self.starts[i.min(self.moves.len())]
+    }
+
+    /// The move that holds path position `s` (clamped; a move's end belongs to it, a
+    /// NaN to the first move).
+    pub fn move_at(&self, s: f64) -> usize {
+        let s = clamp_param(s, 0.0, self.length());
+        // The first move whose end is ≥ s.
+        self.starts[1..]
+            .partition_point(|&end| end < s)
+            .min(self.moves.len() - 1)
+    }
+
+    /// Path position s of the point at parameter `u` of move `i`.
+    pub fn position(&self, i: usize, u: f64) -> f64 {
+        let i = i.min(self.moves.len() - 1);
+        self.starts[i] + clamp_param(u, 0.0, 1.0) * (self.starts[i + 1] - self.starts[i])
+    }
+
+    /// The mirror image about the x axis, travelled in the mirrored sense.
+    pub fn mirrored(&self) -> Program {
+        let moves = self
+            .moves
+            .iter()
+            .map(|m| Move {
+                shape: m.shape.mirrored(),
+                ..m.clone()
+            })
+            .collect();
+        Program::new(moves).expect("the mirror image of a valid program is valid")
+    }
+
+    /// Move `i`'s own parameter at path position `s`.
+    fn local(&self, i: usize, s: f64) -> f64 {
+        let (a, b) = (self.starts[i], self.starts[i + 1]);
+        ((s - a) / (b - a)).clamp(0.0, 1.0)
+    }
+}
+
+/// A program as saved: its moves.
+#[derive(Serialize, Deserialize)]
+struct ProgramData {
+    moves: Vec<Move>,
+}
+
+impl From<Program> for ProgramData {
+    fn from(p: Program) -> Self {
+        ProgramData { moves: p.moves }
+    }
+}
+
+impl TryFrom<ProgramData> for Program {
+    type Error = String;
+    fn try_from(data: ProgramData) -> Result<Self, String> {
+        for m in &data.moves {
+            let checked = match &m.shape {
+                Shape::Line(l) => Line::new(l.start(), l.end()).map(drop),
+                Shape::Arc(a) => {
+                    CircularArc::new(a.center(), a.radius(), a.start_angle(), a.sweep()).map(drop)
+                }
+            };
+            checked.map_err(|e| format!("move of line {}: {e}", m.line))?;
+            let speed_ok = match m.speed {
+                Speed::Feed(f) => f.is_finite() && f > 0.0,
+                Speed::Rapid | Speed::Default => true,
+            };
+            let corner_ok = match m.corner {
+                Corner::Blend(t) => t.is_finite() && t > 0.0,
+                Corner::ExactStop | Corner::BlendDefault => true,
+            };
+            if !(speed_ok && corner_ok) {
+                return Err(format!(
+                    "move of line {}: feed {:?} or corner {:?} is invalid",
+                    m.line, m.speed, m.corner
+                ));
+            }
+        }
+        Program::new(data.moves).map_err(|e| e.to_string())
+    }
+}
+
+impl Curve for Program {
+    fn param_range(&self) -> (f64, f64) {
+        (0.0, self.length())
+    }
+    fn eval(&self, s: f64) -> CurvePoint {
+        let i = self.move_at(s);
+        let scale = 1.0 / (self.starts[i + 1] - self.starts[i]);
+        let e = self.moves[i].shape.curve().eval(self.local(i, s));
+        CurvePoint {
+            p: e.p,
+            d1: e.d1 * scale,
+            d2: e.d2 * (scale * scale),
+        }
+    }
+    fn point(&self, s: f64) -> Vector2 {
+        let i = self.move_at(s);
+        self.moves[i].shape.curve().point(self.local(i, s))
+    }
+    fn length_between(&self, s0: f64, s1: f64) -> f64 {
+        let (a, b) = self.param_range();
+        (clamp_param(s1, a, b) - clamp_param(s0, a, b)).abs()
+    }
+    fn length(&self) -> f64 {
+        self.starts[self.moves.len()]
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        self.starts.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn feed_move(shape: Shape, line: usize) -> Move {
+        Move {
+            shape,
+            speed: Speed::Feed(10.0),
+            corner: Corner::ExactStop,
+            line,
+        }
+    }
+
+    #[test]
+    fn a_line_then_a_half_circle_by_arc_length() {
+        let line = Shape::Line(Line::new([0.0, 0.0], [10.0, 0.0]).unwrap());
+        let arc = Shape::Arc(CircularArc::new([10.0, 5.0], 5.0, -PI / 2.0, PI).unwrap());
+        let p = Program::new(vec![feed_move(line, 1), feed_move(arc, 2)]).unwrap();
+        assert!((p.length() - (10.0 + 5.0 * PI)).abs() < 1e-12);
+        assert_eq!(p.breakpoints(), vec![0.0, 10.0, 10.0 + 5.0 * PI]);
+        assert_eq!(p.move_at(10.0), 0);
+        assert_eq!(p.move_at(10.0 + 1e-9), 1);
+        assert_eq!(p.move_at(f64::NAN), 0);
+        // A quarter of the way round the arc: 45° up from its start, unit speed in s.
+        let e = p.eval(10.0 + 5.0 * PI / 2.0);
+        assert!((e.p - Vector2::new(15.0, 5.0)).amax() < 1e-12);
+        assert!((e.d1 - Vector2::new(0.0, 1.0)).amax() < 1e-12);
+        assert!(
+            (e.d2 - Vector2::new(-0.2, 0.0)).amax() < 1e-12,
+            "{:?}",
+            e.d2
+        );
+        assert_eq!(p.position(1, 0.5), 10.0 + 5.0 * PI / 2.0);
+        let m = p.mirrored();
+        assert!((m.point(12.0) - Vector2::new(p.point(12.0)[0], -p.point(12.0)[1])).amax() < 1e-12);
+    }
+
+    #[test]
+    fn bytes_from_elsewhere_are_checked_as_new_programs_are() {
+        let line = |a: [f64; 2], b: [f64; 2]| Shape::Line(Line::new(a, b).unwrap());
+        let p = Program::new(vec![
+            feed_move(line([0.0, 0.0], [1.0, 0.0]), 1),
+            feed_move(line([1.0, 0.0], [1.0, 2.0]), 2),
+        ])
+        .unwrap();
+        let bytes = postcard::to_stdvec(&p).unwrap();
+        assert_eq!(postcard::from_bytes::<Program>(&bytes).unwrap(), p);
+        // The same moves with a gap between them, and with a feed of −1 mm/s.
+        let mut gap = p.moves.clone();
+        gap[1].shape = line([1.0, 0.5], [1.0, 2.0]);
+        let bytes = postcard::to_stdvec(&ProgramData { moves: gap }).unwrap();
+        assert!(postcard::from_bytes::<Program>(&bytes).is_err());
+        let mut slow = p.moves.clone();
+        slow[0].speed = Speed::Feed(-1.0);
+        let bytes = postcard::to_stdvec(&ProgramData { moves: slow }).unwrap();
+        assert!(postcard::from_bytes::<Program>(&bytes).is_err());
+        let bytes = postcard::to_stdvec(&ProgramData { moves: vec![] }).unwrap();
+        assert!(postcard::from_bytes::<Program>(&bytes).is_err());
+    }
+
+    #[test]
+    fn refuses_a_gap_and_an_empty_program() {
+        let a = Shape::Line(Line::new([0.0, 0.0], [10.0, 0.0]).unwrap());
+        let b = Shape::Line(Line::new([10.0, 1e-6], [10.0, 5.0]).unwrap());
+        let e = Program::new(vec![feed_move(a, 3), feed_move(b, 4)]).unwrap_err();
+        assert!(
+            e.to_string().contains("line 4") && e.to_string().contains("line 3"),
+            "{e}"
+        );
+        assert!(Program::new(vec![]).is_err());
+    }
+}

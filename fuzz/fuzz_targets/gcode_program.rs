@@ -1,0 +1,45 @@
+//! The G-code program reader on arbitrary text (`parse_program`, as PathInterpolator2D
+//! reads a `.ngc` file; lossily UTF-8, as a file would be refused otherwise before
+//! parsing). What reads is then used as the models use it: evaluated at awkward path
+//! positions, mirrored, measured against by the exact distance from points near and far,
+//! round-tripped through the FMU state's encoding and followed by the interpolator for a
+//! few samples. Nothing may panic; every loop in there is bounded.
+#![no_main]
+
+use contour_core::contour::planar::TrueErrorIndex;
+use contour_core::geometry::Vector2;
+use contour_core::path::program::{parse_program, Program};
+use contour_core::path::{Curve, Interpolator, Path};
+use contour_fmu_fuzz::install_panic_hook;
+use libfuzzer_sys::fuzz_target;
+
+const SAMPLES: usize = 32;
+
+fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
+    let text = String::from_utf8_lossy(data);
+    let Ok(program) = parse_program(&text, "fuzz.ngc") else {
+        return;
+    };
+    let length = program.length();
+    for s in [0.0, length, 0.5 * length, -1.0, length + 1.0, f64::NAN, f64::INFINITY] {
+        let _ = (program.eval(s), program.move_at(s));
+    }
+    let bytes = postcard::to_stdvec(&program).expect("a program serialises");
+    let back: Program = postcard::from_bytes(&bytes).expect("a saved program reads back");
+    assert_eq!(back.moves(), program.moves());
+    let path = Path::Program(program);
+    let _ = path.mirrored();
+    let index = TrueErrorIndex::new(&path);
+    let (start, end) = (path.start_point(), path.end_point());
+    for p in [start, end, (start + end) * 0.5, Vector2::new(1e9, -1e9), Vector2::new(f64::NAN, 0.0)] {
+        let _ = index.error(p, 0.5 * length);
+    }
+    let feed = (length / (SAMPLES as f64 * 1e-3)).clamp(1e-3, 1e6);
+    if let Ok(mut interpolator) = Interpolator::new(path, feed, 1e-3) {
+        for _ in 0..SAMPLES {
+            if interpolator.step().done {
+                break;
+            }
+        }
+    }
+});
