@@ -230,3 +230,38 @@ fn at_constant_feed_every_sample_is_on_the_part_one_feed_step_apart() {
     );
     assert_eq!(it.current().point, Vector2::zeros());
 }
+
+#[test]
+fn beyond_a_sharp_corner_the_sign_says_outside() {
+    // A counter-clockwise triangle with 120° turns (and the closing vertex at the start):
+    // points all round each vertex are positive outside and negative inside, by the
+    // test's own half-plane test, whichever move's end is the foot.
+    let h = 5.0 * 3f64.sqrt();
+    let program = parse_program("G1 X10 F600\nG1 X5 Y8.660254037844386\nG1 X0 Y0\n", "t.ngc");
+    let path = Path::Program(program.unwrap());
+    let index = TrueErrorIndex::new(&path);
+    let corners = [
+        Vector2::new(0.0, 0.0),
+        Vector2::new(10.0, 0.0),
+        Vector2::new(5.0, h),
+    ];
+    let inside = |p: Vector2| {
+        (0..3).all(|k| {
+            let (a, b) = (corners[k], corners[(k + 1) % 3]);
+            (b - a)[0] * (p - a)[1] - (b - a)[1] * (p - a)[0] > 0.0
+        })
+    };
+    for corner in corners {
+        for k in 0..360 {
+            let phi = (k as f64 + 0.5).to_radians();
+            let p = corner + Vector2::new(phi.cos(), phi.sin());
+            for hint in [0.0, 15.0, 30.0] {
+                let e = index.error(p, hint).error;
+                let want = if inside(p) { -1.0 } else { 1.0 };
+                assert_eq!(e.signum(), want, "{p:?}, hint {hint}: {e}");
+            }
+            let brute = contour_core::contour::planar::true_error(&path, p).error;
+            assert_eq!(brute, index.error(p, 7.0).error, "{p:?}");
+        }
+    }
+}

@@ -65,11 +65,43 @@ pub fn true_error(path: &Path, p: Vector2) -> TrueError {
 }
 
 /// Exact distance to move `i` of a program, its foot parameter the path position s.
+/// Where the foot is a corner's vertex (the move's end, shared with the next move, or
+/// its start, shared with the one before; on a closed program also the start and the end)
+/// the point is as far from both moves, and the side is judged against the bisector of
+/// the two tangents: against either one alone, a point beyond a corner that turns by
+/// more than 90° would be on the wrong side.
 fn move_true_error(program: &Program, i: usize, p: Vector2) -> TrueError {
-    let mut e = match &program.moves()[i].shape {
+    let moves = program.moves();
+    let mut e = match &moves[i].shape {
         Shape::Line(l) => line_true_error(l, p),
         Shape::Arc(a) => arc_true_error(a, p),
     };
+    let last = moves.len() - 1;
+    let closed = program.point(0.0) == program.point(program.length());
+    let neighbour = match e.u {
+        u if u == 1.0 && i < last => Some((i, i + 1)),
+        u if u == 1.0 && closed && moves.len() > 1 => Some((i, 0)),
+        u if u == 0.0 && i > 0 => Some((i - 1, i)),
+        u if u == 0.0 && closed && moves.len() > 1 => Some((last, i)),
+        _ => None,
+    };
+    if let Some((before, after)) = neighbour {
+        let tangent = |j: usize, u: f64| {
+            let d = match &moves[j].shape {
+                Shape::Line(l) => l.eval(u).d1,
+                Shape::Arc(a) => a.eval(u).d1,
+            };
+            d * (1.0 / geometry::norm(&d))
+        };
+        let bisector = tangent(before, 1.0) + tangent(after, 0.0);
+        let length = geometry::norm(&bisector);
+        // A reversal has no bisector: the move's own side stands.
+        if length > 1e-9 {
+            let signed_here = signed(p, e.foot, bisector * (1.0 / length), e.u);
+            e.error = signed_here.error;
+            e.normal = signed_here.normal;
+        }
+    }
     e.u = program.position(i, e.u);
     e
 }
@@ -388,7 +420,9 @@ impl TrueErrorIndex {
         while top > 0 {
             top -= 1;
             let node = stack[top];
-            if box_dist2(&self.tree[node], p) >= best2 {
+            // Strictly farther only: a move as near as the best may be an earlier one,
+            // which wins the tie whatever the hint.
+            if box_dist2(&self.tree[node], p) > best2 {
                 continue;
             }
             if node >= self.leaves {

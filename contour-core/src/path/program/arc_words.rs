@@ -1,24 +1,29 @@
 //! The circle of a G2/G3 block from its words (docs/design/two-axis.md §4.7): the start,
 //! the programmed end and either the centre (I, J) or the radius R (negative: the arc
 //! over 180°). A centre that is not equally far from both ends, beyond [`END_TOLERANCE`],
-//! is refused, as LinuxCNC refuses it; within it, the centre moves to the nearest point
-//! equally far from both, so the arc ends exactly at the programmed end and the next
-//! move starts there.
+//! is refused; within it, the centre moves to the nearest point equally far from both,
+//! so the arc ends exactly at the programmed end and the next move starts there. That
+//! move is refused too when it would exceed the tolerance (a short chord: a near-full
+//! circle whose end misses its start). LinuxCNC accepts more, max(0.028 mm, 0.1 % of r),
+//! and cuts a spiral; a reference path here is a true circle, so it must be closer.
 
 use std::f64::consts::PI;
 
 use crate::geometry::{self, Vector2};
 use crate::path::CircularArc;
 
-/// How far (mm) the programmed end may lie off the circle through the start:
-/// max(0.002 mm, 10⁻⁴ of the radius). CAM systems round coordinates to 3 or 4 decimals,
-/// which puts ends up to 0.0007 mm off; more than that is a wrong program.
+/// How far (mm) the programmed end may lie off the circle through the start, and the
+/// centre move: max(0.002 mm, 10⁻⁴ of the radius). CAM systems round coordinates to 3
+/// or 4 decimals, which puts ends up to 0.0007 mm off; more than that is a wrong program.
 pub fn end_tolerance(radius: f64) -> f64 {
     END_TOLERANCE.max(1e-4 * radius)
 }
 
 /// The absolute part of [`end_tolerance`], mm.
 pub const END_TOLERANCE: f64 = 0.002;
+
+/// How far short of half the chord R may fall (LinuxCNC's 0.00005 in), mm.
+pub const RADIUS_TOLERANCE: f64 = 0.00127;
 
 /// How the circle was given.
 #[derive(Clone, Copy, Debug)]
@@ -74,7 +79,17 @@ fn fit_centre(start: Vector2, end: Vector2, c: Vector2) -> Result<Vector2, Strin
     }
     // Onto the perpendicular bisector of the chord.
     let middle = (start + end) * 0.5;
-    Ok(c - chord * ((c - middle).dot(&chord) / length2))
+    let fitted = c - chord * ((c - middle).dot(&chord) / length2);
+    let shift = geometry::dist(&fitted, &c);
+    if shift > end_tolerance(r0) {
+        return Err(format!(
+            "the arc's end is {:.6} mm off its circle, and a centre that fits both ends is              {shift:.6} mm away (the ends are {:.6} mm apart; tolerance {:.4} mm)",
+            (r1 - r0).abs(),
+            length2.sqrt(),
+            end_tolerance(r0)
+        ));
+    }
+    Ok(fitted)
 }
 
 /// The centre of the circle of radius |r| through `start` and `end` on the side R's sign
@@ -90,7 +105,7 @@ fn radius_centre(start: Vector2, end: Vector2, r: f64, clockwise: bool) -> Resul
     }
     let half = 0.5 * length;
     let radius = r.abs();
-    if radius == 0.0 || radius < half - end_tolerance(half) || radius.is_nan() {
+    if radius == 0.0 || radius < half - RADIUS_TOLERANCE || radius.is_nan() {
         return Err(format!(
             "R = {r} mm is too small for an arc whose ends are {length:.6} mm apart"
         ));
@@ -156,6 +171,20 @@ mod tests {
             false,
         );
         assert!(e.unwrap_err().contains("not on its circle"));
+        // A full circle whose end misses its start by 0.001 mm radially: on the circle
+        // within the tolerance, yet the centre that fits both ends is 5 mm away (it would
+        // be a 0.0005 mm circle). 0.001 mm along the circle instead is a near-full turn.
+        let near = Vector2::new(5.001, 0.0);
+        let e = arc(s, near, Circle::Centre(Vector2::zeros()), true).unwrap_err();
+        assert!(e.contains("a centre that fits both ends"), "{e}");
+        let along = arc(
+            s,
+            Vector2::new(5.0, 0.001),
+            Circle::Centre(Vector2::zeros()),
+            true,
+        );
+        let along = along.unwrap();
+        assert!((along.sweep() + 2.0 * PI).abs() < 3e-4 && (along.radius() - 5.0).abs() < 1e-6);
         assert!(arc(s, s, Circle::Radius(5.0), false).is_err());
         assert!(arc(s, -s, Circle::Radius(4.0), false)
             .unwrap_err()

@@ -270,7 +270,7 @@ mod tests {
         assert_eq!(p.move_at(10.0), 0);
         assert_eq!(p.move_at(10.0 + 1e-9), 1);
         assert_eq!(p.move_at(f64::NAN), 0);
-        // A quarter of the way round the arc: 45° up from its start, unit speed in s.
+        // Half way round the half circle (at its angle 0): unit speed in s, curvature 1/5.
         let e = p.eval(10.0 + 5.0 * PI / 2.0);
         assert!((e.p - Vector2::new(15.0, 5.0)).amax() < 1e-12);
         assert!((e.d1 - Vector2::new(0.0, 1.0)).amax() < 1e-12);

@@ -279,7 +279,8 @@ impl<'a> Reader<'a> {
                         return Err(self.error(line, column, "G64's P must be >= 0"));
                     }
                     if tol == 0.0 {
-                        Corner::ExactStop
+                        // LinuxCNC: no limit on the blend; here the `tolerance` parameter's.
+                        Corner::BlendDefault
                     } else {
                         Corner::Blend(tol * self.scale)
                     }
@@ -327,15 +328,19 @@ impl<'a> Reader<'a> {
             };
             let moves_z = self.z.is_some_and(|z0| z0 != new_z) || self.z.is_none() && v != 0.0;
             self.z = Some(new_z);
-            if moves_z && end_point != self.position {
+            let arc = matches!(mode, Motion::Clockwise | Motion::CounterClockwise);
+            if moves_z && mode != Motion::Rapid && (end_point != self.position || arc) {
                 return Err(self.error(
                     line,
                     column,
-                    "a move of X or Y together with Z: its feed is along the 3D path, \
-                     which the XY table cannot follow; move Z in a block of its own",
+                    "a move of X or Y together with Z (a ramp or a helix): its feed is along \
+                     the 3D path, which the XY table cannot follow; move Z in a block of its own",
                 ));
             }
-            if moves_z {
+            if moves_z && end_point != self.position {
+                // A rapid goes there at the machine's rapid whatever Z does.
+                self.skip("Z in rapids (their XY part is followed)", line);
+            } else if moves_z {
                 // The table stands still while Z moves: an exact stop in XY.
                 self.skip("Z-only moves (the table stops while Z moves)", line);
                 if let Some(last) = self.moves.last_mut() {
@@ -349,21 +354,21 @@ impl<'a> Reader<'a> {
         };
         let shape = match mode {
             Motion::Rapid | Motion::Linear => {
-                if let Some((_, column)) = arc_words.or(p) {
+                if let Some((_, column)) = arc_words.or(p.filter(|_| !p_used)) {
                     return Err(self.error(line, column, "I, J, R and P belong to arcs"));
                 }
                 if end_point == self.position {
                     return Ok(!end);
                 }
-                match Line::new(self.position, end_point) {
-                    Ok(l) => Shape::Line(l),
-                    // Too short to have a direction: no motion.
-                    Err(_) => return Ok(!end),
-                }
+                // Finite ends that differ make a line (the reader's values are decimals).
+                Shape::Line(
+                    Line::new(self.position, end_point)
+                        .map_err(|e| self.error(line, 1, e.to_string()))?,
+                )
             }
             Motion::Clockwise | Motion::CounterClockwise => {
                 let motion_column = motion.map_or(1, |(_, c)| c);
-                if let Some((turns, column)) = p {
+                if let Some((turns, column)) = p.filter(|_| !p_used) {
                     if turns != 1.0 {
                         return Err(self.error(
                             line,
@@ -473,8 +478,8 @@ mod tests {
         );
         assert_eq!(p.warnings.len(), 11, "{:#?}", p.warnings);
         assert!(p.warnings.iter().any(|w| w.starts_with("t.ngc:5: Z-only")));
-        // The path starts at the first cut's start; the plunge before it and the retract
-        // after the arc are exact stops; the last rapid is part of the path.
+        // The path starts at the first cut's start; the retract after the arc makes it an
+        // exact stop; the last rapid is part of the path.
         assert_eq!(p.point(0.0), Vector2::new(10.0, 10.0));
         let moves = p.moves();
         assert_eq!(moves.len(), 3);
@@ -493,6 +498,20 @@ mod tests {
             panic!()
         };
         assert_eq!(a.sweep(), -2.0 * PI);
+    }
+
+    #[test]
+    fn g64_p_on_a_move_line_p0_and_rapids_with_z() {
+        let p = read("G64 P0.01 G1 X1 F60\nG64 P0 G1 X2\nG0 X5 Y5 Z3\nG1 X6\n");
+        let moves = p.moves();
+        assert_eq!(moves[0].corner, Corner::Blend(0.01));
+        assert_eq!(moves[1].corner, Corner::BlendDefault);
+        assert_eq!((moves[2].speed, moves.len()), (Speed::Rapid, 4));
+        assert!(
+            p.warnings.iter().any(|w| w.contains("Z in rapids")),
+            "{:?}",
+            p.warnings
+        );
     }
 
     #[test]
@@ -529,6 +548,10 @@ mod tests {
                 "t.ngc:2:12: arcs of more than one turn",
             ),
             ("G54.1 P1\n", "t.ngc:1:1: G54.1 is not supported"),
+            (
+                "G1 X5\nG2 Z-1 I-5\n",
+                "t.ngc:2:4: a move of X or Y together with Z",
+            ),
         ] {
             let e = refused(text);
             assert!(e.starts_with(want), "{text:?}: {e}");
