@@ -7,7 +7,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use contour_core::contour::planar::TrueErrorIndex;
 use contour_core::geometry::Vector2;
-use contour_core::path::program::{parse_program, Corner, Shape, Speed};
+use contour_core::path::program::{parse_program, Corner, Speed};
 use contour_core::path::{Curve, Interpolator, Path};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -108,10 +108,7 @@ fn the_reader_gives_the_parts_pieces_and_their_modes() {
     let moves = program.moves();
     assert_eq!(moves.len(), pieces.len());
     for (m, piece) in moves.iter().zip(&pieces) {
-        let curve: &dyn Curve = match &m.shape {
-            Shape::Line(l) => l,
-            Shape::Arc(a) => a,
-        };
+        let curve = m.shape.curve();
         for t in [0.0, 0.25, 0.5, 0.75, 1.0] {
             let off = (curve.point(t) - piece.at(t)).amax();
             assert!(off < 1e-12, "line {}: {off} mm off at {t}", m.line);

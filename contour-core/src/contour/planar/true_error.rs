@@ -87,10 +87,7 @@ fn move_true_error(program: &Program, i: usize, p: Vector2) -> TrueError {
     };
     if let Some((before, after)) = neighbour {
         let tangent = |j: usize, u: f64| {
-            let d = match &moves[j].shape {
-                Shape::Line(l) => l.eval(u).d1,
-                Shape::Arc(a) => a.eval(u).d1,
-            };
+            let d = moves[j].shape.curve().eval(u).d1;
             d * (1.0 / geometry::norm(&d))
         };
         let bisector = tangent(before, 1.0) + tangent(after, 0.0);

@@ -26,7 +26,8 @@ pub enum Shape {
 }
 
 impl Shape {
-    fn curve(&self) -> &dyn Curve {
+    /// The move as a curve of its own parameter, 0 … 1.
+    pub fn curve(&self) -> &dyn Curve {
         match self {
             Shape::Line(l) => l,
             Shape::Arc(a) => a,
