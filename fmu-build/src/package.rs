@@ -68,15 +68,11 @@ impl Resource {
                 )
             })?
             .to_string();
-        let lower = name.to_ascii_lowercase();
-        let is_program = contour_core::path::program::PROGRAM_EXTENSIONS
-            .iter()
-            .any(|x| lower.ends_with(&format!(".{x}")));
         let checked = if model != PATH_MODEL {
             Ok(())
-        } else if lower.ends_with(".json") {
+        } else if name.to_ascii_lowercase().ends_with(".json") {
             contour_core::path::file::load_nurbs::<2>(&source).map(drop)
-        } else if is_program {
+        } else if contour_core::path::program::is_program_file(&source) {
             contour_core::path::program::load_program(&source).map(drop)
         } else {
             Ok(())

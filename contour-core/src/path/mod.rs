@@ -181,7 +181,8 @@ pub enum Path {
 
 impl Path {
     /// Builds a path from a built-in name (`circle`, `line`, `arc`, `infinity`, `trident`)
-    /// or, failing that, from a NURBS JSON file (relative names resolved against `base_dir`).
+    /// or, failing that, from a G-code program (by its name's ending) or a NURBS JSON file
+    /// (relative names resolved against `base_dir`).
     pub fn from_spec(spec: &str, base_dir: Option<&std::path::Path>) -> Result<Path, PathError> {
         match builtin::by_name(spec) {
             Ok(p) => Ok(p),
@@ -193,11 +194,7 @@ impl Path {
                 };
                 // Something that looks like a file gets the file's own error (naming it).
                 let looks_like_file = spec.ends_with(".json") || spec.contains(['/', '\\']);
-                let extension = fs.extension().and_then(|e| e.to_str()).unwrap_or("");
-                let is_program = program::PROGRAM_EXTENSIONS
-                    .iter()
-                    .any(|x| x.eq_ignore_ascii_case(extension));
-                if is_program {
+                if program::is_program_file(fs) {
                     program::load_program(&full).map(Path::Program)
                 } else if full.is_file() || looks_like_file {
                     file::load_nurbs(&full).map(Path::Nurbs)

@@ -77,12 +77,14 @@ fn move_true_error(program: &Program, i: usize, p: Vector2) -> TrueError {
         Shape::Arc(a) => arc_true_error(a, p),
     };
     let last = moves.len() - 1;
-    let closed = program.point(0.0) == program.point(program.length());
+    // Only asked at an end of the first or last move.
+    let closed =
+        || last > 0 && moves[0].shape.curve().point(0.0) == moves[last].shape.curve().point(1.0);
     let neighbour = match e.u {
         u if u == 1.0 && i < last => Some((i, i + 1)),
-        u if u == 1.0 && closed && moves.len() > 1 => Some((i, 0)),
+        u if u == 1.0 && closed() => Some((i, 0)),
         u if u == 0.0 && i > 0 => Some((i - 1, i)),
-        u if u == 0.0 && closed && moves.len() > 1 => Some((last, i)),
+        u if u == 0.0 && closed() => Some((last, i)),
         _ => None,
     };
     if let Some((before, after)) = neighbour {

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use super::{clamp_param, CircularArc, Curve, CurvePoint, Line, PathError};
 use crate::geometry::Vector2;
 
-pub use reader::{load_program, parse_program, PROGRAM_EXTENSIONS};
+pub use reader::{is_program_file, load_program, parse_program, PROGRAM_EXTENSIONS};
 
 /// The geometry of one move.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -18,6 +18,14 @@ use crate::path::{Line, PathError};
 /// The file name endings read as G-code (case-insensitive).
 pub const PROGRAM_EXTENSIONS: [&str; 4] = ["ngc", "nc", "gcode", "tap"];
 
+/// Whether `file` is named as a G-code program (by [`PROGRAM_EXTENSIONS`]).
+pub fn is_program_file(file: &std::path::Path) -> bool {
+    let extension = file.extension().and_then(|e| e.to_str()).unwrap_or("");
+    PROGRAM_EXTENSIONS
+        .iter()
+        .any(|x| x.eq_ignore_ascii_case(extension))
+}
+
 /// Reads a G-code file (see the module docs).
 pub fn load_program(file: impl AsRef<std::path::Path>) -> Result<Program, PathError> {
     let (name, text) = read_path_file(file.as_ref())?;
