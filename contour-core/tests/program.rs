@@ -262,3 +262,105 @@ fn beyond_a_sharp_corner_the_sign_says_outside() {
         }
     }
 }
+
+/// The test's own signed distance from `p` to the nearest of `pieces` (positive right of
+/// travel; the sign `None` where the foot is a vertex), its piece, foot and unit tangent.
+fn nearest_piece(pieces: &[Piece], p: Vector2) -> (f64, Option<f64>, usize, Vector2, Vector2) {
+    let (i, (distance, t, tangent)) = pieces
+        .iter()
+        .map(|q| q.nearest(p))
+        .enumerate()
+        .reduce(|b, c| if c.1 .0 < b.1 .0 { c } else { b })
+        .unwrap();
+    let foot = pieces[i].at(t);
+    let r = p - foot;
+    let right = -(tangent[0] * r[1] - tangent[1] * r[0]);
+    let sign = (t > 1e-9 && t < 1.0 - 1e-9 && distance > 1e-9).then_some(right.signum());
+    (distance, sign, i, foot, tangent)
+}
+
+#[test]
+fn the_program_estimate_is_the_exact_distance_on_every_sample_of_closed_loop_runs() {
+    use contour_core::contour::planar::EstimatorKind;
+    use contour_core::sim::{SimConfig, Simulator};
+    let (text, pieces) = part();
+    let program = parse_program(&text, "part.ngc").unwrap();
+    let mirrored_pieces: Vec<Piece> = pieces
+        .iter()
+        .map(|p| match *p {
+            Piece::Line(a, b) => Piece::Line([a[0], -a[1]], [b[0], -b[1]]),
+            Piece::Arc(c, r, a0, sweep) => Piece::Arc([c[0], -c[1]], r, -a0, -sweep),
+        })
+        .collect();
+    // 120° turns: past each corner the reference pulls the tool back along the side it
+    // has left.
+    let triangle = parse_program("G1 X10 F600\nG1 X5 Y8.660254037844386\nG1 X0 Y0\n", "t.ngc");
+    let h = 8.660254037844386;
+    let triangle_pieces = vec![
+        Piece::Line([0.0, 0.0], [10.0, 0.0]),
+        Piece::Line([10.0, 0.0], [5.0, h]),
+        Piece::Line([5.0, h], [0.0, 0.0]),
+    ];
+    let cases = [
+        ("part", Path::Program(program.clone()), pieces),
+        (
+            "mirrored part",
+            Path::Program(program.mirrored()),
+            mirrored_pieces,
+        ),
+        (
+            "triangle",
+            Path::Program(triangle.unwrap()),
+            triangle_pieces,
+        ),
+    ];
+    for (name, path, pieces) in cases {
+        for (feed, ccc) in [(20.0, true), (50.0, true), (50.0, false)] {
+            let mut config = SimConfig::new(path.clone(), feed);
+            config.estimator = EstimatorKind::Program;
+            config.settle = 0.3;
+            if !ccc {
+                config.controller.ccc.mode = contour_core::control::CccMode::Off;
+            }
+            let run = Simulator::new(config).unwrap().run();
+            let trace = &run.trace;
+            let (mut signs, mut own, mut peak) = (0, 0, 0.0f64);
+            // The reference's piece: the first from the last one on that holds it.
+            let mut reference_piece = 0;
+            for k in 0..trace.len() {
+                let r = trace.reference[k];
+                reference_piece = (reference_piece..pieces.len())
+                    .find(|&i| pieces[i].nearest(r).0 < 1e-9)
+                    .expect("the reference is on the part");
+                let (mut want, mut sign, piece, foot, tangent) =
+                    nearest_piece(&pieces, trace.actual[k]);
+                // The tool the reference pulls back along a piece it has left is
+                // measured against the reference's piece.
+                if piece < reference_piece && (r - foot).dot(&tangent) < 0.0 {
+                    want = pieces[reference_piece].nearest(trace.actual[k]).0;
+                    sign = None;
+                    own += 1;
+                }
+                let got = trace.estimated_error[k];
+                assert!(
+                    (got.abs() - want).abs() < 1e-9,
+                    "{name} at {feed} mm/s, sample {k}: {got} vs {want}"
+                );
+                if let Some(sign) = sign {
+                    assert_eq!(got.signum(), sign, "{name}, sample {k}");
+                    signs += 1;
+                }
+                peak = peak.max(want);
+            }
+            assert!(
+                signs > trace.len() / 2,
+                "{name}: {signs} of {}",
+                trace.len()
+            );
+            // The corners make real contour error: the comparison is not of zeros.
+            assert!(peak > 0.01, "{name} at {feed} mm/s: peak {peak} mm");
+            // Only the triangle's corners are sharper than 90°.
+            assert_eq!(own > 0, name == "triangle", "{name}: {own}");
+        }
+    }
+}

@@ -440,6 +440,9 @@ impl Instance {
                 "step at t = {current} failed: {message}"
             )));
         }
+        for warning in self.model.take_warnings() {
+            self.log_warning(&warning);
+        }
         // Never report success with a non-finite output: parameters at the edge of f64
         // (an inertia of 1e-300) can overflow a model, the importer would carry the NaN
         // on, and a state saved now could not be restored.

@@ -26,8 +26,10 @@ pub trait Model: Send {
     /// computes the outputs. Called in initialization mode, possibly several times.
     fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult;
 
-    /// Warnings about the last initialization that did not stop it (a path file's
-    /// tolerated irregularities): the FMI layer logs them, and they are gone.
+    /// Warnings about the last initialization or step that did not stop it (a path
+    /// file's tolerated irregularities, an input that does not fit a parameter): the FMI
+    /// layer logs them, and they are gone. Called after every step: it must not allocate
+    /// when there is nothing to say.
     fn take_warnings(&mut self) -> Vec<String> {
         Vec::new()
     }

@@ -6,6 +6,7 @@
 use super::axis_variables::{COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_IN};
 use super::controller_parameters::{self, axis_gain, nonnegative};
 use super::line_arc_parameters;
+use super::path_parameter;
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
 use crate::framework::state_check;
@@ -13,7 +14,8 @@ use crate::framework::state_codec::{SavedState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, AxisUnit, XY};
 use crate::framework::variables::{EnumItem, EnumType, Start, Values, Variable};
 use contour_core::contour::planar::{
-    ArcEstimator, Estimator, EstimatorKind, FreeCurveEstimator, LineEstimator,
+    ArcEstimator, Estimator, EstimatorKind, FreeCurveEstimator, LineEstimator, ProgramEstimator,
+    ON_PATH,
 };
 use contour_core::control::{
     CccConfig, ConfigError, ControllerConfig, CrossCoupledController, FuzzyFactor, FuzzyFactors,
@@ -25,7 +27,7 @@ use contour_core::geometry::{Vector, Vector2};
 type Vector3 = Vector<3>;
 
 /// The `estimator` parameter's type: an FMI Enumeration (importers show a drop-down), in
-/// the order of [`EstimatorKind::ALL`] (values 1, 2, 3).
+/// the order of [`EstimatorKind::ALL`] (values 1, 2, 3, 4).
 pub static ESTIMATOR_TYPE: EnumType = EnumType {
     name: "ContourEstimator",
     description: "How the controller estimates the contour error",
@@ -41,6 +43,11 @@ pub static ESTIMATOR_TYPE: EnumType = EnumType {
         EnumItem {
             name: "arc",
             description: "Arc: exact error to the circle of the arc.* parameters",
+        },
+        EnumItem {
+            name: "program",
+            description: "Program: exact error along the whole path of the 'path' parameter \
+                          (a G-code program, a NURBS file or a built-in), tracked with the reference",
         },
     ],
 };
@@ -111,11 +118,16 @@ variable_table! {
     ESTIMATOR: Int = Variable::parameter(
         "estimator",
         Start::Integer(1),
-        "Contour estimator: free_curve (two circles through recent references), or line / arc \
-         (exact, from the line.*/arc.* parameters)",
+        "Contour estimator: free_curve (two circles through recent references), line / arc \
+         (exact, from the line.*/arc.* parameters) or program (exact, along 'path')",
     )
     .enumeration(&ESTIMATOR_TYPE);
     GEOMETRY: Reals<{ line_arc_parameters::COUNT }> = line_arc_parameters::VARIABLES;
+    PATH: Str = Variable::parameter(
+        "path",
+        Start::String(path_parameter::DEFAULT),
+        path_parameter::DESCRIPTION,
+    );
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -132,7 +144,13 @@ pub static INFO: ModelInfo = ModelInfo {
     // Every output starts at 0: the control law first runs in fmi2DoStep.
     initial_dependencies: &[],
     initial_dependencies_on_some_paths: &[],
-    create: |_: &Environment| Box::new(ContourCCC2D { state: None }),
+    create: |environment: &Environment| {
+        Box::new(ContourCCC2D {
+            environment: environment.clone(),
+            state: None,
+            warnings: Vec::new(),
+        })
+    },
 };
 
 /// `Option<State>` as below. Version 2: the controller became N-axis (per-axis contour
@@ -186,7 +204,11 @@ impl SavedState for State {
 }
 
 pub struct ContourCCC2D {
+    environment: Environment,
     state: Option<State>,
+    /// For the log: the path reader's warnings at initialization, and a reference off
+    /// the `program` estimator's path once.
+    warnings: Vec<String>,
 }
 
 fn gains([kp, ki, kd]: [f64; 3]) -> PidGains {
@@ -264,9 +286,14 @@ fn estimator_kind(values: &Values) -> Result<EstimatorKind, String> {
         })
 }
 
-fn estimator(values: &Values) -> Result<Estimator, String> {
+/// The estimator the parameters choose, with the path reader's warnings.
+fn estimator(
+    values: &Values,
+    environment: &Environment,
+) -> Result<(Estimator, Vec<String>), String> {
     let kind = estimator_kind(values)?;
-    Ok(match kind {
+    let mut warnings = Vec::new();
+    let estimator = match kind {
         EstimatorKind::FreeCurve => Estimator::FreeCurve(FreeCurveEstimator::default()),
         EstimatorKind::Line => Estimator::Line(LineEstimator::new(&line_arc_parameters::line(
             values, GEOMETRY,
@@ -274,15 +301,22 @@ fn estimator(values: &Values) -> Result<Estimator, String> {
         EstimatorKind::Arc => Estimator::Arc(ArcEstimator::new(&line_arc_parameters::arc(
             values, GEOMETRY,
         )?)),
-    })
+        EstimatorKind::Program => {
+            let mut path = path_parameter::path(PATH.get(values), values, GEOMETRY, environment)?;
+            warnings = path_parameter::reader_warnings(&mut path);
+            Estimator::Program(ProgramEstimator::new(&path))
+        }
+    };
+    Ok((estimator, warnings))
 }
 
 impl Model for ContourCCC2D {
     fn initialize(&mut self, values: &mut Values, start_time: f64) -> ModelResult {
         check_period("Ts", TS.get(values))?;
         let config = config(values);
-        let controller =
-            CrossCoupledController::new(config, estimator(values)?).map_err(config_message)?;
+        let (estimator, warnings) = estimator(values, &self.environment)?;
+        let controller = CrossCoupledController::new(config, estimator).map_err(config_message)?;
+        self.warnings = warnings;
         self.state = Some(State {
             controller,
             clock: SampleClock::new(start_time, config.ts),
@@ -306,7 +340,22 @@ impl Model for ContourCCC2D {
             let (kp, ki, kd) = out.gains;
             CCC_GAINS.set(values, &Vector3::new(kp, ki, kd));
         }
+        if let Some(off) = state.controller.estimator_mut().take_off_path() {
+            // Once per instance: the only text a step makes.
+            self.warnings.push(format!(
+                "the reference ref.x, ref.y came {off:.6} mm off the path of parameter \
+                 'path' by t = {} s (more than {} mm: another program, file or tolerance than \
+                 the interpolator's?); the contour error is measured to the nearest point \
+                 ahead on 'path'",
+                time + step,
+                ON_PATH
+            ));
+        }
         Ok(())
+    }
+
+    fn take_warnings(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.warnings)
     }
 
     crate::framework::state_codec::sampled_state_methods!(State, LAYOUT);
@@ -321,7 +370,9 @@ mod tests {
         assert_eq!(DEFAULT, ControllerConfig::default());
         let values = Values::from_table(&VARIABLES);
         assert_eq!(config(&values), ControllerConfig::default());
-        assert_eq!(estimator(&values).unwrap().kind(), EstimatorKind::FreeCurve);
+        let (estimator, warnings) = estimator(&values, &Environment::default()).unwrap();
+        assert_eq!(estimator.kind(), EstimatorKind::FreeCurve);
+        assert!(warnings.is_empty());
     }
 
     #[test]
@@ -360,14 +411,14 @@ mod tests {
             );
             assert_eq!(estimator_kind(&values), Ok(kind));
         }
-        for bad in [0, 4, -1] {
+        for bad in [0, 5, -1] {
             values.set(
                 ESTIMATOR.vr(),
                 crate::framework::variables::Value::Integer(bad),
             );
             let message = estimator_kind(&values).unwrap_err();
             assert!(
-                message.contains("1 = free_curve, 2 = line, 3 = arc"),
+                message.contains("1 = free_curve, 2 = line, 3 = arc, 4 = program"),
                 "{message}"
             );
         }

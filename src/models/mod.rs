@@ -12,6 +12,7 @@ pub mod kinematics_parameters;
 pub mod line_arc_parameters;
 pub mod path_interpolator_2d;
 pub mod path_interpolator_5x;
+pub mod path_parameter;
 pub mod servo_plant;
 pub mod xy_servo_plant;
 

@@ -6,6 +6,7 @@ use std::f64::consts::PI;
 
 use super::axis_variables::REFERENCE_OUT;
 use super::line_arc_parameters;
+use super::path_parameter;
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
 use crate::framework::state_check;
@@ -24,10 +25,8 @@ variable_table! {
     );
     PATH: Str = Variable::parameter(
         "path",
-        Start::String("circle"),
-        "circle (the paper's), line or arc (from the line.*/arc.* parameters), infinity, \
-         trident, a NURBS JSON file or a G-code program (.ngc, .nc, .gcode, .tap): absolute, \
-         or relative to the FMU's resources folder",
+        Start::String(path_parameter::DEFAULT),
+        path_parameter::DESCRIPTION,
     );
     FEED: Real = Variable::parameter(
         "feed",
@@ -163,30 +162,7 @@ fn positive(values: &Values, variable: Real) -> Result<f64, String> {
 
 /// The path the parameters describe; file errors name the file and line.
 fn path(values: &Values, environment: &Environment) -> Result<Path, String> {
-    let spec = PATH.get(values).trim();
-    match spec.to_ascii_lowercase().as_str() {
-        "line" => line_arc_parameters::line(values, GEOMETRY).map(Path::Line),
-        "arc" => line_arc_parameters::arc(values, GEOMETRY).map(Path::Arc),
-        _ => Path::from_spec(spec, environment.resource_dir.as_deref()).map_err(|e| {
-            let e = e.to_string();
-            format!(
-                "parameter 'path': {e}{}",
-                resource_hint(spec, environment, &e)
-            )
-        }),
-    }
-}
-
-/// The cause when a relative path file cannot be read and the importer gave no usable
-/// resource location (NULL, or not a local file URI) to look it up in: the file system's
-/// "No such file" alone would hide it.
-pub(super) fn resource_hint(spec: &str, environment: &Environment, error: &str) -> &'static str {
-    let relative = std::path::Path::new(spec.trim()).is_relative();
-    if relative && environment.resource_dir.is_none() && error.contains("cannot read") {
-        " (looked up in the working directory: the importer gave no usable resource location)"
-    } else {
-        ""
-    }
+    path_parameter::path(PATH.get(values), values, GEOMETRY, environment)
 }
 
 impl PathInterpolator2D {
@@ -204,18 +180,14 @@ impl Model for PathInterpolator2D {
         let feed = positive(values, FEED)?;
         let ts = check_period("Ts", TS.get(values))?;
         let mut path = path(values, &self.environment)?;
-        self.warnings = match &mut path {
-            Path::Program(program) => std::mem::take(&mut program.warnings)
-                .into_iter()
-                .chain(std::iter::once(
-                    "the program runs at the constant 'feed': its F words, rapids and corner \
-                     modes are read but not yet planned"
-                        .to_string(),
-                ))
-                .map(|w| format!("parameter 'path': {w}"))
-                .collect(),
-            _ => Vec::new(),
-        };
+        self.warnings = path_parameter::reader_warnings(&mut path);
+        if let Path::Program(_) = path {
+            self.warnings.push(
+                "parameter 'path': the program runs at the constant 'feed': its F words, \
+                 rapids and corner modes are read but not yet planned"
+                    .to_string(),
+            );
+        }
         let interpolator = Interpolator::new(path, feed, ts).map_err(|e| e.to_string())?;
         self.state = Some(State {
             interpolator,

@@ -251,7 +251,7 @@ fn programmed(spec: &str, environment: &Environment) -> Result<Programmed, Strin
         _ => file.to_path_buf(),
     };
     let hint = |e: String| {
-        let h = super::path_interpolator_2d::resource_hint(spec, environment, &e);
+        let h = super::path_parameter::resource_hint(spec, environment, &e);
         e + h
     };
     let lower = spec.to_ascii_lowercase();

@@ -18,7 +18,7 @@ use contour_core::control::{
 };
 use contour_core::geometry::Vector2;
 use contour_core::kinematics::Joints;
-use contour_core::path::{builtin, Curve, Interpolator};
+use contour_core::path::{builtin, Curve, Interpolator, Path};
 use contour_core::sim::{SimConfig, Simulator};
 
 thread_local! {
@@ -283,8 +283,10 @@ fn sample_and_fuzzy_evaluation_do_not_allocate() {
 
 #[test]
 fn path_estimator_and_true_error_do_not_allocate() {
-    for name in ["circle", "infinity", "trident"] {
-        let path = builtin::by_name(name).unwrap();
+    let part = "G1 X30 F600\nG3 X35 Y5 R5\nG1 Y20\nX0\nY0\n";
+    let part = Path::Program(contour_core::path::program::parse_program(part, "p.ngc").unwrap());
+    let paths = ["circle", "infinity", "trident"].map(|n| (n, builtin::by_name(n).unwrap()));
+    for (name, path) in paths.into_iter().chain([("program", part)]) {
         let mut interp = Interpolator::new(path.clone(), 50.0, 1e-3).unwrap();
         let mut refs = Vec::with_capacity(10_000);
         let count = allocations_during(|| {
@@ -298,9 +300,10 @@ fn path_estimator_and_true_error_do_not_allocate() {
         assert_eq!(count, 0, "{name}: Interpolator::step allocated");
         assert!(refs.len() > 1000 && refs.len() < 10_000);
 
-        // The free-curve estimator and the true error of a point lagging 35 samples and
-        // 0.1 mm off the path, as in the closed loop.
-        let mut estimator = Estimator::for_path(EstimatorKind::FreeCurve, &path);
+        // The free-curve and program estimators and the true error of a point lagging 35
+        // samples and 0.1 mm off the path, as in the closed loop.
+        let mut free_curve = Estimator::for_path(EstimatorKind::FreeCurve, &path);
+        let mut program = Estimator::for_path(EstimatorKind::Program, &path);
         let index = TrueErrorIndex::new(&path);
         let mut acc = 0.0;
         let count = allocations_during(|| {
@@ -310,13 +313,14 @@ fn path_estimator_and_true_error_do_not_allocate() {
                 let d = path.eval(lag.u).d1;
                 let s = 0.1 / d[0].hypot(d[1]);
                 let p = Vector2::new(lag.point[0] - d[1] * s, lag.point[1] + d[0] * s);
-                let est = estimator.estimate(black_box(refs[k].point), black_box(p));
+                let est = free_curve.estimate(black_box(refs[k].point), black_box(p));
+                let exact = program.estimate(black_box(refs[k].point), black_box(p));
                 let truth = index.error(black_box(p), hint);
                 hint = truth.u;
-                acc += est.error + truth.error;
+                acc += est.error + exact.error + truth.error;
             }
         });
-        assert_eq!(count, 0, "{name}: estimate or true error allocated");
+        assert_eq!(count, 0, "{name}: an estimate or the true error allocated");
         assert!(acc.is_finite());
     }
 }

@@ -362,13 +362,13 @@ fn out_of_range_parameters_are_refused_when_set_and_the_old_value_kept() {
     );
 
     // The estimator is an enumeration, set with fmi2SetInteger.
-    for bad in [0, 4, -1] {
+    for bad in [0, 5, -1] {
         assert_eq!(i.set_integer(estimator, bad), ERROR);
         assert_eq!(
             i.last_error(),
             format!(
                 "fmi2SetInteger: variable 'estimator' = {bad} is not a value of its \
-                 enumeration ContourEstimator (1 = free_curve, 2 = line, 3 = arc)"
+                 enumeration ContourEstimator (1 = free_curve, 2 = line, 3 = arc, 4 = program)"
             )
         );
         assert_eq!(i.get_integer(estimator), (OK, 1));

@@ -41,7 +41,7 @@ def test_validates_without_problems(fmu_dir, model):
     assert validate_fmu(str(fmu_dir / f"{model}.fmu")) == []
 
 
-ESTIMATOR = {"free_curve": 1, "line": 2, "arc": 3}
+ESTIMATOR = {"free_curve": 1, "line": 2, "arc": 3, "program": 4}
 
 
 def test_estimator_is_an_enumeration_importers_can_offer_as_a_choice(fmu_dir):
@@ -266,7 +266,7 @@ def test_bad_parameters_are_refused_when_initialization_ends(request, fixture, v
     assert any(words in m for m in s.log.errors()), s.log.errors()
 
 
-@pytest.mark.parametrize("value", [0, 4, -1])
+@pytest.mark.parametrize("value", [0, 5, -1])
 def test_an_estimator_value_outside_the_enumeration_is_refused_and_the_old_one_kept(controller, value):
     estimator = controller.vr["estimator"]
     with pytest.raises(FMICallException) as failure:
@@ -274,7 +274,7 @@ def test_an_estimator_value_outside_the_enumeration_is_refused_and_the_old_one_k
     assert failure.value.status == 3  # fmi2Error
     assert controller.log.errors()[-1] == (
         f"fmi2SetInteger: variable 'estimator' = {value} is not a value of its enumeration "
-        "ContourEstimator (1 = free_curve, 2 = line, 3 = arc)")
+        "ContourEstimator (1 = free_curve, 2 = line, 3 = arc, 4 = program)")
     assert controller.fmu.getInteger([estimator]) == [ESTIMATOR["free_curve"]]
     controller.fmu.exitInitializationMode()
 
@@ -383,3 +383,104 @@ def test_a_gcode_part_runs_at_constant_feed_with_its_preamble_warned_about(inter
     interpolator.fmu.doStep(currentCommunicationPoint=time, communicationStepSize=length / 10.0 - time + 0.01)
     assert np.allclose(interpolator.reals(["ref.x", "ref.y"]), [0.0, 0.0], atol=1e-9)
     assert interpolator.fmu.getBoolean([interpolator.vr["done"]])[0]
+
+
+# A part with a tangent arc, a corner into an arc, a 0.5 mm radius and 90° corners, closed
+# counter-clockwise, and its pieces as the test knows them: lines (start, end) and arcs
+# (centre, radius, start angle, signed sweep).
+PART = ("%\nG21 G90 G17 G64\nG0 X0 Y0\nG1 X25 F1200\nG3 X30 Y5 R5\nG1 Y12\nG2 X25 Y17 R5\n"
+        "G1 Y20\nX0.5\nG3 X0 Y19.5 R0.5\nG1 Y0\nM30\n%\n")
+PART_PIECES = [
+    ("line", (0.0, 0.0), (25.0, 0.0)),
+    ("arc", (25.0, 5.0), 5.0, -np.pi / 2, np.pi / 2),
+    ("line", (30.0, 5.0), (30.0, 12.0)),
+    ("arc", (30.0, 17.0), 5.0, -np.pi / 2, -np.pi / 2),
+    ("line", (25.0, 17.0), (25.0, 20.0)),
+    ("line", (25.0, 20.0), (0.5, 20.0)),
+    ("arc", (0.5, 19.5), 0.5, np.pi / 2, np.pi / 2),
+    ("line", (0.0, 19.5), (0.0, 0.0)),
+]
+
+
+def distance_to_pieces(pieces, points):
+    """The test's own distance from each point to the nearest piece, and the side (+1 right
+    of travel, -1 left, 0 where the foot is a piece's end)."""
+    best = np.full(len(points), np.inf)
+    side = np.zeros(len(points))
+    for piece in pieces:
+        if piece[0] == "line":
+            a, b = np.array(piece[1]), np.array(piece[2])
+            d = b - a
+            t = np.clip((points - a) @ d / (d @ d), 0.0, 1.0)
+            foot = a + t[:, None] * d
+            tangent = np.broadcast_to(d / np.linalg.norm(d), points.shape)
+        else:
+            _, c, r, a0, sweep = piece
+            q = points - np.array(c)
+            turned = np.mod(np.sign(sweep) * (np.arctan2(q[:, 1], q[:, 0]) - a0), 2 * np.pi)
+            ends = [np.array(c) + r * np.array([np.cos(a0 + u * sweep), np.sin(a0 + u * sweep)])
+                    for u in (0.0, 1.0)]
+            nearer_end = np.where(np.linalg.norm(points - ends[0], axis=1)
+                                  <= np.linalg.norm(points - ends[1], axis=1), 0.0, 1.0)
+            t = np.where(turned <= abs(sweep), turned / abs(sweep), nearer_end)
+            phi = a0 + t * sweep
+            foot = np.array(c) + r * np.stack([np.cos(phi), np.sin(phi)], axis=1)
+            tangent = np.sign(sweep) * np.stack([-np.sin(phi), np.cos(phi)], axis=1)
+        distance = np.linalg.norm(points - foot, axis=1)
+        offset = points - foot
+        right = -(tangent[:, 0] * offset[:, 1] - tangent[:, 1] * offset[:, 0])
+        inside = (t > 1e-9) & (t < 1 - 1e-9) & (distance > 1e-9)
+        nearer = distance < best
+        best = np.where(nearer, distance, best)
+        side = np.where(nearer, np.where(inside, np.sign(right), 0.0), side)
+    return best, side
+
+
+def test_the_program_estimator_gives_the_exact_distance_to_a_gcode_part_in_the_closed_loop(
+        fmu_dir, tmp_path):
+    part = tmp_path / "part.ngc"
+    part.write_text(PART)
+    length = 25 + 2.5 * np.pi + 7 + 2.5 * np.pi + 3 + 24.5 + 0.25 * np.pi + 19.5
+    feed = 50.0
+    stop = round(length / feed + 0.3, 3)
+    controller = {"estimator": ESTIMATOR["program"], "path": str(part)}
+    runs = {}
+    for name, extra in [("ccc", {}), ("no ccc", {"ccc.enable": False})]:
+        before, after = closed_loop(fmu_dir, path=str(part), feed=feed, stop=stop,
+                                    controller={**controller, **extra})
+        points = np.stack([before["plant.pos.x"], before["plant.pos.y"]], axis=1)
+        want, side = distance_to_pieces(PART_PIECES, points)
+        # The command of the step from t_k is computed from pos(t_k).
+        got = after["controller.contourError"]
+        assert np.abs(np.abs(got) - want).max() < 1e-9, name
+        signed = side != 0
+        assert signed.sum() > 0.5 * len(got)
+        assert np.array_equal(np.sign(got[signed]), side[signed]), name
+        runs[name] = want
+    # The exact estimate at the corners makes the CCC worth having (0.62 -> 0.18 mm).
+    assert runs["no ccc"].max() > 0.3
+    assert runs["ccc"].max() < 0.4 * runs["no ccc"].max()
+
+
+def test_a_reference_off_the_program_estimators_path_is_warned_about_once(controller):
+    # The controller measures against the line (0, 0) -> (40, 30) of the line.* parameters;
+    # the reference goes along it, then 0.5 um off it (within 1 um: rounding), then 20 um
+    # and 50 um off it (another path).
+    controller.fmu.setDebugLogging(True, ["logStatusWarning"])
+    controller.set(estimator=ESTIMATOR["program"], path="line")
+    controller.fmu.exitInitializationMode()
+    normal = np.array([-0.6, 0.8])
+    time = 0.0
+    for k, off in enumerate([0.0, 0.0, 0.0005, 0.02, 0.05, 0.0]):
+        reference = np.array([0.4, 0.3]) * (k + 1) + normal * off
+        actual = reference - np.array([0.4, 0.3]) + normal * 0.01
+        controller.fmu.setReal([controller.vr[n] for n in ["ref.x", "ref.y", "pos.x", "pos.y"]],
+                               [*reference, *actual])
+        controller.fmu.doStep(currentCommunicationPoint=time, communicationStepSize=1e-3)
+        time += 1e-3
+        # 10 um left of the line: -0.01 mm, as far as the reference is on it.
+        if off == 0.0:
+            assert abs(controller.reals(["contourError"])[0] + 0.01) < 1e-12
+        warnings = [w for w in controller.log.warnings() if "off the path" in w]
+        assert len(warnings) == (1 if off >= 0.02 or k == 5 else 0), (k, warnings)
+    assert "0.020000 mm off the path of parameter 'path' by t = 0.004 s" in warnings[0], warnings

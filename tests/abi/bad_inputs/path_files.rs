@@ -22,6 +22,20 @@ pub(super) static CASES: &[Case] = &[
         Corrected,
     ),
     case(
+        "the program estimator's G-code arc whose end is not on its circle",
+        C2,
+        Initialization,
+        |s| {
+            s.exit_with(|s| {
+                s.ok(s.set_integer("estimator", 4));
+                s.set_string("path", &s.file("off_circle.ngc"))
+            })
+        },
+        ERROR,
+        Some("off_circle.ngc:2:1: the arc's end is not on its circle"),
+        Corrected,
+    ),
+    case(
         "a G-code move of X together with Z",
         P2,
         Initialization,

@@ -1,4 +1,5 @@
-//! The estimator the controller runs, chosen by name (`free_curve`, `line`, `arc`), as one
+//! The estimator the controller runs, chosen by name (`free_curve`, `line`, `arc`,
+//! `program`), as one
 //! serialisable enum so the FMU can save and restore it with the rest of its state.
 
 use std::fmt;
@@ -6,7 +7,7 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
-use super::{ArcEstimator, FreeCurveEstimator, LineEstimator};
+use super::{ArcEstimator, FreeCurveEstimator, LineEstimator, ProgramEstimator};
 use crate::contour::{ContourEstimate, ContourEstimator};
 use crate::geometry::Vector2;
 use crate::path::Path;
@@ -20,14 +21,17 @@ pub enum EstimatorKind {
     Line,
     /// Exact arc/circle error (Koren–Lo).
     Arc,
+    /// Exact error along the whole programmed path, tracked (any path).
+    Program,
 }
 
 impl EstimatorKind {
-    /// All kinds, in FMI enumeration order (1, 2, 3).
-    pub const ALL: [EstimatorKind; 3] = [
+    /// All kinds, in FMI enumeration order (1, 2, 3, 4).
+    pub const ALL: [EstimatorKind; 4] = [
         EstimatorKind::FreeCurve,
         EstimatorKind::Line,
         EstimatorKind::Arc,
+        EstimatorKind::Program,
     ];
 
     /// Canonical name.
@@ -36,6 +40,7 @@ impl EstimatorKind {
             EstimatorKind::FreeCurve => "free_curve",
             EstimatorKind::Line => "line",
             EstimatorKind::Arc => "arc",
+            EstimatorKind::Program => "program",
         }
     }
 }
@@ -48,8 +53,8 @@ impl fmt::Display for EstimatorKind {
 
 impl FromStr for EstimatorKind {
     type Err = String;
-    /// Accepts `free_curve`, `free curve`, `freecurve`, `free-curve`, `line`, `arc`
-    /// (case-insensitive).
+    /// Accepts `free_curve`, `free curve`, `freecurve`, `free-curve`, `line`, `arc`,
+    /// `program` (case-insensitive).
     fn from_str(s: &str) -> Result<Self, String> {
         let k: String = s
             .trim()
@@ -61,8 +66,9 @@ impl FromStr for EstimatorKind {
             "freecurve" => Ok(EstimatorKind::FreeCurve),
             "line" => Ok(EstimatorKind::Line),
             "arc" | "circle" => Ok(EstimatorKind::Arc),
+            "program" => Ok(EstimatorKind::Program),
             _ => Err(format!(
-                "unknown contour estimator '{s}': expected free_curve, line or arc"
+                "unknown contour estimator '{s}': expected free_curve, line, arc or program"
             )),
         }
     }
@@ -77,6 +83,8 @@ pub enum Estimator {
     Line(LineEstimator),
     /// Arc estimator (fixed circle or tracking three-point circle).
     Arc(ArcEstimator),
+    /// Exact error along the programmed path.
+    Program(ProgramEstimator),
 }
 
 impl Estimator {
@@ -84,6 +92,7 @@ impl Estimator {
     /// path's own geometry when it is a line/arc; on other paths they fall back to the
     /// local line (direction of the last reference move) or the circle through the last
     /// three reference points, which is what those classic estimators do on free curves.
+    /// The program estimator measures against the whole of `path`.
     pub fn for_path(kind: EstimatorKind, path: &Path) -> Self {
         match (kind, path) {
             (EstimatorKind::FreeCurve, _) => Estimator::FreeCurve(FreeCurveEstimator::default()),
@@ -91,6 +100,7 @@ impl Estimator {
             (EstimatorKind::Line, _) => Estimator::Line(LineEstimator::tracking()),
             (EstimatorKind::Arc, Path::Arc(a)) => Estimator::Arc(ArcEstimator::new(a)),
             (EstimatorKind::Arc, _) => Estimator::Arc(ArcEstimator::tracking()),
+            (EstimatorKind::Program, _) => Estimator::Program(ProgramEstimator::new(path)),
         }
     }
 
@@ -100,6 +110,16 @@ impl Estimator {
             Estimator::FreeCurve(_) => EstimatorKind::FreeCurve,
             Estimator::Line(_) => EstimatorKind::Line,
             Estimator::Arc(_) => EstimatorKind::Arc,
+            Estimator::Program(_) => EstimatorKind::Program,
+        }
+    }
+
+    /// How far off the path a reference was, the first time one was off it by more than
+    /// [`ON_PATH`](super::ON_PATH) (the program estimator only; then `None`).
+    pub fn take_off_path(&mut self) -> Option<f64> {
+        match self {
+            Estimator::Program(e) => e.take_off_path(),
+            _ => None,
         }
     }
 }
@@ -110,6 +130,7 @@ impl ContourEstimator for Estimator {
             Estimator::FreeCurve(e) => e.estimate(reference, actual),
             Estimator::Line(e) => e.estimate(reference, actual),
             Estimator::Arc(e) => e.estimate(reference, actual),
+            Estimator::Program(e) => e.estimate(reference, actual),
         }
     }
     fn reset(&mut self) {
@@ -117,6 +138,7 @@ impl ContourEstimator for Estimator {
             Estimator::FreeCurve(e) => e.reset(),
             Estimator::Line(e) => e.reset(),
             Estimator::Arc(e) => e.reset(),
+            Estimator::Program(e) => e.reset(),
         }
     }
 }

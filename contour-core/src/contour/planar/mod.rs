@@ -1,6 +1,7 @@
 //! The two-axis paper's contour errors (docs/design/two-axis.md §4.1): exact errors of a line and
 //! of an arc, the free-curve estimator (two circles through the interpolation points
-//! nearest the actual position), the estimator chosen by name, and the true error by
+//! nearest the actual position), the exact error along a whole programmed path, the
+//! estimator chosen by name, and the true error by
 //! brute-force search that the tests and metrics take as ground truth.
 
 mod arc;
@@ -8,10 +9,12 @@ mod choice;
 mod free_curve;
 mod line;
 mod local_circle;
+mod program;
 mod true_error;
 
 pub use arc::ArcEstimator;
 pub use choice::{Estimator, EstimatorKind};
 pub use free_curve::FreeCurveEstimator;
 pub use line::LineEstimator;
+pub use program::{ProgramEstimator, ON_PATH};
 pub use true_error::{true_error, TrueError, TrueErrorIndex};

@@ -16,6 +16,8 @@
 //! Lines and arcs are solved analytically (the finite segment/arc: beyond its ends the
 //! nearest end point is the foot).
 
+use std::ops::Range;
+
 use serde::{Deserialize, Serialize};
 
 use crate::contour::ContourEstimate;
@@ -55,7 +57,7 @@ pub fn true_error(path: &Path, p: Vector2) -> TrueError {
         Path::Arc(a) => arc_true_error(a, p),
         Path::Nurbs(n) => curve_true_error(n, p),
         Path::Program(program) => (0..program.moves().len())
-            .map(|i| move_true_error(program, i, p))
+            .map(|i| move_true_error(program, i, p, WHOLE))
             .fold(None, |best: Option<TrueError>, e| match best {
                 Some(b) if b.error.abs() <= e.error.abs() => Some(b),
                 _ => Some(e),
@@ -64,17 +66,24 @@ pub fn true_error(path: &Path, p: Vector2) -> TrueError {
     }
 }
 
-/// Exact distance to move `i` of a program, its foot parameter the path position s.
+/// A parameter interval [t₀, t₁] the foot is sought in.
+type Span = (f64, f64);
+
+/// All of a move or a line or an arc.
+const WHOLE: Span = (0.0, 1.0);
+
+/// Exact distance to move `i` of a program, its foot within the move's own parameters
+/// `span` and reported as the path position s.
 /// Where the foot is a corner's vertex (the move's end, shared with the next move, or
 /// its start, shared with the one before; on a closed program also the start and the end)
 /// the point is as far from both moves, and the side is judged against the bisector of
 /// the two tangents: against either one alone, a point beyond a corner that turns by
 /// more than 90° would be on the wrong side.
-fn move_true_error(program: &Program, i: usize, p: Vector2) -> TrueError {
+fn move_true_error(program: &Program, i: usize, p: Vector2, span: Span) -> TrueError {
     let moves = program.moves();
     let mut e = match &moves[i].shape {
-        Shape::Line(l) => line_true_error(l, p),
-        Shape::Arc(a) => arc_true_error(a, p),
+        Shape::Line(l) => line_error_within(l, p, span),
+        Shape::Arc(a) => arc_error_within(a, p, span),
     };
     let last = moves.len() - 1;
     // Only asked at an end of the first or last move.
@@ -105,26 +114,29 @@ fn move_true_error(program: &Program, i: usize, p: Vector2) -> TrueError {
     e
 }
 
-/// The box of move `i` of a program: its end points, and on an arc the extreme points
-/// of its circle that the sweep passes.
-fn move_box(program: &Program, i: usize) -> BBox {
-    let point = |q: Vector2| [q[0], q[1], q[0], q[1]];
-    match &program.moves()[i].shape {
-        Shape::Line(l) => union(&point(l.start()), &point(l.end())),
-        Shape::Arc(a) => {
-            let mut b = union(&point(a.point(0.0)), &point(a.point(1.0)));
-            for k in 0..4 {
-                let phi = k as f64 * std::f64::consts::FRAC_PI_2;
-                if a.param_of_angle(phi).is_some() {
-                    let (s, c) = phi.sin_cos();
-                    b = union(&b, &point(a.center() + Vector2::new(c, s) * a.radius()));
-                }
-            }
-            // Rounding in the extreme points' sines: a nanometre of margin.
-            let m = 1e-9 * (1.0 + a.radius());
-            [b[0] - m, b[1] - m, b[2] + m, b[3] + m]
+/// The box of a segment: its end points.
+fn line_box(l: &Line) -> BBox {
+    union(&point_box(l.start()), &point_box(l.end()))
+}
+
+/// The box of an arc: its end points and the extreme points of its circle that the
+/// sweep passes.
+fn arc_box(a: &CircularArc) -> BBox {
+    let mut b = union(&point_box(a.point(0.0)), &point_box(a.point(1.0)));
+    for k in 0..4 {
+        let phi = k as f64 * std::f64::consts::FRAC_PI_2;
+        if a.param_of_angle(phi).is_some() {
+            let (s, c) = phi.sin_cos();
+            b = union(&b, &point_box(a.center() + Vector2::new(c, s) * a.radius()));
         }
     }
+    // Rounding in the extreme points' sines: a nanometre of margin.
+    let m = 1e-9 * (1.0 + a.radius());
+    [b[0] - m, b[1] - m, b[2] + m, b[3] + m]
+}
+
+fn point_box(q: Vector2) -> BBox {
+    [q[0], q[1], q[0], q[1]]
 }
 
 /// Samples per smooth piece in the brute force.
@@ -238,27 +250,45 @@ fn signed(p: Vector2, foot: Vector2, t: Vector2, u: f64) -> TrueError {
 
 /// Exact distance to a finite segment.
 fn line_true_error(l: &Line, p: Vector2) -> TrueError {
-    let u = l.nearest_parameter(&p);
+    line_error_within(l, p, WHOLE)
+}
+
+/// Exact distance to the part `span` of a segment.
+fn line_error_within(l: &Line, p: Vector2, (t0, t1): Span) -> TrueError {
+    let u = l.nearest_parameter(&p).clamp(t0, t1);
     signed(p, l.point(u), l.direction(), u)
 }
 
 /// Exact distance to a finite arc.
 fn arc_true_error(arc: &CircularArc, p: Vector2) -> TrueError {
+    arc_error_within(arc, p, WHOLE)
+}
+
+/// Exact distance to the part `span` of an arc: the radial foot when it lies in the
+/// span (on a full circle the start angle is both 0 and 1), else the nearer end of it
+/// (the distance to a circle's points grows with the angle from the radial foot).
+fn arc_error_within(arc: &CircularArc, p: Vector2, (t0, t1): Span) -> TrueError {
     let o = arc.center();
     let d = p - o;
     let r = geometry::norm(&d);
-    let within = if r > 0.0 {
+    let radial = if r > 0.0 {
         arc.param_of_angle(d[1].atan2(d[0]))
     } else {
-        Some(0.0)
+        Some(t0)
+    };
+    let inside = |u: f64| (t0..=t1).contains(&u);
+    let within = match radial {
+        Some(u) if inside(u) => Some(u),
+        Some(u) if arc.is_full_circle() && inside(u + 1.0) => Some(u + 1.0),
+        _ => None,
     };
     let u = match within {
         Some(u) => u,
         None => {
-            if geometry::dist(&arc.point(0.0), &p) <= geometry::dist(&arc.point(1.0), &p) {
-                0.0
+            if geometry::dist(&arc.point(t0), &p) <= geometry::dist(&arc.point(t1), &p) {
+                t0
             } else {
-                1.0
+                t1
             }
         }
     };
@@ -324,6 +354,9 @@ const CHUNK_SUB: usize = 4;
 pub struct TrueErrorIndex {
     path: Path,
     chunks: Vec<Chunk>,
+    /// Arc length from the path's start to the start of every chunk, then the path's
+    /// length: `chunks.len() + 1` entries (a program's move starts).
+    lengths: Vec<f64>,
     /// Implicit complete binary tree: node i has children 2i, 2i+1; leaves from `leaves`.
     tree: Vec<BBox>,
     leaves: usize,
@@ -334,6 +367,7 @@ impl TrueErrorIndex {
     pub fn new(path: &Path) -> Self {
         let mut chunks = Vec::new();
         let mut boxes = Vec::new();
+        let mut lengths = vec![0.0];
         if let Path::Nurbs(_) = path {
             let bps = path.breakpoints();
             for w in bps.windows(2) {
@@ -361,8 +395,21 @@ impl TrueErrorIndex {
                     };
                     chunks.push(Chunk { u0, u1 });
                     boxes.push(chunk_box(path, u0, u1));
+                    let before = lengths[lengths.len() - 1];
+                    lengths.push(before + path.length_between(u0, u1));
                 }
             }
+        }
+        if let Path::Line(_) | Path::Arc(_) = path {
+            // One chunk, solved exactly.
+            let (u0, u1) = path.param_range();
+            chunks.push(Chunk { u0, u1 });
+            boxes.push(match path {
+                Path::Line(l) => line_box(l),
+                Path::Arc(a) => arc_box(a),
+                _ => unreachable!("a line or an arc"),
+            });
+            lengths.push(path.length());
         }
         if let Path::Program(program) = path {
             // One chunk a move, solved exactly.
@@ -371,7 +418,11 @@ impl TrueErrorIndex {
                     u0: program.start_of(i),
                     u1: program.start_of(i + 1),
                 });
-                boxes.push(move_box(program, i));
+                boxes.push(match &program.moves()[i].shape {
+                    Shape::Line(l) => line_box(l),
+                    Shape::Arc(a) => arc_box(a),
+                });
+                lengths.push(program.start_of(i + 1));
             }
         }
         let leaves = chunks.len().max(1).next_power_of_two();
@@ -385,6 +436,7 @@ impl TrueErrorIndex {
         TrueErrorIndex {
             path: path.clone(),
             chunks,
+            lengths,
             tree,
             leaves,
         }
@@ -395,7 +447,7 @@ impl TrueErrorIndex {
         &self.path
     }
 
-    /// Number of chunks (0 for analytic paths).
+    /// Number of chunks (1 for a line or an arc).
     pub fn chunk_count(&self) -> usize {
         self.chunks.len()
     }
@@ -404,53 +456,166 @@ impl TrueErrorIndex {
     /// (the previous foot or the reference's parameter). Any hint gives the same result.
     pub fn error(&self, p: Vector2, hint: f64) -> TrueError {
         match &self.path {
-            Path::Line(l) => return line_true_error(l, p),
-            Path::Arc(a) => return arc_true_error(a, p),
-            Path::Nurbs(_) | Path::Program(_) => {}
+            Path::Line(l) => line_true_error(l, p),
+            Path::Arc(a) => arc_true_error(a, p),
+            Path::Nurbs(_) | Path::Program(_) => {
+                self.error_between(p, self.locate(hint), f64::NEG_INFINITY, f64::INFINITY)
+                    .1
+            }
         }
-        let first = self.locate(hint);
-        let mut best = self.chunk_min(first, p);
+    }
+
+    /// The exact distance from `p` to the stretch of the path between the arc lengths
+    /// `from` and `to` (clamped to the path), with the chunk of the foot; `hint` is a
+    /// chunk to try first. Equal distances go to the earlier chunk.
+    pub fn error_between(&self, p: Vector2, hint: usize, from: f64, to: f64) -> (usize, TrueError) {
+        let chunks = self.chunks_between(from, to);
+        let first = hint.clamp(chunks.start, chunks.end - 1);
+        let mut best = self.chunk_min(first, p, from, to);
         let mut best_chunk = first;
         let mut best2 = best.0 * best.0;
-        // Depth-first branch and bound; a stack of depth ≤ 2·log2(leaves) suffices.
-        let mut stack = [0usize; 128];
-        let mut top = 1;
-        stack[0] = 1;
-        while top > 0 {
-            top -= 1;
-            let node = stack[top];
+        let mut pending = Pending::root();
+        while let Some(node) = pending.pop() {
+            let leaves = self.leaves_of(node);
             // Strictly farther only: a move as near as the best may be an earlier one,
             // which wins the tie whatever the hint.
-            if box_dist2(&self.tree[node], p) > best2 {
+            if leaves.end <= chunks.start
+                || leaves.start >= chunks.end
+                || box_dist2(&self.tree[node], p) > best2
+            {
                 continue;
             }
             if node >= self.leaves {
                 let i = node - self.leaves;
-                if i != first && i < self.chunks.len() {
-                    let r = self.chunk_min(i, p);
+                if i != first {
+                    let r = self.chunk_min(i, p, from, to);
                     if r.0 < best.0 || r.0 == best.0 && i < best_chunk {
                         best = r;
                         best2 = r.0 * r.0;
                         best_chunk = i;
                     }
                 }
-            } else if top + 2 <= stack.len() {
+            } else {
                 let (l, r) = (2 * node, 2 * node + 1);
-                // Push the farther child first so the nearer one is searched first.
+                // The nearer child is searched first.
                 if box_dist2(&self.tree[l], p) <= box_dist2(&self.tree[r], p) {
-                    stack[top] = r;
-                    stack[top + 1] = l;
+                    pending.push(r, l);
                 } else {
-                    stack[top] = l;
-                    stack[top + 1] = r;
+                    pending.push(l, r);
                 }
-                top += 2;
             }
         }
-        match &self.path {
-            Path::Program(program) => move_true_error(program, best_chunk, p),
-            _ => finish(&self.path, p, best.1),
+        (best_chunk, self.result(best_chunk, best.1, p, from, to))
+    }
+
+    /// The first place at or after the arc length `from`, in path order, where the path
+    /// passes within `tolerance` of `p`: the chunk and the exact distance there; `None`
+    /// when there is none. Left-first branch and bound: O(log n) boxes plus the chunks
+    /// that pass near `p`.
+    pub fn first_within(
+        &self,
+        p: Vector2,
+        from: f64,
+        tolerance: f64,
+    ) -> Option<(usize, TrueError)> {
+        let start = self.chunks_between(from, f64::INFINITY).start;
+        let limit = tolerance * tolerance;
+        let mut pending = Pending::root();
+        while let Some(node) = pending.pop() {
+            if self.leaves_of(node).end <= start || box_dist2(&self.tree[node], p) > limit {
+                continue;
+            }
+            if node >= self.leaves {
+                let i = node - self.leaves;
+                let (d, u) = self.chunk_min(i, p, from, f64::INFINITY);
+                if d <= tolerance {
+                    return Some((i, self.result(i, u, p, from, f64::INFINITY)));
+                }
+            } else {
+                // Leaves come off in path order.
+                pending.push(2 * node + 1, 2 * node);
+            }
         }
+        None
+    }
+
+    /// Arc length from the path's start to parameter `u` of chunk `i` (within the chunk
+    /// by its share of the parameter: exact on a program, a line and an arc).
+    pub fn length_at(&self, i: usize, u: f64) -> f64 {
+        let Chunk { u0, u1 } = self.chunks[i];
+        let (a, b) = (self.lengths[i], self.lengths[i + 1]);
+        let share = if u1 > u0 {
+            ((u - u0) / (u1 - u0)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        a + share * (b - a)
+    }
+
+    /// Arc lengths to the start and the end of chunk `i`, with the points there.
+    pub fn chunk_ends(&self, i: usize) -> [(f64, Vector2); 2] {
+        let c = self.chunks[i];
+        [
+            (self.lengths[i], self.path.point(c.u0)),
+            (self.lengths[i + 1], self.path.point(c.u1)),
+        ]
+    }
+
+    /// The chunks that cover the arc lengths `from` … `to` (at least one).
+    fn chunks_between(&self, from: f64, to: f64) -> Range<usize> {
+        let n = self.chunks.len();
+        // The first chunk that ends at or after `from`, through the last that starts at
+        // or before `to`.
+        let first = self.lengths[1..]
+            .partition_point(|&end| end < from)
+            .min(n - 1);
+        let end = self.lengths[..n].partition_point(|&start| start <= to);
+        first..end.clamp(first + 1, n)
+    }
+
+    /// Chunk `i`'s parameters that lie between the arc lengths `from` and `to` (the
+    /// whole chunk when it lies inside; its nearer end when outside).
+    fn span(&self, i: usize, from: f64, to: f64) -> Span {
+        let Chunk { u0, u1 } = self.chunks[i];
+        let (a, b) = (self.lengths[i], self.lengths[i + 1]);
+        let at = |s: f64| {
+            if s <= a || b <= a {
+                u0
+            } else if s >= b {
+                u1
+            } else {
+                u0 + (s - a) / (b - a) * (u1 - u0)
+            }
+        };
+        (at(from), at(to).max(at(from)))
+    }
+
+    /// The leaves (chunk indices) under tree node `node`.
+    fn leaves_of(&self, node: usize) -> Range<usize> {
+        let level = usize::BITS - 1 - node.leading_zeros();
+        let span = self.leaves >> level;
+        let first = node * span - self.leaves;
+        first..first + span
+    }
+
+    /// The signed result at the foot parameter `u` found in chunk `chunk` between the
+    /// arc lengths `from` and `to`.
+    fn result(&self, chunk: usize, u: f64, p: Vector2, from: f64, to: f64) -> TrueError {
+        match &self.path {
+            Path::Program(program) => {
+                move_true_error(program, chunk, p, self.move_span(chunk, from, to))
+            }
+            Path::Line(l) => line_error_within(l, p, self.span(chunk, from, to)),
+            Path::Arc(a) => arc_error_within(a, p, self.span(chunk, from, to)),
+            Path::Nurbs(_) => finish(&self.path, p, u),
+        }
+    }
+
+    /// The move's own parameters (0 … 1) between the arc lengths `from` and `to`.
+    fn move_span(&self, i: usize, from: f64, to: f64) -> Span {
+        let (a, b) = self.span(i, from, to);
+        let Chunk { u0, u1 } = self.chunks[i];
+        ((a - u0) / (u1 - u0), (b - u0) / (u1 - u0))
     }
 
     /// Chunk containing parameter `u` (clamped).
@@ -463,13 +628,24 @@ impl TrueErrorIndex {
         self.chunks.partition_point(|c| c.u1 < u).min(n - 1)
     }
 
-    /// Minimum distance over chunk `i`: best of its samples, then Newton in the bracket.
-    fn chunk_min(&self, i: usize, p: Vector2) -> (f64, f64) {
-        if let Path::Program(program) = &self.path {
-            let e = move_true_error(program, i, p);
-            return (e.error.abs(), e.u);
-        }
-        let Chunk { u0, u1 } = self.chunks[i];
+    /// Minimum distance over chunk `i` between the arc lengths `from` and `to`, and its
+    /// parameter: exact on a move, a line or an arc; on a NURBS the best of the chunk's
+    /// samples, then Newton in the bracket.
+    fn chunk_min(&self, i: usize, p: Vector2, from: f64, to: f64) -> (f64, f64) {
+        let e = match &self.path {
+            Path::Program(program) => move_true_error(program, i, p, self.move_span(i, from, to)),
+            Path::Line(l) => line_error_within(l, p, self.span(i, from, to)),
+            Path::Arc(a) => arc_error_within(a, p, self.span(i, from, to)),
+            Path::Nurbs(_) => {
+                let (u0, u1) = self.span(i, from, to);
+                return self.curve_min(p, u0, u1);
+            }
+        };
+        (e.error.abs(), e.u)
+    }
+
+    /// Minimum distance over the NURBS parameters [u0, u1] (within one chunk).
+    fn curve_min(&self, p: Vector2, u0: f64, u1: f64) -> (f64, f64) {
         let h = (u1 - u0) / CHUNK_SUB as f64;
         let mut bi = 0;
         let mut bd = f64::INFINITY;
@@ -487,6 +663,36 @@ impl TrueErrorIndex {
             u0 + h * (bi + 1) as f64
         };
         refine(&self.path, p, a, b.min(u1), u0 + h * bi as f64)
+    }
+}
+
+/// The tree nodes still to visit, depth first: a stack of depth ≤ 2·log2(leaves) fits
+/// (a path of up to 2⁶³ chunks), so nothing is allocated.
+struct Pending {
+    nodes: [usize; 128],
+    top: usize,
+}
+
+impl Pending {
+    /// The root alone.
+    fn root() -> Self {
+        let mut nodes = [0; 128];
+        nodes[0] = 1;
+        Pending { nodes, top: 1 }
+    }
+
+    fn pop(&mut self) -> Option<usize> {
+        self.top = self.top.checked_sub(1)?;
+        Some(self.nodes[self.top])
+    }
+
+    /// Pushes two nodes, `first` to be visited first.
+    fn push(&mut self, second: usize, first: usize) {
+        if self.top + 2 <= self.nodes.len() {
+            self.nodes[self.top] = second;
+            self.nodes[self.top + 1] = first;
+            self.top += 2;
+        }
     }
 }
 
