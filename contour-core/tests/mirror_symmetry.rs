@@ -52,6 +52,7 @@ fn mirror_by_definition(path: &Path) -> Path {
                         Path::Arc(a) => Shape::Arc(a),
                         _ => unreachable!(),
                     },
+                    Shape::Blend(_) => unreachable!("a program read from G-code has no blends"),
                 };
                 Move { shape, ..m.clone() }
             });

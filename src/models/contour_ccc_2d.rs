@@ -128,6 +128,7 @@ variable_table! {
         Start::String(path_parameter::DEFAULT),
         path_parameter::DESCRIPTION,
     );
+    TOLERANCE: Real = path_parameter::TOLERANCE;
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -304,6 +305,7 @@ fn estimator(
         EstimatorKind::Program => {
             let mut path = path_parameter::path(PATH.get(values), values, GEOMETRY, environment)?;
             warnings = path_parameter::reader_warnings(&mut path);
+            let path = path_parameter::with_blends(path, TOLERANCE.get(values));
             Estimator::Program(ProgramEstimator::new(&path))
         }
     };

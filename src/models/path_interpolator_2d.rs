@@ -1,6 +1,9 @@
 //! `PathInterpolator2D`: the reference trajectory. Follows a line, an arc, the paper's
-//! circle, the built-in `infinity` and `trident` NURBS or a NURBS file at a constant
-//! feed, one sample every `Ts`; `ref.x`, `ref.y` hold the latest sample between samples.
+//! circle, the built-in `infinity` and `trident` NURBS, a NURBS file or a G-code program,
+//! one sample every `Ts`; `ref.x`, `ref.y` hold the latest sample between samples. With
+//! `accel` = 0 at the constant `feed` (the paper's interpolator); with `accel` > 0 a
+//! program, a line or an arc is planned at initialization within the speeds, the
+//! acceleration and the jerk, corners blended (docs/design/two-axis.md §4.9).
 
 use std::f64::consts::PI;
 
@@ -13,6 +16,7 @@ use crate::framework::state_check;
 use crate::framework::state_codec::{SavedState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, Real, XY};
 use crate::framework::variables::{Start, Values, Variable};
+use contour_core::path::plan::{XyLimits, XyReference};
 use contour_core::path::{CircularArc, Curve, Interpolator, Line, Path};
 
 variable_table! {
@@ -31,7 +35,8 @@ variable_table! {
     FEED: Real = Variable::parameter(
         "feed",
         Start::Real(10.0 * PI),
-        "Feed rate along the path (> 0)",
+        "Feed rate along the path (> 0); with a plan, the speed of moves before a \
+         program's first F word",
     )
     .unit("mm/s");
     TS: Real = Variable::parameter(
@@ -41,6 +46,38 @@ variable_table! {
     )
     .unit("s");
     GEOMETRY: Reals<{ line_arc_parameters::COUNT }> = line_arc_parameters::VARIABLES;
+    ACCEL: Real = Variable::parameter(
+        "accel",
+        Start::Real(0.0),
+        "Greatest acceleration along the path, tangential and centripetal (0: no plan, \
+         the constant feed)",
+    )
+    .unit("mm/s2")
+    .min(0.0);
+    JERK: Real = Variable::parameter(
+        "jerk",
+        Start::Real(1e5),
+        "Greatest jerk of the planned reference (0: no jerk limit)",
+    )
+    .unit("mm/s3")
+    .min(0.0);
+    TOLERANCE: Real = path_parameter::TOLERANCE;
+    RAPID: Real = Variable::parameter(
+        "rapid",
+        Start::Real(100.0),
+        "Speed of a program's G0 moves with a plan (> 0)",
+    )
+    .unit("mm/s");
+    FEED_RATE: Real = Variable::output(
+        "feedRate",
+        "Path speed of the reference (the constant feed without a plan)",
+    )
+    .unit("mm/s");
+    DURATION: Real = Variable::output(
+        "plannedDuration",
+        "Time from the start to the end of the path (known after initialization)",
+    )
+    .unit("s");
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -79,7 +116,11 @@ pub static INFO: ModelInfo = ModelInfo {
             ],
         ),
     ],
-    initial_dependencies_on_some_paths: &[],
+    initial_dependencies_on_some_paths: &[
+        // At rest with a plan, the feed without.
+        (FEED_RATE.vr(), &[FEED.vr(), ACCEL.vr()]),
+        (DURATION.vr(), &DURATION_KNOWNS),
+    ],
     create: |environment: &Environment| {
         Box::new(PathInterpolator2D {
             environment: environment.clone(),
@@ -89,15 +130,49 @@ pub static INFO: ModelInfo = ModelInfo {
     },
 };
 
-/// Version 1: `Option<State>` as below.
+/// What the planned duration depends on: the path and every limit.
+const DURATION_KNOWNS: [usize; 16] = {
+    let mut k = [0; 16];
+    let head = [
+        PATH.vr(),
+        FEED.vr(),
+        TS.vr(),
+        ACCEL.vr(),
+        JERK.vr(),
+        TOLERANCE.vr(),
+        RAPID.vr(),
+    ];
+    let mut i = 0;
+    while i < head.len() {
+        k[i] = head[i];
+        i += 1;
+    }
+    while i < 16 {
+        k[i] = GEOMETRY.at(i - head.len()).vr();
+        i += 1;
+    }
+    k
+};
+
+/// Version 2: `Option<State>` as below (version 1 had the constant-feed interpolator
+/// alone).
 const LAYOUT: StateLayout = StateLayout {
     model: "PathInterpolator2D",
-    version: 1,
+    version: 2,
 };
+
+/// The reference the parameters choose.
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
+enum Reference {
+    /// `accel` = 0: the paper's constant-feed interpolator.
+    ConstantFeed(Interpolator),
+    /// `accel` > 0: the plan.
+    Planned(XyReference),
+}
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct State {
-    interpolator: Interpolator,
+    reference: Reference,
     clock: SampleClock,
 }
 
@@ -106,7 +181,20 @@ impl SavedState for State {
     /// the offending value. (A NURBS path is validated by its own decoder.)
     fn validate(&self, time: f64) -> Result<(), String> {
         self.clock.validate_at(time)?;
-        let it = &self.interpolator;
+        let it = match &self.reference {
+            Reference::ConstantFeed(it) => it,
+            // Planned again from its inputs when it was read: within its limits.
+            Reference::Planned(planned) => {
+                if planned.limits().ts != self.clock.period() {
+                    return Err(format!(
+                        "planned reference period {} s differs from the sample clock period {} s",
+                        planned.limits().ts,
+                        self.clock.period()
+                    ));
+                }
+                return state_check::all_finite(self);
+            }
+        };
         if !(it.feed().is_finite() && it.feed() >= 0.0) {
             return Err(format!(
                 "interpolator feed {} mm/s must be finite and >= 0",
@@ -167,11 +255,32 @@ fn path(values: &Values, environment: &Environment) -> Result<Path, String> {
 
 impl PathInterpolator2D {
     fn write_outputs(&self, values: &mut Values) {
-        if let Some(state) = &self.state {
-            let sample = state.interpolator.current();
-            REF.set(values, &sample.point);
-            DONE.set(values, sample.done);
-        }
+        let Some(state) = &self.state else { return };
+        let (point, done, speed, duration) = match &state.reference {
+            Reference::ConstantFeed(it) => {
+                let sample = it.current();
+                let speed = if sample.done { 0.0 } else { it.feed() };
+                (
+                    sample.point,
+                    sample.done,
+                    speed,
+                    it.path().length() / it.feed(),
+                )
+            }
+            Reference::Planned(planned) => {
+                let sample = planned.current();
+                (
+                    sample.point,
+                    planned.done(),
+                    sample.speed,
+                    planned.duration(),
+                )
+            }
+        };
+        REF.set(values, &point);
+        DONE.set(values, done);
+        FEED_RATE.set(values, speed);
+        DURATION.set(values, duration);
     }
 }
 
@@ -181,16 +290,34 @@ impl Model for PathInterpolator2D {
         let ts = check_period("Ts", TS.get(values))?;
         let mut path = path(values, &self.environment)?;
         self.warnings = path_parameter::reader_warnings(&mut path);
-        if let Path::Program(_) = path {
-            self.warnings.push(
-                "parameter 'path': the program runs at the constant 'feed': its F words, \
-                 rapids and corner modes are read but not yet planned"
-                    .to_string(),
-            );
-        }
-        let interpolator = Interpolator::new(path, feed, ts).map_err(|e| e.to_string())?;
+        let tolerance = TOLERANCE.get(values);
+        let accel = ACCEL.get(values);
+        let reference = if accel > 0.0 {
+            let limits = XyLimits {
+                feed,
+                rapid: positive(values, RAPID)?,
+                accel,
+                jerk: JERK.get(values),
+                tolerance,
+                ts,
+            };
+            limits.validate().map_err(|e| format!("parameter {e}"))?;
+            Reference::Planned(
+                XyReference::new(path, limits).map_err(|e| format!("parameter 'path': {e}"))?,
+            )
+        } else {
+            if let Path::Program(_) = path {
+                self.warnings.push(
+                    "parameter 'path': with accel = 0 the program runs at the constant 'feed' \
+                     (its F words, rapids and exact stops are not planned: set 'accel' > 0)"
+                        .to_string(),
+                );
+            }
+            let path = path_parameter::with_blends(path, tolerance);
+            Reference::ConstantFeed(Interpolator::new(path, feed, ts).map_err(|e| e.to_string())?)
+        };
         self.state = Some(State {
-            interpolator,
+            reference,
             clock: SampleClock::new(start_time, ts),
         });
         self.write_outputs(values);
@@ -204,7 +331,14 @@ impl Model for PathInterpolator2D {
     fn do_step(&mut self, values: &mut Values, time: f64, step: f64) -> ModelResult {
         let state = self.state.as_mut().ok_or("not initialized")?;
         while state.clock.take_until(time + step) {
-            state.interpolator.step();
+            match &mut state.reference {
+                Reference::ConstantFeed(it) => {
+                    it.step();
+                }
+                Reference::Planned(planned) => {
+                    planned.step();
+                }
+            }
         }
         self.write_outputs(values);
         Ok(())

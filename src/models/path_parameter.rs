@@ -4,7 +4,8 @@
 
 use super::line_arc_parameters;
 use crate::framework::model::Environment;
-use crate::framework::variables::Values;
+use crate::framework::variables::{Start, Values, Variable};
+use contour_core::path::program::blended;
 use contour_core::path::Path;
 
 /// The parameter's start value: the paper's circle.
@@ -14,6 +15,26 @@ pub const DEFAULT: &str = "circle";
 pub const DESCRIPTION: &str = "circle (the paper's), line or arc (from the line.*/arc.* \
      parameters), infinity, trident, a NURBS JSON file or a G-code program (.ngc, .nc, \
      .gcode, .tap): absolute, or relative to the FMU's resources folder";
+
+/// The `tolerance` parameter, the same in both models.
+pub const TOLERANCE: Variable = Variable::parameter(
+    "tolerance",
+    Start::Real(0.0),
+    "How far a blended corner may leave the programmed one: the blend of bare G64 and \
+     until a program's first G61/G64 (0: exact stops); the interpolator and the \
+     controller's program estimator need the same value",
+)
+.unit("mm")
+.min(0.0);
+
+/// The path as planned: a program's blended corners rounded within `tolerance` (the
+/// same geometry in the interpolator and the controller); other paths unchanged.
+pub fn with_blends(path: Path, tolerance: f64) -> Path {
+    match path {
+        Path::Program(program) => Path::Program(blended(&program, tolerance)),
+        other => other,
+    }
+}
 
 /// The path `spec` names, with `line` and `arc` from the model's `line.*`/`arc.*`
 /// block; file errors name the file and line.

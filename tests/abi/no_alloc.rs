@@ -326,6 +326,31 @@ fn path_estimator_and_true_error_do_not_allocate() {
 }
 
 #[test]
+fn a_planned_xy_reference_samples_without_allocating() {
+    use contour_core::path::plan::{XyLimits, XyReference};
+    let part = "G64 P0.02\nG1 X30 F1200\nG3 X35 Y5 R5\nG1 Y20\nX0\nY0\n";
+    let part = Path::Program(contour_core::path::program::parse_program(part, "p.ngc").unwrap());
+    let limits = XyLimits {
+        feed: 20.0,
+        rapid: 100.0,
+        accel: 2000.0,
+        jerk: 1e5,
+        tolerance: 0.01,
+        ts: 1e-3,
+    };
+    let mut reference = XyReference::new(part, limits).unwrap();
+    let mut acc = 0.0;
+    let count = allocations_during(|| {
+        while !reference.done() {
+            let p = reference.step();
+            acc += black_box(p.point[0] + p.speed);
+        }
+    });
+    assert_eq!(count, 0, "a planned sample allocated");
+    assert!(acc.is_finite() && reference.duration() > 5.0);
+}
+
+#[test]
 fn closed_loop_samples_do_not_allocate() {
     for name in ["circle", "trident"] {
         let sim = Simulator::new(SimConfig::builtin(name).unwrap()).unwrap();

@@ -61,7 +61,14 @@ def test_dependencies_are_explicit_no_feedthrough_and_initial_values_from_parame
     expected_initial = {
         "PathInterpolator2D": {"ref.x": ["path", "line.x0", "arc.cx", "arc.r", "arc.start"],
                                "ref.y": ["path", "line.y0", "arc.cy", "arc.r", "arc.start"],
-                               "done": []},
+                               "done": [],
+                               # At rest with a plan, the feed without.
+                               "feedRate": ["feed", "accel"],
+                               # The path and every limit.
+                               "plannedDuration": ["path", "feed", "Ts", "accel", "jerk", "tolerance",
+                                                   "rapid", "line.x0", "line.y0", "line.x1",
+                                                   "line.y1", "arc.cx", "arc.cy", "arc.r",
+                                                   "arc.start", "arc.sweep"]},
         "XYServoPlant": {"pos.x": ["pos0.x"], "pos.y": ["pos0.y"], "vel.x": [], "vel.y": []},
         "ContourCCC2D": {name: [] for name in CONTROLLER_OUTPUTS},
     }
@@ -71,7 +78,8 @@ def test_dependencies_are_explicit_no_feedthrough_and_initial_values_from_parame
         assert sorted(u.variable.name for u in md.outputs) == sorted(outputs)
         for unknown in md.outputs:
             assert unknown.dependencies == [], (model, unknown.variable.name)
-        assert {u.variable.name: [d.name for d in u.dependencies] for u in md.initialUnknowns} == initial
+        assert ({u.variable.name: sorted(d.name for d in u.dependencies) for u in md.initialUnknowns}
+                == {name: sorted(knowns) for name, knowns in initial.items()})
 
 
 def test_initial_values_change_only_with_their_listed_dependencies(fmu_dir):

@@ -294,11 +294,12 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
     interpolator.free_state(&mut state);
 
     // The models' current layout versions: ContourCCC2D 2 (the controller became N-axis),
-    // XYServoPlant 2 (each axis's lead became a transmission), PathInterpolator2D 1.
+    // XYServoPlant 2 (each axis's lead became a transmission), PathInterpolator2D 2 (the
+    // planned reference joined the constant-feed one).
     for (i, bytes, model, version) in [
         (&controller, &controller_bytes, "ContourCCC2D", 2u16),
         (&plant_instance, &plant_bytes, "XYServoPlant", 2),
-        (&interpolator, &interpolator_bytes, "PathInterpolator2D", 1),
+        (&interpolator, &interpolator_bytes, "PathInterpolator2D", 2),
     ] {
         let (_, envelope) = open_state(bytes);
         assert_eq!(

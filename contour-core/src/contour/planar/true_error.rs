@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::contour::ContourEstimate;
 use crate::geometry::{self, Vector, Vector2};
-use crate::path::program::Shape;
+use crate::path::program::{CornerBlend, Shape};
 use crate::path::{CircularArc, Curve, Line, Path, Program};
 
 /// Exact contour error of one point.
@@ -84,6 +84,7 @@ fn move_true_error(program: &Program, i: usize, p: Vector2, span: Span) -> TrueE
     let mut e = match &moves[i].shape {
         Shape::Line(l) => line_error_within(l, p, span),
         Shape::Arc(a) => arc_error_within(a, p, span),
+        Shape::Blend(b) => blend_error_within(b, p, span),
     };
     let last = moves.len() - 1;
     // Only asked at an end of the first or last move.
@@ -111,6 +112,33 @@ fn move_true_error(program: &Program, i: usize, p: Vector2, span: Span) -> TrueE
         }
     }
     e.u = program.position(i, e.u);
+    e
+}
+
+/// Samples over a corner blend's span before the refinement.
+const BLEND_SAMPLES: usize = 16;
+
+/// Exact distance to the part `span` of a corner blend: the best of its samples, then
+/// safeguarded Newton in the bracket around it (a blend is short and turns by less than
+/// π: one minimum near the path).
+fn blend_error_within(b: &CornerBlend, p: Vector2, (t0, t1): Span) -> TrueError {
+    let at = |k: usize| t0 + (t1 - t0) * k as f64 / BLEND_SAMPLES as f64;
+    let nearest = (0..=BLEND_SAMPLES)
+        .min_by(|&i, &j| {
+            let (di, dj) = (
+                geometry::dist2(&b.point(at(i)), &p),
+                geometry::dist2(&b.point(at(j)), &p),
+            );
+            di.total_cmp(&dj)
+        })
+        .unwrap_or(0);
+    let (lo, hi) = (
+        at(nearest.saturating_sub(1)),
+        at((nearest + 1).min(BLEND_SAMPLES)),
+    );
+    let (_, u) = refine(b, p, lo, hi, at(nearest));
+    let mut e = finish(b, p, u);
+    e.u = u;
     e
 }
 
@@ -421,6 +449,10 @@ impl TrueErrorIndex {
                 boxes.push(match &program.moves()[i].shape {
                     Shape::Line(l) => line_box(l),
                     Shape::Arc(a) => arc_box(a),
+                    Shape::Blend(b) => {
+                        let [a, v, c] = b.hull();
+                        union(&union(&point_box(a), &point_box(v)), &point_box(c))
+                    }
                 });
                 lengths.push(program.start_of(i + 1));
             }

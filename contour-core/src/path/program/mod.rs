@@ -7,6 +7,8 @@
 //! search over the starts (O(log n), no allocation).
 
 mod arc_words;
+mod blending;
+mod corner_blend;
 pub mod reader;
 
 use serde::{Deserialize, Serialize};
@@ -14,6 +16,8 @@ use serde::{Deserialize, Serialize};
 use super::{clamp_param, CircularArc, Curve, CurvePoint, Line, PathError};
 use crate::geometry::Vector2;
 
+pub use blending::{blended, MIN_BLEND_TURN};
+pub use corner_blend::CornerBlend;
 pub use reader::{is_program_file, load_program, parse_program, PROGRAM_EXTENSIONS};
 
 /// The geometry of one move.
@@ -23,6 +27,8 @@ pub enum Shape {
     Line(Line),
     /// G2 (clockwise, sweep < 0) or G3 (counter-clockwise, sweep > 0).
     Arc(CircularArc),
+    /// A corner rounded by the planner (never read from a program).
+    Blend(CornerBlend),
 }
 
 impl Shape {
@@ -31,6 +37,7 @@ impl Shape {
         match self {
             Shape::Line(l) => l,
             Shape::Arc(a) => a,
+            Shape::Blend(b) => b,
         }
     }
 
@@ -39,6 +46,7 @@ impl Shape {
         match self {
             Shape::Line(l) => Shape::Line(l.mirrored()),
             Shape::Arc(a) => Shape::Arc(a.mirrored()),
+            Shape::Blend(b) => Shape::Blend(b.mirrored()),
         }
     }
 }
@@ -155,6 +163,11 @@ impl Program {
         self.starts[i] + clamp_param(u, 0.0, 1.0) * (self.starts[i + 1] - self.starts[i])
     }
 
+    /// The point of move `i` at path position `s` (clamped into the move).
+    pub fn point_in(&self, i: usize, s: f64) -> Vector2 {
+        self.moves[i].shape.curve().point(self.local(i, s))
+    }
+
     /// The mirror image about the x axis, travelled in the mirrored sense.
     pub fn mirrored(&self) -> Program {
         let moves = self
@@ -196,6 +209,7 @@ impl TryFrom<ProgramData> for Program {
                 Shape::Arc(a) => {
                     CircularArc::new(a.center(), a.radius(), a.start_angle(), a.sweep()).map(drop)
                 }
+                Shape::Blend(b) => b.validate(),
             };
             checked.map_err(|e| format!("move of line {}: {e}", m.line))?;
             let speed_ok = match m.speed {

@@ -1,0 +1,114 @@
+//! The planned XY reference sampled every Ts (docs/design/two-axis.md §4.9): the plan of
+//! [`XyPlan`] made once, then one sample a step in O(1). It saves its inputs and its
+//! sample count; a restored one plans again (the plan is a function of them), so a state
+//! from elsewhere cannot carry a plan that breaks the limits.
+
+use serde::{Deserialize, Serialize};
+
+use super::xy_plan::{XyCursor, XyLimits, XyPlan, XyPoint};
+use crate::path::program::Program;
+use crate::path::{Path, PathError};
+
+/// A planned XY reference at its latest sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct XyReference {
+    path: Path,
+    limits: XyLimits,
+    plan: XyPlan,
+    /// Samples taken: the current one is at k·Ts.
+    k: u64,
+    cursor: XyCursor,
+    current: XyPoint,
+}
+
+#[derive(Serialize, Deserialize)]
+struct XyReferenceData {
+    path: Path,
+    limits: XyLimits,
+    k: u64,
+}
+
+impl XyReference {
+    /// Plans `path` within `limits`; the first sample is the path's start, at rest.
+    pub fn new(path: Path, limits: XyLimits) -> Result<Self, PathError> {
+        Self::at_sample(path, limits, 0)
+    }
+
+    fn at_sample(path: Path, limits: XyLimits, k: u64) -> Result<Self, PathError> {
+        let plan = XyPlan::new(&path, &limits)?;
+        let mut cursor = XyCursor::default();
+        let current = plan.at(k as f64 * limits.ts, &mut cursor);
+        Ok(XyReference {
+            path,
+            limits,
+            plan,
+            k,
+            cursor,
+            current,
+        })
+    }
+
+    /// The next sample.
+    pub fn step(&mut self) -> XyPoint {
+        self.k += 1;
+        self.current = self
+            .plan
+            .at(self.k as f64 * self.limits.ts, &mut self.cursor);
+        self.current
+    }
+
+    /// The latest sample.
+    pub fn current(&self) -> XyPoint {
+        self.current
+    }
+
+    /// The plan has reached the path's end.
+    pub fn done(&self) -> bool {
+        self.k as f64 * self.limits.ts >= self.plan.duration()
+    }
+
+    /// The planned duration, s.
+    pub fn duration(&self) -> f64 {
+        self.plan.duration()
+    }
+
+    /// The planned geometry (blended corners included).
+    pub fn geometry(&self) -> &Program {
+        self.plan.geometry()
+    }
+
+    /// The limits it was planned with.
+    pub fn limits(&self) -> &XyLimits {
+        &self.limits
+    }
+}
+
+impl Serialize for XyReference {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        #[derive(Serialize)]
+        struct Data<'a> {
+            path: &'a Path,
+            limits: &'a XyLimits,
+            k: u64,
+        }
+        Data {
+            path: &self.path,
+            limits: &self.limits,
+            k: self.k,
+        }
+        .serialize(s)
+    }
+}
+
+impl<'de> Deserialize<'de> for XyReference {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let data = XyReferenceData::deserialize(d)?;
+        let samples = data.limits.ts * data.k as f64;
+        if !samples.is_finite() {
+            return Err(serde::de::Error::custom(
+                "planned reference: sample time not finite",
+            ));
+        }
+        XyReference::at_sample(data.path, data.limits, data.k).map_err(serde::de::Error::custom)
+    }
+}

@@ -1,0 +1,310 @@
+//! A corner between two lines rounded by two mirror-image clothoids (Euler spirals),
+//! docs/design/two-axis.md §4.9. Along a clothoid the curvature grows linearly with arc
+//! length, so the blend leaves the incoming line with zero curvature, reaches its peak at
+//! the corner's bisector and joins the outgoing line with zero curvature again: the
+//! acceleration of a reference passing it changes continuously (a circular blend would
+//! jump to v²/r and make a jerk spike in the samples), and its parameter is exact arc
+//! length. Its points are Fresnel integrals, summed as power series (their argument is
+//! at most √(π/2) here).
+
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::{self, Vector2};
+use crate::path::{Curve, CurvePoint, PathError};
+
+/// Two clothoids, each `half` long, turning by `turn` together.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CornerBlend {
+    /// Where the blend leaves the incoming line.
+    start: Vector2,
+    /// The incoming line's unit direction.
+    incoming: Vector2,
+    /// The turn from the incoming to the outgoing direction, rad (> 0 to the left),
+    /// 0 < |turn| < π.
+    turn: f64,
+    /// Arc length of each clothoid, mm.
+    half: f64,
+}
+
+/// ∫₀ˣ cos(w²) dw and ∫₀ˣ sin(w²) dw by their power series (|x| ≤ 1.3: 12 terms reach
+/// the last bit).
+fn fresnel(x: f64) -> (f64, f64) {
+    let x2 = x * x;
+    let x4 = x2 * x2;
+    let (mut c, mut s) = (0.0, 0.0);
+    // Term n: (−1)ⁿ x^(4n+1) / ((4n+1)(2n)!) and (−1)ⁿ x^(4n+3) / ((4n+3)(2n+1)!).
+    let mut power = x;
+    let mut factorial = 1.0;
+    for n in 0..30 {
+        let k = n as f64;
+        let sign = if n % 2 == 0 { 1.0 } else { -1.0 };
+        let tc = sign * power / ((4.0 * k + 1.0) * factorial);
+        let ts = sign * power * x2 / ((4.0 * k + 3.0) * factorial * (2.0 * k + 1.0));
+        c += tc;
+        s += ts;
+        if tc.abs() <= 1e-18 * c.abs() && ts.abs() <= 1e-18 * s.abs().max(f64::MIN_POSITIVE) {
+            break;
+        }
+        power *= x4;
+        factorial *= (2.0 * k + 1.0) * (2.0 * k + 2.0);
+    }
+    (c, s)
+}
+
+/// The left unit normal.
+fn left(t: Vector2) -> Vector2 {
+    Vector2::new(-t[1], t[0])
+}
+
+impl CornerBlend {
+    /// The blend of a corner at `vertex` from unit direction `incoming` to `outgoing`,
+    /// leaving the two lines by at most `tolerance` and starting no more than `reach`
+    /// before the vertex (it ends as far after it). `None` for a turn it cannot round
+    /// (none, or a reversal) or limits that leave nothing.
+    pub fn at_corner(
+        vertex: Vector2,
+        incoming: Vector2,
+        outgoing: Vector2,
+        tolerance: f64,
+        reach: f64,
+    ) -> Option<(CornerBlend, f64)> {
+        let turn = geometry::cross(&incoming, &outgoing).atan2(incoming.dot(&outgoing));
+        if !(turn.abs() > 0.0 && turn.abs() < std::f64::consts::PI - 1e-6) {
+            return None;
+        }
+        // A unit-length half: its end's offsets along and across the incoming line.
+        let unit = CornerBlend {
+            start: Vector2::zeros(),
+            incoming: Vector2::new(1.0, 0.0),
+            turn,
+            half: 1.0,
+        };
+        let (along, across) = unit.first_half(1.0);
+        let across = across.abs();
+        let beta = 0.5 * turn.abs();
+        // The middle lies on the bisector: the trim before the vertex per unit half.
+        let trim = along + across * beta.tan();
+        let half = (tolerance / across).min(reach / trim);
+        if !(half.is_finite() && half > 0.0) {
+            return None;
+        }
+        let blend = CornerBlend {
+            start: vertex - incoming * (trim * half),
+            incoming,
+            turn,
+            half,
+        };
+        Some((blend, trim * half))
+    }
+
+    /// Checks restored values as [`CornerBlend::at_corner`] makes them.
+    pub fn validate(&self) -> Result<(), PathError> {
+        let unit = (geometry::norm(&self.incoming) - 1.0).abs() < 1e-9;
+        let finite = self.start.iter().all(|v| v.is_finite());
+        if unit
+            && finite
+            && self.turn.abs() > 0.0
+            && self.turn.abs() < std::f64::consts::PI
+            && self.half.is_finite()
+            && self.half > 0.0
+        {
+            Ok(())
+        } else {
+            Err(PathError::invalid(format!(
+                "corner blend {self:?} is invalid"
+            )))
+        }
+    }
+
+    /// The turn, rad (> 0 to the left).
+    pub fn turn(&self) -> f64 {
+        self.turn
+    }
+
+    /// The peak curvature (at the bisector), 1/mm.
+    pub fn peak_curvature(&self) -> f64 {
+        self.turn.abs() / self.half
+    }
+
+    /// The rate of change of the curvature along the blend, 1/mm².
+    pub fn curvature_rate(&self) -> f64 {
+        self.turn.abs() / (self.half * self.half)
+    }
+
+    /// The three corners of the triangle the blend lies in: its ends and the vertex.
+    pub fn hull(&self) -> [Vector2; 3] {
+        let end = self.point(1.0);
+        let (along, across) = self.first_half(self.half);
+        let trim = along + across.abs() * (0.5 * self.turn.abs()).tan();
+        [self.start, self.start + self.incoming * trim, end]
+    }
+
+    /// The blend mirrored about the x axis (y → −y), travelled the mirrored way.
+    pub fn mirrored(&self) -> CornerBlend {
+        CornerBlend {
+            start: Vector2::new(self.start[0], -self.start[1]),
+            incoming: Vector2::new(self.incoming[0], -self.incoming[1]),
+            turn: -self.turn,
+            half: self.half,
+        }
+    }
+
+    /// The first clothoid's point at arc length `s` ≤ `half` in the incoming frame:
+    /// (along the incoming line, across it, > 0 to the left for a left turn).
+    fn first_half(&self, s: f64) -> (f64, f64) {
+        // φ(s) = s²/(2A²) with φ(half) = |turn|/2: A² = half²/|turn|; w = s/(A√2).
+        let a = self.half / self.turn.abs().sqrt();
+        let scale = a * std::f64::consts::SQRT_2;
+        let (c, s) = fresnel(s / scale);
+        (scale * c, scale * s * self.turn.signum())
+    }
+
+    /// Tangent angle from the incoming direction at arc length `s` from the start.
+    fn angle(&self, s: f64) -> f64 {
+        let rate = self.turn.abs() / (self.half * self.half);
+        let h = self.half;
+        let phi = if s <= h {
+            0.5 * rate * s * s
+        } else {
+            let r = 2.0 * h - s;
+            self.turn.abs() - 0.5 * rate * r * r
+        };
+        phi * self.turn.signum()
+    }
+}
+
+impl Curve for CornerBlend {
+    fn param_range(&self) -> (f64, f64) {
+        (0.0, 1.0)
+    }
+
+    fn eval(&self, u: f64) -> CurvePoint {
+        let length = 2.0 * self.half;
+        let s = u.clamp(0.0, 1.0) * length;
+        let h = self.half;
+        let n1 = left(self.incoming);
+        let p = if s <= h {
+            let (x, y) = self.first_half(s);
+            self.start + self.incoming * x + n1 * y
+        } else {
+            // The second clothoid from the end, backwards: the mirror image of the first.
+            let (sin, cos) = self.turn.sin_cos();
+            let outgoing = Vector2::new(
+                self.incoming[0] * cos - self.incoming[1] * sin,
+                self.incoming[0] * sin + self.incoming[1] * cos,
+            );
+            let (x_h, y_h) = self.first_half(h);
+            let trim = x_h + y_h.abs() * (0.5 * self.turn.abs()).tan();
+            let end = self.start + self.incoming * trim + outgoing * trim;
+            let (x, y) = self.first_half(2.0 * h - s);
+            end - outgoing * x + left(outgoing) * y
+        };
+        let phi = self.angle(s);
+        let (sin, cos) = phi.sin_cos();
+        let tangent = self.incoming * cos + n1 * sin;
+        // κ(s): rising to the bisector, then falling, with the turn's sign.
+        let kappa =
+            self.turn.signum() * self.curvature_rate() * if s <= h { s } else { 2.0 * h - s };
+        CurvePoint {
+            p,
+            d1: tangent * length,
+            d2: left(tangent) * (kappa * length * length),
+        }
+    }
+
+    fn length_between(&self, u0: f64, u1: f64) -> f64 {
+        (u1.clamp(0.0, 1.0) - u0.clamp(0.0, 1.0)).abs() * 2.0 * self.half
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    #[test]
+    fn the_series_are_the_fresnel_integrals() {
+        // By the midpoint rule on a fine grid (independent of the series).
+        for x in [0.0, 0.1, 0.5, 1.0, 1.2533] {
+            let n = 200_000;
+            let h: f64 = x / n as f64;
+            let (mut c, mut s) = (0.0, 0.0);
+            for k in 0..n {
+                let w: f64 = (k as f64 + 0.5) * h;
+                c += (w * w).cos() * h;
+                s += (w * w).sin() * h;
+            }
+            let (fc, fs) = fresnel(x);
+            assert!((fc - c).abs() < 1e-10 && (fs - s).abs() < 1e-10, "{x}");
+        }
+    }
+
+    #[test]
+    fn a_right_angle_blend_keeps_the_tolerance_joins_both_lines_and_is_arc_length() {
+        let vertex = Vector2::new(10.0, 0.0);
+        for (incoming, outgoing) in [
+            (Vector2::new(1.0, 0.0), Vector2::new(0.0, 1.0)),
+            (Vector2::new(1.0, 0.0), Vector2::new(0.0, -1.0)),
+            (Vector2::new(0.6, 0.8), Vector2::new(-0.8, 0.6)),
+        ] {
+            let (b, trim) = CornerBlend::at_corner(vertex, incoming, outgoing, 0.01, 5.0).unwrap();
+            assert!((b.turn().abs() - FRAC_PI_2).abs() < 1e-12);
+            // Ends on the two lines, `trim` from the vertex, tangent to them.
+            assert!((b.point(0.0) - (vertex - incoming * trim)).amax() < 1e-12);
+            assert!((b.point(1.0) - (vertex + outgoing * trim)).amax() < 1e-12);
+            let e0 = b.eval(0.0);
+            let e1 = b.eval(1.0);
+            assert!((e0.d1 / geometry::norm(&e0.d1) - incoming).amax() < 1e-12);
+            assert!((e1.d1 / geometry::norm(&e1.d1) - outgoing).amax() < 1e-12);
+            // Zero curvature at both ends.
+            assert!(geometry::norm(&e0.d2) < 1e-12 && geometry::norm(&e1.d2) < 1e-9);
+            // Continuous at the bisector; the middle 0.01 mm from both lines.
+            let h = 0.5;
+            let (below, above) = (b.point(h - 1e-12), b.point(h + 1e-12));
+            assert!((below - above).amax() < 1e-9);
+            let middle = b.point(h);
+            let off = |p: Vector2, t: Vector2| geometry::cross(&t, &(p - vertex)).abs();
+            assert!((off(middle, incoming) - 0.01).abs() < 1e-12);
+            assert!((off(middle, outgoing) - 0.01).abs() < 1e-12);
+            // Arc length: chords of 20 000 steps sum to the length (short of it by
+            // Σκ²Δs³/24 ≈ 3·10⁻¹¹ mm); the derivative's length is the length.
+            let n = 20_000;
+            let chords: f64 = (0..n)
+                .map(|k| {
+                    geometry::dist(
+                        &b.point(k as f64 / n as f64),
+                        &b.point((k + 1) as f64 / n as f64),
+                    )
+                })
+                .sum();
+            assert!((chords - b.length()).abs() < 1e-9 * b.length(), "{chords}");
+            for k in 0..=20 {
+                let e = b.eval(k as f64 / 20.0);
+                assert!((geometry::norm(&e.d1) - b.length()).abs() < 1e-12);
+                // The second derivative by central differences of the first.
+                let d = 1e-6;
+                let u = (k as f64 / 20.0).clamp(d, 1.0 - d);
+                let numeric = (b.eval(u + d).d1 - b.eval(u - d).d1) / (2.0 * d);
+                assert!((numeric - b.eval(u).d2).amax() < 1e-5 * b.length(), "{k}");
+            }
+            // Every point within the tolerance of the nearer line.
+            for k in 0..=1000 {
+                let p = b.point(k as f64 / 1000.0);
+                assert!(off(p, incoming).min(off(p, outgoing)) <= 0.01 + 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn a_short_side_limits_the_blend_and_reversals_are_not_rounded() {
+        let v = Vector2::new(0.0, 0.0);
+        let (b, trim) =
+            CornerBlend::at_corner(v, Vector2::new(1.0, 0.0), Vector2::new(0.0, 1.0), 1.0, 0.2)
+                .unwrap();
+        assert!((trim - 0.2).abs() < 1e-15 && b.length() < 0.4);
+        let back = Vector2::new(-1.0, 0.0);
+        assert!(CornerBlend::at_corner(v, Vector2::new(1.0, 0.0), back, 0.1, 1.0).is_none());
+        let sharp = Vector2::new((PI - 0.1).cos(), (PI - 0.1).sin());
+        assert!(CornerBlend::at_corner(v, Vector2::new(1.0, 0.0), sharp, 0.1, 1.0).is_some());
+    }
+}

@@ -1,0 +1,221 @@
+//! The planned XY reference on test programs, checked on its samples by finite
+//! differences (docs/design/two-axis.md §4.9): the speed within F, the acceleration and
+//! jerk within the limits (within the derived allowance at junctions), zero speed at
+//! exact stops, the planned path within the tolerance of the programmed one, start and
+//! end at rest; and on single lines the trapezoid's and the S-curve's closed forms.
+
+use contour_core::contour::planar::{true_error, TrueErrorIndex};
+use contour_core::geometry::Vector2;
+use contour_core::path::plan::{XyLimits, XyReference};
+use contour_core::path::program::parse_program;
+use contour_core::path::Path;
+
+const LIMITS: XyLimits = XyLimits {
+    feed: 50.0,
+    rapid: 200.0,
+    accel: 2000.0,
+    jerk: 1e5,
+    tolerance: 0.01,
+    ts: 1e-3,
+};
+
+fn program(text: &str) -> Path {
+    Path::Program(parse_program(text, "test.ngc").unwrap())
+}
+
+/// All samples of a planned reference, from the start to the end.
+fn samples(path: &Path, limits: XyLimits) -> (Vec<Vector2>, XyReference) {
+    let mut r = XyReference::new(path.clone(), limits).unwrap();
+    let mut points = vec![r.current().point];
+    while !r.done() {
+        points.push(r.step().point);
+    }
+    // Two samples at rest at the end, for the differences.
+    points.push(r.step().point);
+    points.push(r.step().point);
+    (points, r)
+}
+
+fn norm(v: Vector2) -> f64 {
+    v[0].hypot(v[1])
+}
+
+struct Case {
+    name: &'static str,
+    text: &'static str,
+    /// Programmed speeds, mm/s (F words; the feed 50 otherwise).
+    fastest: f64,
+    /// Path positions (mm, along the programmed path) of the exact stops.
+    stops: &'static [[f64; 2]],
+}
+
+const CASES: &[Case] = &[
+    Case {
+        name: "square, exact stops",
+        text: "G61\nG1 X20 F3000\nY20\nX0\nY0\n",
+        fastest: 50.0,
+        stops: &[[20.0, 0.0], [20.0, 20.0], [0.0, 20.0]],
+    },
+    Case {
+        name: "square, blended within 0.05 mm",
+        text: "G64 P0.05\nG1 X20 F3000\nY20\nX0\nY0\n",
+        fastest: 50.0,
+        stops: &[],
+    },
+    Case {
+        name: "part with arcs, a small radius, G61 and G64",
+        text: "G21 G90 G64 P0.01\nG1 X30 F2400\nG3 X35 Y5 I0 J5\nG1 Y20\nG2 X30 Y25 R5\n\
+               G1 X10 F600\nG3 X9.5 Y24.5 R0.5\nG61\nG1 Y15\nG2 X4.5 Y10 I-5 J0\n\
+               G64 G1 X0\nY0\n",
+        fastest: 40.0,
+        stops: &[[9.5, 15.0], [4.5, 10.0]],
+    },
+    Case {
+        name: "a rapid, then a feed of 10 mm/s",
+        text: "G0 X0 Y0\nG1 X5 F600\nG0 X30\nG1 Y10 F600\n",
+        fastest: 200.0,
+        stops: &[],
+    },
+];
+
+#[test]
+fn every_sample_keeps_the_limits_and_the_tolerance() {
+    for limits in [
+        LIMITS,
+        XyLimits {
+            jerk: 0.0,
+            ..LIMITS
+        },
+    ] {
+        for case in CASES {
+            let path = program(case.text);
+            let (p, reference) = samples(&path, limits);
+            let ts = limits.ts;
+            let name = format!("{} (jerk {})", case.name, limits.jerk);
+            // Start and end at rest, at the path's ends.
+            assert!(norm(p[0] - path.start_point()) < 1e-12, "{name}");
+            // From rest: the first step is at most what the jerk (or the acceleration)
+            // covers in one sample.
+            let first = if limits.jerk > 0.0 {
+                limits.jerk * ts.powi(3) / 6.0
+            } else {
+                limits.accel * ts * ts / 2.0
+            };
+            assert!(
+                norm(p[1] - p[0]) <= first * (1.0 + 1e-9),
+                "{name}: starts moving at once"
+            );
+            let n = p.len();
+            assert!(norm(p[n - 1] - path.end_point()) < 1e-9, "{name}");
+            assert!(norm(p[n - 1] - p[n - 3]) < 1e-12, "{name}");
+            // The geometry's junctions with a curvature jump or a kink: the derived
+            // allowance of the samples there (design §4.9).
+            let geometry = Path::Program(reference.geometry().clone());
+            let junctions: Vec<Vector2> = reference
+                .geometry()
+                .moves()
+                .iter()
+                .map(|m| m.shape.curve().point(1.0))
+                .collect();
+            let near_junction =
+                |q: Vector2, reach: f64| junctions.iter().any(|&j| norm(q - j) <= reach);
+            let index = TrueErrorIndex::new(&path);
+            let (mut max_a, mut max_j) = (0.0f64, 0.0f64);
+            for k in 1..n - 2 {
+                let v = norm(p[k + 1] - p[k]) / ts;
+                assert!(
+                    v <= case.fastest * (1.0 + 1e-9),
+                    "{name}: {v} mm/s at sample {k}"
+                );
+                let a = norm(p[k + 1] - p[k] * 2.0 + p[k - 1]) / (ts * ts);
+                let j = norm(p[k + 2] - p[k + 1] * 3.0 + p[k] * 3.0 - p[k - 1]) / (ts * ts * ts);
+                // The samples' acceleration averages the reference's over ±Ts, so it
+                // keeps the limit; their jerk averages the jerk over three samples, where
+                // a curvature jump's step v²Δκ ≤ jerk·Ts weighs at most 3/4 (the kernel's
+                // peak): up to 1.75·jerk within three samples of a junction.
+                let reach = 3.0 * v * ts + 1e-9;
+                let j_allowed = if near_junction(p[k], reach) {
+                    1.75
+                } else {
+                    1.0 + 1e-6
+                } * limits.jerk;
+                assert!(
+                    a <= limits.accel * (1.0 + 1e-6),
+                    "{name}: {a} mm/s² at sample {k} ({:?})",
+                    p[k]
+                );
+                if limits.jerk > 0.0 {
+                    assert!(
+                        j <= j_allowed,
+                        "{name}: {j} mm/s³ at sample {k} ({:?})",
+                        p[k]
+                    );
+                }
+                max_a = max_a.max(a);
+                max_j = max_j.max(j);
+                // On the planned geometry, within the tolerance of the programmed path.
+                assert!(
+                    true_error(&geometry, p[k]).error.abs() < 1e-9,
+                    "{name}: off at {k}"
+                );
+                let off = index.error(p[k], 0.0).error.abs();
+                assert!(
+                    off <= 0.05 + 1e-9,
+                    "{name}: {off} mm from the program at {k}"
+                );
+            }
+            // The limits are used, not just kept.
+            assert!(max_a > 0.5 * limits.accel, "{name}: {max_a}");
+            // Exact stops: the motion comes to rest there between two samples, so the
+            // samples either side are within one sample's motion from rest of it (one
+            // passing at v would be v·Ts/2 away).
+            for stop in case.stops {
+                let stop = Vector2::from(*stop);
+                let at_rest = (1..n - 1).any(|k| {
+                    norm(p[k] - stop) <= first * (1.0 + 1e-6)
+                        && norm(p[k + 1] - stop) <= first * (1.0 + 1e-6)
+                });
+                assert!(at_rest, "{name}: no stop at {stop:?}");
+            }
+            let _ = max_j;
+        }
+    }
+}
+
+#[test]
+fn a_line_takes_the_closed_form_time_of_its_limits() {
+    for length in [0.001, 0.01, 0.1, 0.5, 1.0, 2.0, 10.0, 100.0] {
+        let path = program(&format!("G1 X{length} F3000\n"));
+        // Trapezoid (no jerk limit): triangle below 2·v²/2a = 1.25 mm.
+        let (v, a, j) = (50.0f64, 2000.0f64, 1e5f64);
+        let r = XyReference::new(
+            path.clone(),
+            XyLimits {
+                jerk: 0.0,
+                ..LIMITS
+            },
+        )
+        .unwrap();
+        let want = if length >= v * v / a {
+            length / v + v / a
+        } else {
+            2.0 * (length / a).sqrt()
+        };
+        assert!(
+            (r.duration() - want).abs() < 1e-9 * want,
+            "{length}: {} vs {want}",
+            r.duration()
+        );
+        // S-curve, where both limits are reached: L/v + v/a + a/j.
+        let r = XyReference::new(path, LIMITS).unwrap();
+        if length >= v * (v / a + a / j) {
+            let want = length / v + v / a + a / j;
+            assert!(
+                (r.duration() - want).abs() < 1e-9 * want,
+                "{length}: {}",
+                r.duration()
+            );
+        }
+        assert!(r.duration() > 0.0);
+    }
+}
