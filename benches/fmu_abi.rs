@@ -28,6 +28,15 @@
 //! `fmu_abi/five_axis_plant_round`: the same round on `FiveAxisPlant`, the lightest
 //! packaged five-axis model (five velocity commands in, five positions and velocities out).
 //!
+//! `fmu_abi/interpolator_circle`: `PathInterpolator2D` as the paper runs it (the circle at
+//! constant feed; ref.x, ref.y read); `fmu_abi/interpolator_program_1k` and `_100k`: the
+//! first 4 000 samples of a planned G-code spiral of 1 000 and of 100 000 short lines
+//! (accel 2000 mm/s², jerk 10⁵ mm/s³, G64 P0.005: every corner a blend).
+//! `fmu_abi/contour_ccc_2d_program_1k` and `_100k`: `ContourCCC2D` with
+//! `estimator = program` on those spirals, the reference their planned samples and the
+//! tool 35 samples behind and 10 µm off in y (against `contour_ccc_2d_sample`, the
+//! free-curve estimator on the paper's circle).
+//!
 //! Criterion's throughput gives the time per sample. At the end the bench prints the
 //! median per sample of each benchmark, taken from the same timed runs criterion
 //! analyses, and the ratios controller / pass-through, path_100k / path_1k and
@@ -114,6 +123,18 @@ impl Fmu {
         // SAFETY: the callbacks are boxed in the returned value, which frees the instance
         // (Drop) before they are dropped.
         let c = unsafe { linked::instantiate_started(model, &name, &*functions) };
+        Fmu::from_instance(c, model, inputs, outputs, functions)
+    }
+
+    /// The instance `c` of `model`, made with `functions`, for a round of `inputs` and
+    /// `outputs`.
+    fn from_instance(
+        c: fmi2Component,
+        model: &ModelInfo,
+        inputs: &[&str],
+        outputs: &[&str],
+        functions: Box<fmi2CallbackFunctions>,
+    ) -> Fmu {
         Fmu {
             c,
             inputs: linked::vrs(model, inputs),
@@ -184,7 +205,27 @@ impl Drop for Fmu {
 }
 
 /// The ratios the summary prints and writes: (name, numerator, denominator).
-const RATIOS: [(&str, &str, &str); 4] = [
+const RATIOS: [(&str, &str, &str); 8] = [
+    (
+        "planned_over_circle_interpolator",
+        "interpolator_program_1k",
+        "interpolator_circle",
+    ),
+    (
+        "interpolator_100k_over_1k",
+        "interpolator_program_100k",
+        "interpolator_program_1k",
+    ),
+    (
+        "program_estimator_over_circle",
+        "contour_ccc_2d_program_1k",
+        "contour_ccc_2d_sample",
+    ),
+    (
+        "program_estimator_100k_over_1k",
+        "contour_ccc_2d_program_100k",
+        "contour_ccc_2d_program_1k",
+    ),
     (
         "ccc_2d_over_pass_through",
         "contour_ccc_2d_sample",
@@ -456,6 +497,106 @@ fn two_axis() -> Vec<Round> {
     ]
 }
 
+/// A spiral of `n` short lines (0.2 mm each, turning by 0.04 rad at first), every corner
+/// blended within 5 µm, at 50 mm/s: written to the temporary folder, its name returned.
+fn spiral_program(n: usize) -> String {
+    use std::fmt::Write;
+    let mut text = String::from("G21 G90 G64 P0.005\nG1 X5 Y0 F3000\n");
+    for k in 1..=n {
+        let phi = (k as f64 * 0.4).sqrt();
+        let r = 5.0 + 0.5 * phi;
+        writeln!(text, "X{:.4} Y{:.4}", r * phi.cos(), r * phi.sin()).expect("a String");
+    }
+    let file = std::env::temp_dir().join(format!("fmu_abi_spiral_{n}.ngc"));
+    std::fs::write(&file, text).expect("the temporary folder is writable");
+    file.to_string_lossy().into_owned()
+}
+
+/// The interpolator on the paper's circle, then planned on the 1k and 100k spirals; the
+/// controller's program estimator on the spirals' planned samples.
+fn two_axis_programs() -> Vec<Round> {
+    use contour_core::path::plan::{XyLimits, XyReference};
+    use linked::Start;
+    const TIMED: usize = 4_000;
+    let interpolator = |parameters: &[(&str, Start)]| {
+        let model = model("PathInterpolator2D");
+        let functions = Box::new(linked::quiet_callbacks());
+        let name = CString::new("fmu-abi-bench").unwrap();
+        // SAFETY: the callbacks are boxed in the returned value, which frees the instance
+        // first.
+        let c = unsafe { linked::instantiate_configured(model, &name, &*functions, parameters) };
+        Fmu::from_instance(c, model, &[], &["ref.x", "ref.y"], functions)
+    };
+    let mut rounds = vec![Round::fresh(
+        "interpolator_circle",
+        interpolator(&[]),
+        vec![[0.0f64; 0]; TIMED],
+    )];
+    for (n, planned, estimated) in [
+        (
+            1_000,
+            "interpolator_program_1k",
+            "contour_ccc_2d_program_1k",
+        ),
+        (
+            100_000,
+            "interpolator_program_100k",
+            "contour_ccc_2d_program_100k",
+        ),
+    ] {
+        let file = spiral_program(n);
+        let limits = [
+            ("path", Start::String(&file)),
+            ("feed", Start::Real(50.0)),
+            ("accel", Start::Real(2000.0)),
+            ("jerk", Start::Real(1e5)),
+        ];
+        rounds.push(Round::fresh(
+            planned,
+            interpolator(&limits),
+            vec![[0.0f64; 0]; TIMED],
+        ));
+        // The same plan in process: the reference rows, the tool trailing it.
+        let program = contour_core::path::program::load_program(std::path::Path::new(&file))
+            .expect("the spiral reads");
+        let mut reference = XyReference::new(
+            contour_core::path::Path::Program(program),
+            XyLimits {
+                feed: 50.0,
+                rapid: 100.0,
+                accel: 2000.0,
+                jerk: 1e5,
+                tolerance: 0.0,
+                ts: 1e-3,
+            },
+        )
+        .expect("the spiral plans");
+        let mut samples = vec![reference.current().point];
+        while samples.len() < TIMED + 35 {
+            samples.push(reference.step().point);
+        }
+        let rows: Vec<[f64; 4]> = (35..TIMED + 35)
+            .map(|k| {
+                let (r, p) = (samples[k], samples[k - 35]);
+                [r[0], r[1], p[0], p[1] - 0.01]
+            })
+            .collect();
+        let model_2d = model("ContourCCC2D");
+        let functions = Box::new(linked::quiet_callbacks());
+        let name = CString::new("fmu-abi-bench").unwrap();
+        let parameters = [
+            ("estimator", Start::Integer(4)),
+            ("path", Start::String(&file)),
+        ];
+        // SAFETY: as above.
+        let c =
+            unsafe { linked::instantiate_configured(model_2d, &name, &*functions, &parameters) };
+        let ccc = Fmu::from_instance(c, model_2d, &CCC_2D_INPUTS, &CCC_2D_OUTPUTS, functions);
+        rounds.push(Round::fresh(estimated, ccc, rows));
+    }
+    rounds
+}
+
 /// The recorded closed loops replayed on ContourCCC5X on CL data: the dome raster (over a
 /// hemisphere's apex, the reference planned within the machine's limits), and the pass
 /// through vertical at constant feed (C flips by π at the pole: the correction stands
@@ -582,6 +723,7 @@ fn main() {
     let mut c = Criterion::default().configure_from_args();
     let mut summary = Summary::default();
     let mut rounds = two_axis();
+    rounds.extend(two_axis_programs());
     rounds.extend(five_axis());
     rounds.extend(cam_paths());
     rounds.extend(path_lengths());

@@ -13,8 +13,8 @@ use std::ffi::{c_char, CStr};
 
 use contour_fmu::fmi2::bindings::{
     fmi2Boolean, fmi2Byte, fmi2CallbackFunctions, fmi2CallbackLogger, fmi2Component,
-    fmi2ComponentEnvironment, fmi2FMUstate, fmi2Real, fmi2Status, fmi2String, fmi2Type,
-    fmi2Type_fmi2CoSimulation, fmi2ValueReference,
+    fmi2ComponentEnvironment, fmi2FMUstate, fmi2Integer, fmi2Real, fmi2Status, fmi2String,
+    fmi2Type, fmi2Type_fmi2CoSimulation, fmi2ValueReference,
 };
 use contour_fmu::framework::model::ModelInfo;
 use contour_fmu::models;
@@ -36,6 +36,18 @@ extern "C" {
         start_time: fmi2Real,
         stop_time_defined: fmi2Boolean,
         stop_time: fmi2Real,
+    ) -> fmi2Status;
+    pub fn fmi2SetInteger(
+        c: fmi2Component,
+        vr: *const fmi2ValueReference,
+        nvr: usize,
+        value: *const fmi2Integer,
+    ) -> fmi2Status;
+    pub fn fmi2SetString(
+        c: fmi2Component,
+        vr: *const fmi2ValueReference,
+        nvr: usize,
+        value: *const fmi2String,
     ) -> fmi2Status;
     pub fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status;
     pub fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status;
@@ -149,6 +161,13 @@ pub fn vrs(model: &ModelInfo, names: &[&str]) -> Vec<fmi2ValueReference> {
         .collect()
 }
 
+/// A parameter value for [`instantiate_configured`].
+pub enum Start<'a> {
+    Real(f64),
+    Integer(i32),
+    String(&'a str),
+}
+
 /// A Co-Simulation instance of `model`, logging off, set up at t = 0 without a stop time
 /// and initialized: ready for `fmi2DoStep(c, 0.0, …)`.
 ///
@@ -158,6 +177,20 @@ pub unsafe fn instantiate_started(
     model: &ModelInfo,
     name: &CStr,
     functions: *const fmi2CallbackFunctions,
+) -> fmi2Component {
+    // SAFETY: as the caller promises.
+    unsafe { instantiate_configured(model, name, functions, &[]) }
+}
+
+/// [`instantiate_started`] with `parameters` set in initialization mode.
+///
+/// # Safety
+/// As [`instantiate_started`].
+pub unsafe fn instantiate_configured(
+    model: &ModelInfo,
+    name: &CStr,
+    functions: *const fmi2CallbackFunctions,
+    parameters: &[(&str, Start)],
 ) -> fmi2Component {
     let guid = std::ffi::CString::new(model.guid()).expect("GUID without NUL");
     // SAFETY: NUL-terminated strings that live across the call, callbacks as the caller
@@ -178,7 +211,24 @@ pub unsafe fn instantiate_started(
     unsafe {
         assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
         assert_eq!(fmi2EnterInitializationMode(c), 0);
-        assert_eq!(fmi2ExitInitializationMode(c), 0);
+        for (name, value) in parameters {
+            let vr = vrs(model, &[name])[0];
+            let status = match value {
+                Start::Real(x) => fmi2SetReal(c, &vr, 1, x),
+                Start::Integer(i) => fmi2SetInteger(c, &vr, 1, i),
+                Start::String(text) => {
+                    let text = std::ffi::CString::new(*text).expect("a value without NUL");
+                    fmi2SetString(c, &vr, 1, &text.as_ptr())
+                }
+            };
+            assert_eq!(status, 0, "{}: setting {name}", model.identifier);
+        }
+        assert_eq!(
+            fmi2ExitInitializationMode(c),
+            0,
+            "{}: initialization failed",
+            model.identifier
+        );
     }
     c
 }

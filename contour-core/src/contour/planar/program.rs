@@ -155,6 +155,9 @@ impl ProgramEstimator {
 /// Arc length of the foot of `e`, found in `chunk`. A full circle's start is also its
 /// end: a foot there is at whichever of the two is nearer `near`.
 fn along(index: &TrueErrorIndex, chunk: usize, e: &TrueError, near: f64) -> f64 {
+    if !index.is_closed(chunk) {
+        return index.length_at(chunk, e.u);
+    }
     let [(start, start_point), (end, end_point)] = index.chunk_ends(chunk);
     let at_both = |p: Vector2| geometry::dist(&p, &e.foot) <= 1e-9 * (1.0 + p.amax());
     if at_both(start_point) && at_both(end_point) {

@@ -116,7 +116,7 @@ fn move_true_error(program: &Program, i: usize, p: Vector2, span: Span) -> TrueE
 }
 
 /// Samples over a corner blend's span before the refinement.
-const BLEND_SAMPLES: usize = 16;
+const BLEND_SAMPLES: usize = 8;
 
 /// Exact distance to the part `span` of a corner blend: the best of its samples, then
 /// safeguarded Newton in the bracket around it (a blend is short and turns by less than
@@ -537,7 +537,7 @@ impl TrueErrorIndex {
                 }
             }
         }
-        (best_chunk, self.result(best_chunk, best.1, p, from, to))
+        (best_chunk, self.result(best, p))
     }
 
     /// The first place at or after the arc length `from`, in path order, where the path
@@ -559,9 +559,9 @@ impl TrueErrorIndex {
             }
             if node >= self.leaves {
                 let i = node - self.leaves;
-                let (d, u) = self.chunk_min(i, p, from, f64::INFINITY);
-                if d <= tolerance {
-                    return Some((i, self.result(i, u, p, from, f64::INFINITY)));
+                let found = self.chunk_min(i, p, from, f64::INFINITY);
+                if found.0 <= tolerance {
+                    return Some((i, self.result(found, p)));
                 }
             } else {
                 // Leaves come off in path order.
@@ -582,6 +582,19 @@ impl TrueErrorIndex {
             0.0
         };
         a + share * (b - a)
+    }
+
+    /// Chunk `i` is a full circle: its start point is also its end.
+    pub fn is_closed(&self, i: usize) -> bool {
+        let arc = match &self.path {
+            Path::Arc(a) => a,
+            Path::Program(program) => match &program.moves()[i].shape {
+                Shape::Arc(a) => a,
+                _ => return false,
+            },
+            _ => return false,
+        };
+        arc.is_full_circle()
     }
 
     /// Arc lengths to the start and the end of chunk `i`, with the points there.
@@ -630,16 +643,12 @@ impl TrueErrorIndex {
         first..first + span
     }
 
-    /// The signed result at the foot parameter `u` found in chunk `chunk` between the
-    /// arc lengths `from` and `to`.
-    fn result(&self, chunk: usize, u: f64, p: Vector2, from: f64, to: f64) -> TrueError {
-        match &self.path {
-            Path::Program(program) => {
-                move_true_error(program, chunk, p, self.move_span(chunk, from, to))
-            }
-            Path::Line(l) => line_error_within(l, p, self.span(chunk, from, to)),
-            Path::Arc(a) => arc_error_within(a, p, self.span(chunk, from, to)),
-            Path::Nurbs(_) => finish(&self.path, p, u),
+    /// The signed result of what [`TrueErrorIndex::chunk_min`] found (a NURBS foot is
+    /// signed only for the winner).
+    fn result(&self, found: ChunkMin, p: Vector2) -> TrueError {
+        match found.2 {
+            Some(e) => e,
+            None => finish(&self.path, p, found.1),
         }
     }
 
@@ -663,17 +672,18 @@ impl TrueErrorIndex {
     /// Minimum distance over chunk `i` between the arc lengths `from` and `to`, and its
     /// parameter: exact on a move, a line or an arc; on a NURBS the best of the chunk's
     /// samples, then Newton in the bracket.
-    fn chunk_min(&self, i: usize, p: Vector2, from: f64, to: f64) -> (f64, f64) {
+    fn chunk_min(&self, i: usize, p: Vector2, from: f64, to: f64) -> ChunkMin {
         let e = match &self.path {
             Path::Program(program) => move_true_error(program, i, p, self.move_span(i, from, to)),
             Path::Line(l) => line_error_within(l, p, self.span(i, from, to)),
             Path::Arc(a) => arc_error_within(a, p, self.span(i, from, to)),
             Path::Nurbs(_) => {
                 let (u0, u1) = self.span(i, from, to);
-                return self.curve_min(p, u0, u1);
+                let (d, u) = self.curve_min(p, u0, u1);
+                return (d, u, None);
             }
         };
-        (e.error.abs(), e.u)
+        (e.error.abs(), e.u, Some(e))
     }
 
     /// Minimum distance over the NURBS parameters [u0, u1] (within one chunk).
@@ -697,6 +707,10 @@ impl TrueErrorIndex {
         refine(&self.path, p, a, b.min(u1), u0 + h * bi as f64)
     }
 }
+
+/// What a chunk's search found: the distance, the foot's parameter and, where it is
+/// solved exactly (a move, a line, an arc), the signed result.
+type ChunkMin = (f64, f64, Option<TrueError>);
 
 /// The tree nodes still to visit, depth first: a stack of depth ≤ 2·log2(leaves) fits
 /// (a path of up to 2⁶³ chunks), so nothing is allocated.

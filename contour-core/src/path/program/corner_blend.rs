@@ -24,6 +24,9 @@ pub struct CornerBlend {
     turn: f64,
     /// Arc length of each clothoid, mm.
     half: f64,
+    /// Distance from the vertex to either end, mm (a function of the above, kept so that
+    /// a point on the second clothoid costs one Fresnel sum).
+    trim: f64,
 }
 
 /// ∫₀ˣ cos(w²) dw and ∫₀ˣ sin(w²) dw by their power series (|x| ≤ 1.3: 12 terms reach
@@ -78,6 +81,7 @@ impl CornerBlend {
             incoming: Vector2::new(1.0, 0.0),
             turn,
             half: 1.0,
+            trim: 0.0,
         };
         let (along, across) = unit.first_half(1.0);
         let across = across.abs();
@@ -93,6 +97,7 @@ impl CornerBlend {
             incoming,
             turn,
             half,
+            trim: trim * half,
         };
         Some((blend, trim * half))
     }
@@ -101,13 +106,13 @@ impl CornerBlend {
     pub fn validate(&self) -> Result<(), PathError> {
         let unit = (geometry::norm(&self.incoming) - 1.0).abs() < 1e-9;
         let finite = self.start.iter().all(|v| v.is_finite());
-        if unit
+        let shape = unit
             && finite
             && self.turn.abs() > 0.0
             && self.turn.abs() < std::f64::consts::PI
             && self.half.is_finite()
-            && self.half > 0.0
-        {
+            && self.half > 0.0;
+        if shape && (self.trim - self.computed_trim()).abs() <= 1e-9 * (1.0 + self.trim) {
             Ok(())
         } else {
             Err(PathError::invalid(format!(
@@ -133,10 +138,18 @@ impl CornerBlend {
 
     /// The three corners of the triangle the blend lies in: its ends and the vertex.
     pub fn hull(&self) -> [Vector2; 3] {
-        let end = self.point(1.0);
+        [
+            self.start,
+            self.start + self.incoming * self.trim,
+            self.point(1.0),
+        ]
+    }
+
+    /// The trim the other values make: the first clothoid's end offsets, the middle on the
+    /// bisector.
+    fn computed_trim(&self) -> f64 {
         let (along, across) = self.first_half(self.half);
-        let trim = along + across.abs() * (0.5 * self.turn.abs()).tan();
-        [self.start, self.start + self.incoming * trim, end]
+        along + across.abs() * (0.5 * self.turn.abs()).tan()
     }
 
     /// The blend mirrored about the x axis (y → −y), travelled the mirrored way.
@@ -146,6 +159,7 @@ impl CornerBlend {
             incoming: Vector2::new(self.incoming[0], -self.incoming[1]),
             turn: -self.turn,
             half: self.half,
+            trim: self.trim,
         }
     }
 
@@ -193,9 +207,7 @@ impl Curve for CornerBlend {
                 self.incoming[0] * cos - self.incoming[1] * sin,
                 self.incoming[0] * sin + self.incoming[1] * cos,
             );
-            let (x_h, y_h) = self.first_half(h);
-            let trim = x_h + y_h.abs() * (0.5 * self.turn.abs()).tan();
-            let end = self.start + self.incoming * trim + outgoing * trim;
+            let end = self.start + (self.incoming + outgoing) * self.trim;
             let (x, y) = self.first_half(2.0 * h - s);
             end - outgoing * x + left(outgoing) * y
         };
