@@ -301,7 +301,16 @@ fn the_program_estimate_is_the_exact_distance_on_every_sample_of_closed_loop_run
         Piece::Line([10.0, 0.0], [5.0, h]),
         Piece::Line([5.0, h], [0.0, 0.0]),
     ];
+    // A slot's end: a half circle of 0.5 mm between two passes 1 mm apart, all joins
+    // tangent; at speed the reference comes back behind the tool round it.
+    let slot = parse_program("G1 X20 F600\nG3 X20 Y1 R0.5\nG1 X0\n", "slot.ngc");
+    let slot_pieces = vec![
+        Piece::Line([0.0, 0.0], [20.0, 0.0]),
+        Piece::Arc([20.0, 0.5], 0.5, -FRAC_PI_2, PI),
+        Piece::Line([20.0, 1.0], [0.0, 1.0]),
+    ];
     let cases = [
+        ("slot end", Path::Program(slot.unwrap()), slot_pieces),
         ("part", Path::Program(program.clone()), pieces),
         (
             "mirrored part",
@@ -352,15 +361,21 @@ fn the_program_estimate_is_the_exact_distance_on_every_sample_of_closed_loop_run
                 }
                 peak = peak.max(want);
             }
+            // Straight passes followed exactly have no side: a fifth at least.
             assert!(
-                signs > trace.len() / 2,
+                signs > trace.len() / 5,
                 "{name}: {signs} of {}",
                 trace.len()
             );
             // The corners make real contour error: the comparison is not of zeros.
             assert!(peak > 0.01, "{name} at {feed} mm/s: peak {peak} mm");
-            // Only the triangle's corners are sharper than 90°.
-            assert_eq!(own > 0, name == "triangle", "{name}: {own}");
+            // The triangle's 120° corners always; the slot's end where the lag is longer
+            // than its half circle; never the part's.
+            match name {
+                "triangle" => assert!(own > 0, "{name}"),
+                "slot end" => assert!(own > 0 || feed < 50.0, "{name} at {feed}"),
+                _ => assert_eq!(own, 0, "{name}"),
+            }
         }
     }
 }

@@ -83,8 +83,9 @@ variable_table! {
 pub static INFO: ModelInfo = ModelInfo {
     identifier: "PathInterpolator2D",
     description:
-        "Two-axis reference trajectory: a line, arc, circle or NURBS path sampled every Ts \
-                  at a constant feed (second-order Taylor interpolation)",
+        "Two-axis reference trajectory: a line, arc, circle, NURBS or G-code path sampled \
+                  every Ts at a constant feed (second-order Taylor interpolation) or, with \
+                  accel > 0, planned within the speeds, acceleration and jerk",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment {
         start_time: 0.0,
@@ -309,7 +310,8 @@ impl Model for PathInterpolator2D {
             if let Path::Program(_) = path {
                 self.warnings.push(
                     "parameter 'path': with accel = 0 the program runs at the constant 'feed' \
-                     (its F words, rapids and exact stops are not planned: set 'accel' > 0)"
+                     (its F words, rapids and exact stops are not planned: set 'accel' > 0; its \
+                     blended corners are rounded all the same)"
                         .to_string(),
                 );
             }

@@ -16,7 +16,9 @@
 //! has left, and the nearest point, on that move, would make the contour correction hold
 //! the tool on it while the axis loops drag it back: the tool slides away from the
 //! corner. So where the foot is on a move before the reference's and the reference lies
-//! behind it along that move, the tool is measured against the reference's own move.
+//! behind it along that move, the tool is measured against the reference's own move. The
+//! same holds round an arc tighter than the lag (a slot's end at speed): the reference
+//! comes back behind the tool, which the nearest point would hold on the pass it left.
 //! A planned reference slows down into a kink, and the exception does not arise.
 //!
 //! The reference is located at the first place, from its last one on, where the path
@@ -180,7 +182,8 @@ impl ContourEstimator for ProgramEstimator {
             self.index
                 .error_between(actual, t.foot_chunk, oldest - ON_PATH, to);
         // Held to a move the reference has left while the reference pulls back along
-        // it: measure against the reference's own move (design §4.8).
+        // it (the path turned by more than 90° between them, at a kink or round a tight
+        // arc): measure against the reference's own move (design §4.8).
         if chunk < t.reference_chunk {
             let tangent = Vector2::new(e.normal[1], -e.normal[0]);
             if (reference - e.foot).dot(&tangent) < 0.0 {

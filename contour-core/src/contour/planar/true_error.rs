@@ -451,7 +451,10 @@ impl TrueErrorIndex {
                     Shape::Arc(a) => arc_box(a),
                     Shape::Blend(b) => {
                         let [a, v, c] = b.hull();
-                        union(&union(&point_box(a), &point_box(v)), &point_box(c))
+                        let h = union(&union(&point_box(a), &point_box(v)), &point_box(c));
+                        // Rounding in the Fresnel sums: a nanometre of margin.
+                        let m = 1e-9 * (1.0 + v.amax());
+                        [h[0] - m, h[1] - m, h[2] + m, h[3] + m]
                     }
                 });
                 lengths.push(program.start_of(i + 1));
@@ -656,6 +659,10 @@ impl TrueErrorIndex {
     fn move_span(&self, i: usize, from: f64, to: f64) -> Span {
         let (a, b) = self.span(i, from, to);
         let Chunk { u0, u1 } = self.chunks[i];
+        // A move that rounding left without length: all of it.
+        if u1 <= u0 {
+            return WHOLE;
+        }
         ((a - u0) / (u1 - u0), (b - u0) / (u1 - u0))
     }
 

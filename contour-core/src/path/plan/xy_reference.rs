@@ -50,7 +50,7 @@ impl XyReference {
 
     /// The next sample.
     pub fn step(&mut self) -> XyPoint {
-        self.k += 1;
+        self.k = self.k.saturating_add(1);
         self.current = self
             .plan
             .at(self.k as f64 * self.limits.ts, &mut self.cursor);

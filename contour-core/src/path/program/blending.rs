@@ -41,6 +41,11 @@ pub fn blended(program: &Program, tolerance: f64) -> Program {
                 return None;
             }
             let reach = REACH * a.length().min(b.length());
+            // Lines of a few rounding units: not rounded (what a blend would leave of
+            // them could round to nothing).
+            if reach <= 1e-9 * (1.0 + a.end().amax()) {
+                return None;
+            }
             CornerBlend::at_corner(a.end(), t1, t2, within, reach)
         })
         .collect();
