@@ -120,7 +120,7 @@ fn every_sample_keeps_the_limits_and_the_tolerance() {
             let near_junction =
                 |q: Vector2, reach: f64| junctions.iter().any(|&j| norm(q - j) <= reach);
             let index = TrueErrorIndex::new(&path);
-            let (mut max_a, mut max_j) = (0.0f64, 0.0f64);
+            let mut max_a = 0.0f64;
             for k in 1..n - 2 {
                 let v = norm(p[k + 1] - p[k]) / ts;
                 assert!(
@@ -152,7 +152,6 @@ fn every_sample_keeps_the_limits_and_the_tolerance() {
                     );
                 }
                 max_a = max_a.max(a);
-                max_j = max_j.max(j);
                 // On the planned geometry, within the tolerance of the programmed path.
                 assert!(
                     true_error(&geometry, p[k]).error.abs() < 1e-9,
@@ -177,7 +176,6 @@ fn every_sample_keeps_the_limits_and_the_tolerance() {
                 });
                 assert!(at_rest, "{name}: no stop at {stop:?}");
             }
-            let _ = max_j;
         }
     }
 }
