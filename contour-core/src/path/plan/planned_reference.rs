@@ -31,6 +31,11 @@ use crate::path::{PathError, ToolPath};
 pub const QUANTUM: f64 = 1.0 / (1u64 << 30) as f64;
 /// Rounds of plan, measure, slow down.
 const ROUNDS: usize = 30;
+/// The samples all rounds together may measure, in sample budgets: a plan that keeps
+/// slowing down near the budget is refused after a few full-length rounds, not thirty
+/// (the test paths converge within 3 rounds; a fuzzed restored state had taken 30
+/// rounds of 20 000 samples under the sanitizer, past the fuzzer's 10 s).
+const MEASURED_BUDGETS: u64 = 4;
 /// The most samples a plan may have by default: 2²⁶, 18.6 hours at 1 ms. Planning costs
 /// a few microseconds per sample and round, so this also bounds the time a restored
 /// state may spend planning again.
@@ -49,6 +54,16 @@ pub fn set_sample_budget(samples: u64) {
 fn sample_budget() -> u64 {
     SAMPLE_LIMIT.load(std::sync::atomic::Ordering::Relaxed)
 }
+
+/// Evaluations of the limits at a node (the windows of [`Constraints::bends`]) all the
+/// plans and rounds of one path may make, per sample of the budget: planning costs a few
+/// per node and round (the figure-eight, 930 samples on 10 322 nodes, about 55 000; the
+/// fuzzers' short CL move through the pole, about 220 000), so the sample budget bounds
+/// the time spent planning as well as the plan's length (at the default budget, about a
+/// quarter of an hour of a release build). A fuzzed restored state with 30 times the
+/// acceleration at the same jerk asked a million (a jerk filter 600 samples long, every
+/// node bisected): 0.6 s in a release build, half a minute under the sanitizers.
+const WORK_PER_SAMPLE: u64 = 16;
 
 /// What a plan measured on its own samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -130,6 +145,9 @@ struct Constraints<'a> {
     top_speed: &'a [Cell<f64>],
     /// The last node, speed and bends found.
     last_bends: Cell<Option<(usize, f64, Bends)>>,
+    /// The evaluations of the limits the plan may still make (`WORK_PER_SAMPLE`); at 0
+    /// the rest of this feed plan sees only the slopes, and the plan is refused.
+    work: &'a Cell<u64>,
 }
 
 impl<'a> Constraints<'a> {
@@ -140,6 +158,7 @@ impl<'a> Constraints<'a> {
         filter: (usize, usize, f64),
         scales: (&'a [f64], &'a [f64]),
         top_speed: &'a [Cell<f64>],
+        work: &'a Cell<u64>,
     ) -> Self {
         let (m1, m2, ts) = filter;
         let count = path.s.len();
@@ -173,6 +192,7 @@ impl<'a> Constraints<'a> {
             accel_scale: scales.1,
             top_speed,
             last_bends: Cell::new(None),
+            work,
         }
     }
 
@@ -247,9 +267,10 @@ impl<'a> Constraints<'a> {
             greatest: Joints::zeros(),
             curvature: 0.0,
         };
-        if n == 0 || n > last || l1.is_nan() || l1 <= 0.0 || l2 <= 0.0 {
+        if n == 0 || n > last || l1.is_nan() || l1 <= 0.0 || l2 <= 0.0 || self.work.get() == 0 {
             return bends;
         }
+        self.work.set(self.work.get() - 1);
         let (a, b) = (0.5 * l1, 0.5 * l2);
         let (centre, area) = (self.path.s[n], l1 * l2);
         for place in [0.0, a - b, b - a, a + b, -a - b] {
@@ -475,6 +496,19 @@ impl Plan {
         let mut speed_scale = vec![1.0; path.s.len()];
         let mut accel_scale = vec![1.0; path.s.len()];
         let unknown = || vec![Cell::new(f64::NAN); path.s.len()];
+        let work = Cell::new(WORK_PER_SAMPLE.saturating_mul(sample_budget()));
+        let worked = |feed: FeedProfile| -> Result<FeedProfile, PathError> {
+            if work.get() == 0 {
+                return Err(PathError::invalid(format!(
+                    "planning this path needs more than {} evaluations of the limits ({} \
+                     per sample of the {} a plan may have)",
+                    WORK_PER_SAMPLE.saturating_mul(sample_budget()),
+                    WORK_PER_SAMPLE,
+                    sample_budget()
+                )));
+            }
+            Ok(feed)
+        };
         let optimum_with = |first: usize| -> Result<f64, PathError> {
             let top_speed = unknown();
             let constraints = Constraints::new(
@@ -484,21 +518,37 @@ impl Plan {
                 (first, 0, ts),
                 (&speed_scale, &accel_scale),
                 &top_speed,
+                &work,
             );
-            Ok(FeedProfile::plan(&constraints)?.duration())
+            Ok(worked(FeedProfile::plan(&constraints)?)?.duration())
         };
-        let optimum = optimum_with(1)?;
-        let relaxed_optimum = optimum_with(filter.0)?;
+        // Both optima are lower bounds of the plan's duration: a plan they already put
+        // beyond the budget is refused before any round.
+        let within_budget = |duration: f64| -> Result<f64, PathError> {
+            let samples = (duration / ts).ceil() + (filter.0 + filter.1) as f64;
+            if samples.is_nan() || samples > sample_budget() as f64 {
+                return Err(PathError::invalid(format!(
+                    "the planned reference takes at least {duration:.0} s: more than the {} \
+                     samples a plan may have",
+                    sample_budget()
+                )));
+            }
+            Ok(duration)
+        };
+        let optimum = within_budget(optimum_with(1)?)?;
+        let relaxed_optimum = within_budget(optimum_with(filter.0)?)?;
         let top_speed = unknown();
+        let mut measured = 0u64;
         for round in 1..=ROUNDS {
-            let feed = FeedProfile::plan(&Constraints::new(
+            let feed = worked(FeedProfile::plan(&Constraints::new(
                 &path,
                 joints,
                 limits,
                 (filter.0, filter.1, ts),
                 (&speed_scale, &accel_scale),
                 &top_speed,
-            ))?;
+                &work,
+            ))?)?;
             let raw = (feed.duration() / ts).ceil();
             let budget = sample_budget();
             if raw.is_nan() || raw + (filter.0 + filter.1) as f64 > budget as f64 {
@@ -518,6 +568,15 @@ impl Plan {
                 filter,
                 report: PlanReport::default(),
             };
+            measured = measured.saturating_add(plan.samples);
+            if measured > MEASURED_BUDGETS * budget {
+                return Err(PathError::invalid(format!(
+                    "no feed found within the limits after {} plans of up to {} samples \
+                     ({MEASURED_BUDGETS} times the {budget} samples a plan may have)",
+                    round - 1,
+                    plan.samples
+                )));
+            }
             let (report, slow) = plan.measure(joints, limits);
             if slow.is_empty() {
                 plan.report = PlanReport {
@@ -814,6 +873,28 @@ pub struct PlanInputs {
 /// again.
 static PLANS: Mutex<Vec<(u64, Weak<Plan>)>> = Mutex::new(Vec::new());
 
+/// The plans used last, kept alive after their instances let go of them: restoring a
+/// state checks it (a plan made and dropped) and then takes it (the same plan again), and
+/// an importer that rolls back between states of two plans would plan each time.
+static RECENT: Mutex<[Option<Arc<Plan>>; RECENT_PLANS]> = Mutex::new([None, None]);
+const RECENT_PLANS: usize = 2;
+/// Larger plans are not kept beyond their instances (about 120 bytes a node).
+const RECENT_NODES: usize = 200_000;
+
+/// Puts `plan` first among the recent plans.
+fn remember(plan: &Arc<Plan>) {
+    if plan.path.s.len() > RECENT_NODES {
+        return;
+    }
+    let mut recent = RECENT.lock().unwrap_or_else(|e| e.into_inner());
+    let at = recent
+        .iter()
+        .position(|p| p.as_ref().is_some_and(|p| Arc::ptr_eq(p, plan)))
+        .unwrap_or(RECENT_PLANS - 1);
+    recent[..=at].rotate_right(1);
+    recent[0] = Some(Arc::clone(plan));
+}
+
 fn fingerprint(inputs: &PlanInputs) -> u64 {
     use std::hash::{Hash, Hasher};
     let mut hasher = std::hash::DefaultHasher::new();
@@ -845,6 +926,8 @@ pub fn plan_for(
             .find(|(k, _)| *k == key)
             .and_then(|(_, p)| p.upgrade())
         {
+            drop(plans);
+            remember(&plan);
             return Ok(plan);
         }
     }
@@ -861,6 +944,7 @@ pub fn plan_for(
         .lock()
         .unwrap_or_else(|e| e.into_inner())
         .push((key, Arc::downgrade(&plan)));
+    remember(&plan);
     Ok(plan)
 }
 
