@@ -1,15 +1,19 @@
-//! `contour-eval`: the offline five-axis contour-error evaluation (docs/design/five-axis.md §5.3a).
-//! Reads a reference (CL file, two-curve JSON or built-in) and a measured run (CSV of
-//! joints), maps every sample to a reference segment with the windowed Viterbi decoder,
-//! and writes the per-sample foot-point errors and, on request, the per-reference-point
-//! evaluation-function estimates and a PNG plot.
+//! `contour-eval`: the offline contour-error evaluation of a measured run.
+//!
+//! The run's columns say what it is ([`measured`]). A five-axis run (docs/design/five-axis.md
+//! §5.3a): a reference (CL file, two-curve JSON or built-in) and a CSV of joints; every
+//! sample is mapped to a reference segment with the windowed Viterbi decoder, and the
+//! per-sample foot-point errors and, on request, the per-reference-point
+//! evaluation-function estimates and a PNG plot are written. A run of the XY table
+//! ([`planar`], [`planar_run`]): a path (G-code, NURBS JSON or built-in) and a CSV of X, Y;
+//! every sample's signed distance to the programmed and to the planned contour.
 //!
 //! Outputs are written beside their targets under a temporary name and renamed into
-//! place only when everything succeeded: a failed run leaves existing files as they were.
+//! place only when everything succeeded ([`staged`]): a failed run leaves existing files
+//! as they were.
 
-use std::fs::File;
-use std::io::{BufRead, BufReader, BufWriter, IsTerminal, Write};
-use std::path::{Path, PathBuf};
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -19,9 +23,18 @@ use contour_core::contour::five_axis::run_evaluation::{
 };
 use contour_core::geometry::{self, Vector};
 use contour_core::kinematics::{Joints, Pose, TableTiltingAc};
-use contour_core::path::load_poses;
 
+use measured::{Kind, Samples};
+use planar_run::PlanarOptions;
+use reference::Reference;
+use staged::{commit, Staged};
+
+mod measured;
+mod planar;
+mod planar_run;
 mod plot;
+mod reference;
+mod staged;
 
 const USAGE: &str = "\
 usage: contour-eval --path PART.cl|PART.apt|PART.json|tilted_helix|figure_eight
@@ -29,9 +42,14 @@ usage: contour-eval --path PART.cl|PART.apt|PART.json|tilted_helix|figure_eight
                     [--plot ERR.png] [--tool-length 100] [--pivot-a Y,Z] [--pivot-c X,Y]
                     [--max-skip K] [--angle-weight 0.1] [--window W]
                     [--reference straight|smooth]
+       contour-eval --path PART.ngc|NURBS.json|line|arc|circle|infinity|trident
+                    --measured RUN.csv --out ERR.csv [--tolerance P] [--plot ERR.png]
 
-Maps every measured sample to a segment of the reference (HMM, Viterbi) and reports the
-tool-tip and orientation contour errors of a table-tilting A-C machine.
+The run's columns say what it is: time,X,Y,Z,A,C a five-axis run, time,X,Y and none of
+Z, A, C a run of the XY table. A --path of the other kind is refused.
+
+Five axes: maps every measured sample to a segment of the reference (HMM, Viterbi) and
+reports the tool-tip and orientation contour errors of a table-tilting A-C machine.
   RUN.csv   header row with columns time,X,Y,Z,A,C (s, mm, rad) in any order; other
             columns are ignored
   ERR.csv   time,segment,tip,orientation per sample (foot-point errors, mm and rad)
@@ -49,10 +67,30 @@ tool-tip and orientation contour errors of a table-tilting A-C machine.
                  each, as CL data means; 'smooth' a G1 cubic through the points, the
                  axis slerped by its parameter. Either way the tip error is the distance
                  to the nearest point and the orientation error is taken there.
-A JSON reference is sampled into poses with tip chords of at most 0.01 mm.";
+A JSON reference is sampled into poses with tip chords of at most 0.01 mm.
 
-/// Longest tip chord when a JSON reference's curves are sampled into poses, mm.
-const JSON_CHORD: f64 = 0.01;
+XY table: the signed distance (mm, > 0 right of travel, as ContourCCC2D's contourError)
+of every sample to the programmed contour and to the planned one, the sample tracked
+along the path so that a pass that comes back near itself is not confused.
+  RUN.csv   header row with columns time,X,Y (s, mm) in any order, none of Z, A, C;
+            other columns are ignored
+  ERR.csv   time,segment,contour,contour_planned per sample (segment: the program's
+            move, from 0; 0 on a line, an arc or a NURBS)
+  --tolerance  P, mm: the corners of bare G64 (and of the start) blended within P as
+               PathInterpolator2D plans them (its 'tolerance'); default 0: only the
+               program's own G64 P corners are blended";
+
+/// The options that apply to five-axis runs only.
+const FIVE_AXIS_ONLY: [&str; 8] = [
+    "--out-reference",
+    "--tool-length",
+    "--pivot-a",
+    "--pivot-c",
+    "--max-skip",
+    "--angle-weight",
+    "--window",
+    "--reference",
+];
 
 struct Options {
     path: String,
@@ -65,6 +103,10 @@ struct Options {
     /// --max-skip and --window as given (else chosen from the data).
     max_skip: Option<usize>,
     window: Option<usize>,
+    /// --tolerance as given (XY runs only).
+    tolerance: Option<f64>,
+    /// The five-axis-only options given, in order.
+    five_axis_only: Vec<String>,
 }
 
 /// Exit 2: the command line or an input is wrong; exit 1: the run or a write failed.
@@ -103,6 +145,8 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
         settings: defaults,
         max_skip: None,
         window: None,
+        tolerance: None,
+        five_axis_only: Vec::new(),
     };
     let mut it = args.iter();
     while let Some(flag) = it.next() {
@@ -122,8 +166,12 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
                 .parse::<usize>()
                 .map_err(|e| format!("{what} '{value}': {e}"))
         };
+        if FIVE_AXIS_ONLY.contains(&flag.as_str()) {
+            o.five_axis_only.push(flag.clone());
+        }
         match flag.as_str() {
             "--path" => path = Some(value.clone()),
+            "--tolerance" => o.tolerance = Some(number("--tolerance")?),
             "--measured" => measured = Some(PathBuf::from(value)),
             "--out" => out = Some(PathBuf::from(value)),
             "--out-reference" => o.out_reference = Some(PathBuf::from(value)),
@@ -167,111 +215,6 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
     Ok(Some(o))
 }
 
-/// The reference poses named by `--path` (CL warnings to stderr).
-fn load_reference(spec: &str) -> Result<Vec<Pose>, String> {
-    let (poses, warnings) = load_poses(spec, JSON_CHORD).map_err(|e| e.to_string())?;
-    for warning in &warnings {
-        eprintln!("contour-eval: warning: {warning}");
-    }
-    Ok(poses)
-}
-
-/// The measured run: times and joints.
-struct Measured {
-    times: Vec<f64>,
-    joints: Vec<Joints>,
-}
-
-fn read_measured(file: &Path) -> Result<Measured, String> {
-    let name = file.display();
-    let reader = BufReader::new(File::open(file).map_err(|e| format!("{name}: cannot read: {e}"))?);
-    let mut lines = reader.lines();
-    let header = match lines.next() {
-        Some(line) => line.map_err(|e| format!("{name}:1: cannot read: {e}"))?,
-        None => return Err(format!("{name}: empty file, expected a header row")),
-    };
-    let columns: Vec<&str> = header.split(',').map(str::trim).collect();
-    const WANTED: [&str; 6] = ["time", "X", "Y", "Z", "A", "C"];
-    let index = WANTED
-        .iter()
-        .map(|w| {
-            columns.iter().position(|c| c == w).ok_or_else(|| {
-                format!("{name}:1: no column '{w}' in the header (need time,X,Y,Z,A,C)")
-            })
-        })
-        .collect::<Result<Vec<usize>, String>>()?;
-    let needed = index.iter().max().map_or(0, |&i| i + 1);
-    let mut run = Measured {
-        times: Vec::new(),
-        joints: Vec::new(),
-    };
-    let mut values = [0.0; 6];
-    for (number, line) in lines.enumerate() {
-        let at = number + 2;
-        let line = line.map_err(|e| format!("{name}:{at}: cannot read: {e}"))?;
-        if line.trim().is_empty() {
-            continue;
-        }
-        let fields: Vec<&str> = line.split(',').collect();
-        if fields.len() < needed {
-            return Err(format!(
-                "{name}:{at}: {} fields, the header needs at least {needed}",
-                fields.len()
-            ));
-        }
-        for (slot, (&i, w)) in values.iter_mut().zip(index.iter().zip(WANTED)) {
-            let text = fields[i].trim();
-            let v: f64 = text
-                .parse()
-                .map_err(|_| format!("{name}:{at}: column '{w}': '{text}' is not a number"))?;
-            if !v.is_finite() {
-                return Err(format!("{name}:{at}: column '{w}': '{text}' is not finite"));
-            }
-            *slot = v;
-        }
-        run.times.push(values[0]);
-        run.joints.push(Joints::new(
-            values[1], values[2], values[3], values[4], values[5],
-        ));
-    }
-    if run.joints.is_empty() {
-        return Err(format!("{name}: no measured samples after the header"));
-    }
-    Ok(run)
-}
-
-/// An output written under a temporary name beside its target.
-struct Staged {
-    temporary: PathBuf,
-    target: PathBuf,
-}
-
-impl Staged {
-    fn new(target: &Path) -> Staged {
-        let name = target
-            .file_name()
-            .map_or("output".into(), |n| n.to_string_lossy().into_owned());
-        // Same extension at the end: the PNG encoder picks its format from it.
-        let extension = target
-            .extension()
-            .map_or("tmp".into(), |e| e.to_string_lossy().into_owned());
-        let temporary = target.with_file_name(format!(
-            ".{name}.partial-{}.{extension}",
-            std::process::id()
-        ));
-        Staged {
-            temporary,
-            target: target.to_path_buf(),
-        }
-    }
-
-    fn create(&self) -> Result<BufWriter<File>, String> {
-        File::create(&self.temporary)
-            .map(|f| BufWriter::with_capacity(1 << 20, f))
-            .map_err(|e| format!("cannot write {}: {e}", self.target.display()))
-    }
-}
-
 fn write_errors(
     staged: &Staged,
     times: &[f64],
@@ -307,13 +250,58 @@ fn write_reference(
     w.into_inner().map_err(|e| e.into_error())?.sync_all()
 }
 
-fn run(mut o: Options) -> Result<(), Failure> {
+/// Reads the run, then the reference of its kind, and evaluates it.
+fn run(o: Options) -> Result<(), Failure> {
     let started = Instant::now();
-    let reference = load_reference(&o.path).map_err(Failure::Input)?;
-    let measured = read_measured(&o.measured).map_err(Failure::Input)?;
+    let measured = measured::read(&o.measured).map_err(Failure::Input)?;
+    let kind = match measured.samples {
+        Samples::Planar(_) => Kind::Planar,
+        Samples::FiveAxis(_) => Kind::FiveAxis,
+    };
+    let name = o.measured.display().to_string();
+    // Options of the other kind are a mistake, not something to ignore.
+    let other = match kind {
+        Kind::Planar => o.five_axis_only.first().cloned(),
+        Kind::FiveAxis => o.tolerance.map(|_| "--tolerance".to_string()),
+    };
+    if let Some(flag) = other {
+        return Err(Failure::Input(format!(
+            "{flag} does not apply to {name}: it has {}",
+            kind.columns()
+        )));
+    }
+    let reference = reference::load(&o.path, kind, &name).map_err(Failure::Input)?;
+    match (reference, measured.samples) {
+        (Reference::Planar(path), Samples::Planar(points)) => {
+            let options = PlanarOptions {
+                spec: o.path.clone(),
+                out: o.out.clone(),
+                plot: o.plot.clone(),
+                tolerance: o.tolerance.unwrap_or(0.0),
+            };
+            planar_run::run(&options, path, &measured.times, &points, started)
+        }
+        (Reference::FiveAxis(poses, warnings), Samples::FiveAxis(joints)) => {
+            for warning in &warnings {
+                eprintln!("contour-eval: warning: {warning}");
+            }
+            five_axis(o, &poses, &measured.times, &joints, started)
+        }
+        _ => unreachable!("reference::load reads the reference of the run's kind"),
+    }
+}
+
+/// The five-axis evaluation of `joints` against `reference`.
+fn five_axis(
+    mut o: Options,
+    reference: &[Pose],
+    times: &[f64],
+    joints: &[Joints],
+    started: Instant,
+) -> Result<(), Failure> {
     let max_skip = o
         .max_skip
-        .unwrap_or_else(|| suggested_max_skip(&o.machine, &reference, &measured.joints));
+        .unwrap_or_else(|| suggested_max_skip(&o.machine, reference, joints));
     o.settings.params.max_skip = max_skip;
     // Room for a few moves of K either side of the best segment.
     o.settings.window = o.window.unwrap_or(o.settings.window.max(8 * max_skip));
@@ -330,49 +318,29 @@ fn run(mut o: Options) -> Result<(), Failure> {
     } else {
         bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
-    let result = evaluate_run(
-        &o.machine,
-        &reference,
-        &measured.joints,
-        &o.settings,
-        |done, total| {
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
-        },
-    )
+    let result = evaluate_run(&o.machine, reference, joints, &o.settings, |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })
     .map_err(|e| Failure::Input(e.to_string()))?;
     bar.finish_and_clear();
 
     let mut staged = vec![Staged::new(&o.out)];
-    let mut written = write_errors(&staged[0], &measured.times, &result)
+    let mut written = write_errors(&staged[0], times, &result)
         .map_err(|e| format!("cannot write {}: {e}", o.out.display()));
     if let (Ok(()), Some(target)) = (&written, &o.out_reference) {
         staged.push(Staged::new(target));
-        written = write_reference(&staged[staged.len() - 1], &reference, &result)
+        written = write_reference(&staged[staged.len() - 1], reference, &result)
             .map_err(|e| format!("cannot write {}: {e}", target.display()));
     }
     if let (Ok(()), Some(target)) = (&written, &o.plot) {
         staged.push(Staged::new(target));
-        written = plot::errors_against_time(
-            &staged[staged.len() - 1].temporary,
-            &measured.times,
-            &result.samples,
-        )
-        .map_err(|e| format!("cannot plot {}: {e}", target.display()));
+        written =
+            plot::errors_against_time(&staged[staged.len() - 1].temporary, times, &result.samples)
+                .map_err(|e| format!("cannot plot {}: {e}", target.display()));
     }
     // All or nothing: rename only when every output is complete.
-    let renamed = written.and_then(|()| {
-        staged.iter().try_for_each(|s| {
-            std::fs::rename(&s.temporary, &s.target)
-                .map_err(|e| format!("cannot write {}: {e}", s.target.display()))
-        })
-    });
-    if let Err(message) = renamed {
-        for s in &staged {
-            let _ = std::fs::remove_file(&s.temporary);
-        }
-        return Err(Failure::Run(message));
-    }
+    commit(&staged, written).map_err(Failure::Run)?;
 
     let n = result.samples.len() as f64;
     let (mut tip_max, mut tip_sum, mut rot_max, mut rot_sum) = (0.0f64, 0.0, 0.0f64, 0.0);

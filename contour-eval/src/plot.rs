@@ -1,11 +1,15 @@
-//! `--plot`: tip and orientation errors against time as a PNG, one panel each. Long runs
-//! are drawn as their per-pixel-column envelope (min and max of each bucket), so a
-//! million samples cost no more to draw than two thousand.
+//! `--plot`: a five-axis run's tip and orientation errors against time as a PNG, one
+//! panel each; an XY run's contour errors to the programmed and the planned contour,
+//! against time and along the path. Long runs are drawn as their per-pixel-column
+//! envelope (min and max of each bucket), so a million samples cost no more to draw than
+//! two thousand.
 
 use std::path::Path;
 
 use contour_core::contour::five_axis::run_evaluation::SampleContourError;
 use plotters::prelude::*;
+
+use crate::planar::PlanarSample;
 
 /// Buckets across the plot (about one per pixel column).
 const BUCKETS: usize = 2000;
@@ -44,14 +48,18 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     }
 }
 
+fn register_font() -> Result<(), String> {
+    plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
+        .map_err(|_| "the embedded font cannot be read".to_string())
+}
+
 /// Draws the errors (µm and µrad) against time into `file` (PNG by its extension).
 pub fn errors_against_time(
     file: &Path,
     times: &[f64],
     samples: &[SampleContourError],
 ) -> Result<(), String> {
-    plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
-        .map_err(|_| "the embedded font cannot be read".to_string())?;
+    register_font()?;
     let fail = |e: &dyn std::fmt::Display| e.to_string();
     let root = BitMapBackend::new(file, (1200, 800)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| fail(&e))?;
@@ -95,6 +103,72 @@ pub fn errors_against_time(
             .map_err(|e| fail(&e))?;
         chart
             .draw_series(LineSeries::new(envelope(times, value), colour))
+            .map_err(|e| fail(&e))?;
+    }
+    root.present().map_err(|e| fail(&e))?;
+    Ok(())
+}
+
+/// Draws an XY run's signed contour errors (µm) to the programmed and the planned
+/// contour into `file` (PNG by its extension): against time above, against the position
+/// along the programmed path below.
+pub fn contour_errors(file: &Path, times: &[f64], samples: &[PlanarSample]) -> Result<(), String> {
+    register_font()?;
+    let fail = |e: &dyn std::fmt::Display| e.to_string();
+    let root = BitMapBackend::new(file, (1200, 800)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let panels = root.split_evenly((2, 1));
+    let along: Vec<f64> = samples.iter().map(|s| s.along).collect();
+    let programmed = |k: usize| 1e3 * samples[k].contour;
+    let planned = |k: usize| 1e3 * samples[k].planned;
+    let (lo, hi) = range((0..samples.len()).flat_map(|k| [programmed(k), planned(k)]));
+    let pad = 0.05 * (hi - lo);
+    let axes = [
+        ("contour error against time", "time (s)", times, &panels[0]),
+        (
+            "contour error along the path",
+            "position along the programmed path (mm)",
+            &along[..],
+            &panels[1],
+        ),
+    ];
+    for (caption, x_label, xs, area) in axes {
+        let (x0, x1) = range(xs.iter().copied());
+        let mut chart = ChartBuilder::on(area)
+            .caption(caption, ("sans-serif", 22))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, lo - pad..hi + pad)
+            .map_err(|e| fail(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc("contour error (um), > 0 right of travel")
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(|e| fail(&e))?;
+        // The planned contour first: where they agree the programmed one is on top.
+        for (name, colour, value) in [
+            (
+                "to the planned contour",
+                RED,
+                &planned as &dyn Fn(usize) -> f64,
+            ),
+            ("to the programmed contour", BLUE, &programmed),
+        ] {
+            chart
+                .draw_series(LineSeries::new(envelope(xs, value), colour))
+                .map_err(|e| fail(&e))?
+                .label(name)
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .draw()
             .map_err(|e| fail(&e))?;
     }
     root.present().map_err(|e| fail(&e))?;

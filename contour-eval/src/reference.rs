@@ -1,0 +1,147 @@
+//! What `--path` names, read for the kind of run the measured columns say it is: a path
+//! of the XY table (a G-code program, a NURBS JSON file, a built-in of
+//! [`builtin::NAMES`]) or a five-axis reference (a CL file, a two-curve JSON file, a
+//! built-in of [`BUILTIN_TOOL_PATHS`]). A built-in name in both lists is read as the
+//! columns say; a path of the other kind is refused, naming both.
+
+use contour_core::kinematics::Pose;
+use contour_core::path::program::is_program_file;
+use contour_core::path::{builtin, load_poses, Path, ToolPath, BUILTIN_TOOL_PATHS};
+
+use crate::measured::Kind;
+
+/// Longest tip chord when a five-axis JSON reference's curves are sampled into poses, mm.
+const JSON_CHORD: f64 = 0.01;
+
+/// A reference of the run's kind.
+pub enum Reference {
+    Planar(Path),
+    /// The poses and the CL reader's warnings.
+    FiveAxis(Vec<Pose>, Vec<String>),
+}
+
+/// The kind a built-in name belongs to; a name in both lists is the run's `columns`.
+fn builtin_kind(spec: &str, columns: Kind, planar: &[&str], five_axis: &[&str]) -> Option<Kind> {
+    // As the readers compare: the XY table's names case-insensitively and trimmed.
+    let in_planar = planar.iter().any(|n| n.eq_ignore_ascii_case(spec.trim()));
+    let in_five_axis = five_axis.contains(&spec);
+    match (in_planar, in_five_axis) {
+        (true, true) => Some(columns),
+        (true, false) => Some(Kind::Planar),
+        (false, true) => Some(Kind::FiveAxis),
+        (false, false) => None,
+    }
+}
+
+/// The kind a file name says by its ending alone (a `.json` file can be either).
+fn file_kind(spec: &str) -> Option<Kind> {
+    let lower = spec.to_ascii_lowercase();
+    if lower.ends_with(".cl") || lower.ends_with(".apt") {
+        Some(Kind::FiveAxis)
+    } else if is_program_file(std::path::Path::new(spec)) {
+        Some(Kind::Planar)
+    } else {
+        None
+    }
+}
+
+fn what(kind: Kind) -> &'static str {
+    match kind {
+        Kind::Planar => "a path of the XY table",
+        Kind::FiveAxis => "a five-axis reference",
+    }
+}
+
+fn mismatch(spec: &str, path: Kind, measured: &str, columns: Kind) -> String {
+    format!(
+        "--path {spec} is {} but {measured} has {}: evaluate it with a run of {}",
+        what(path),
+        columns.columns(),
+        match path {
+            Kind::Planar => "the XY table (time,X,Y)",
+            Kind::FiveAxis => "five axes (time,X,Y,Z,A,C)",
+        }
+    )
+}
+
+fn planar(spec: &str) -> Result<Path, String> {
+    Path::from_spec(spec, None).map_err(|e| e.to_string())
+}
+
+fn five_axis(spec: &str) -> Result<Reference, String> {
+    load_poses(spec, JSON_CHORD)
+        .map(|(poses, warnings)| Reference::FiveAxis(poses, warnings))
+        .map_err(|e| e.to_string())
+}
+
+/// The reference `spec` names, read for a run of `columns` (the file `measured`, named
+/// in messages). Errors are the readers' own, or a mismatch naming both kinds.
+pub fn load(spec: &str, columns: Kind, measured: &str) -> Result<Reference, String> {
+    let by_name = builtin_kind(spec, columns, &builtin::NAMES, &BUILTIN_TOOL_PATHS);
+    if let Some(kind) = by_name.or_else(|| file_kind(spec)) {
+        if kind != columns {
+            return Err(mismatch(spec, kind, measured, columns));
+        }
+    }
+    // A JSON file the run's kind cannot read may be one of the other kind.
+    let json = spec.to_ascii_lowercase().ends_with(".json");
+    match columns {
+        Kind::Planar => planar(spec).map(Reference::Planar).map_err(|e| {
+            if json && ToolPath::load(spec).is_ok() {
+                mismatch(spec, Kind::FiveAxis, measured, columns)
+            } else {
+                e
+            }
+        }),
+        Kind::FiveAxis => five_axis(spec).map_err(|e| {
+            if json && planar(spec).is_ok() {
+                mismatch(spec, Kind::Planar, measured, columns)
+            } else {
+                e
+            }
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_name_in_both_lists_is_read_as_the_columns_say() {
+        let (planar, five) = (["line", "both"], ["both", "helix"]);
+        for columns in [Kind::Planar, Kind::FiveAxis] {
+            let kind = |name: &str| builtin_kind(name, columns, &planar, &five);
+            assert_eq!(kind("both"), Some(columns));
+            assert_eq!(kind("line"), Some(Kind::Planar));
+            assert_eq!(kind(" LINE "), Some(Kind::Planar));
+            assert_eq!(kind("helix"), Some(Kind::FiveAxis));
+            assert_eq!(kind("part.ngc"), None);
+        }
+    }
+
+    #[test]
+    fn the_shipped_names_are_in_one_list_each() {
+        for name in builtin::NAMES {
+            assert_eq!(
+                builtin_kind(name, Kind::FiveAxis, &builtin::NAMES, &BUILTIN_TOOL_PATHS),
+                Some(Kind::Planar)
+            );
+        }
+        for name in BUILTIN_TOOL_PATHS {
+            assert_eq!(
+                builtin_kind(name, Kind::Planar, &builtin::NAMES, &BUILTIN_TOOL_PATHS),
+                Some(Kind::FiveAxis)
+            );
+        }
+    }
+
+    #[test]
+    fn file_endings_say_the_kind() {
+        assert_eq!(file_kind("a/part.NGC"), Some(Kind::Planar));
+        assert_eq!(file_kind("part.tap"), Some(Kind::Planar));
+        assert_eq!(file_kind("blade.cl"), Some(Kind::FiveAxis));
+        assert_eq!(file_kind("blade.APT"), Some(Kind::FiveAxis));
+        assert_eq!(file_kind("curve.json"), None);
+    }
+}
