@@ -14,6 +14,10 @@ fitness histories (standard vs improved, like the paper's Figures 10 and 13), an
 cross-check files of ContourCCC2D (out/cross-check/ContourCCC2D/: _in.csv, _ref.csv,
 _ref.opt) from the fuzzy circle run.
 
+Then the part demo (contour_fmu.part_demo): the G-code part examples/parts/bracket.ngc
+planned within acceleration and jerk limits, without and with the CCC, on the part and on
+its mirror image; a table, CSVs and out/part_bracket.png. Then the five-axis demo.
+
 usage: python -m contour_fmu.demo [--fmu-dir DIR] [--out DIR]
                                   [--tune | --params tuned.json] [--ccc-tune PROGRAM]
 
@@ -34,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import five_axis_demo, repo
+from . import five_axis_demo, part_demo, repo
 from .extras import needs
 from .master import closed_loop
 from .output_files import write_csv
@@ -233,6 +237,12 @@ def main(argv=None, prog="python -m contour_fmu.demo"):
     for path, feed, label, emax, emean, mmax, mmean, rmax, rmean in rows:
         print(f"{path:9} {feed:9.2f}  {label:15} {emax * 1e3:8.3f} {emean * 1e3:8.3f} {mmax * 1e3:9.3f} "
               f"{mmean * 1e3:9.3f} {rmax:10.1f} {rmean:11.1f}")
+    print()
+    program = part_demo.default_program()
+    if program is None:
+        print(f"the part demo skipped: no checkout holds {part_demo.PROGRAM.as_posix()}")
+    else:
+        part_demo.print_table(part_demo.part_demo(args.fmu_dir, args.out, program))
     print()
     five_axis_rows = five_axis_demo.main(args.fmu_dir, args.out)
     five_axis_demo.print_table(five_axis_rows)
