@@ -115,15 +115,21 @@ fn move_true_error(program: &Program, i: usize, p: Vector2, span: Span) -> TrueE
     e
 }
 
-/// Samples over a corner blend's span before the refinement.
+/// Samples over a right-angle corner blend's span before the refinement; a blend that
+/// turns less gets as many per radian (at least 2), one that turns more no more.
 const BLEND_SAMPLES: usize = 8;
 
 /// Exact distance to the part `span` of a corner blend: the best of its samples, then
 /// safeguarded Newton in the bracket around it (a blend is short and turns by less than
-/// π: one minimum near the path).
+/// π: one minimum near the path). The samples are no farther apart in turn than a right
+/// angle's eight: a blend of a small turn, nearly straight, needs few (most of the
+/// corners of a program of short lines, where the nearest point costs mostly these).
 fn blend_error_within(b: &CornerBlend, p: Vector2, (t0, t1): Span) -> TrueError {
-    let at = |k: usize| t0 + (t1 - t0) * k as f64 / BLEND_SAMPLES as f64;
-    let nearest = (0..=BLEND_SAMPLES)
+    let samples = ((BLEND_SAMPLES as f64 * b.turn().abs() / std::f64::consts::FRAC_PI_2).ceil()
+        as usize)
+        .clamp(2, BLEND_SAMPLES);
+    let at = |k: usize| t0 + (t1 - t0) * k as f64 / samples as f64;
+    let nearest = (0..=samples)
         .min_by(|&i, &j| {
             let (di, dj) = (
                 geometry::dist2(&b.point(at(i)), &p),
@@ -134,7 +140,7 @@ fn blend_error_within(b: &CornerBlend, p: Vector2, (t0, t1): Span) -> TrueError 
         .unwrap_or(0);
     let (lo, hi) = (
         at(nearest.saturating_sub(1)),
-        at((nearest + 1).min(BLEND_SAMPLES)),
+        at((nearest + 1).min(samples)),
     );
     let (_, u) = refine(b, p, lo, hi, at(nearest));
     let mut e = finish(b, p, u);
@@ -161,6 +167,26 @@ fn arc_box(a: &CircularArc) -> BBox {
     // Rounding in the extreme points' sines: a nanometre of margin.
     let m = 1e-9 * (1.0 + a.radius());
     [b[0] - m, b[1] - m, b[2] + m, b[3] + m]
+}
+
+/// The squared distance from `p` to the triangle `t` (0 inside it).
+fn triangle_dist2(p: Vector2, t: [Vector2; 3]) -> f64 {
+    let side = |a: Vector2, b: Vector2| geometry::cross(&(b - a), &(p - a));
+    let (s0, s1, s2) = (side(t[0], t[1]), side(t[1], t[2]), side(t[2], t[0]));
+    if (s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0) || (s0 <= 0.0 && s1 <= 0.0 && s2 <= 0.0) {
+        return 0.0;
+    }
+    let edge = |a: Vector2, b: Vector2| {
+        let d = b - a;
+        let length2 = d.dot(&d);
+        let f = if length2 > 0.0 {
+            ((p - a).dot(&d) / length2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        geometry::dist2(&(a + d * f), &p)
+    };
+    edge(t[0], t[1]).min(edge(t[1], t[2])).min(edge(t[2], t[0]))
 }
 
 fn point_box(q: Vector2) -> BBox {
@@ -522,7 +548,7 @@ impl TrueErrorIndex {
             }
             if node >= self.leaves {
                 let i = node - self.leaves;
-                if i != first {
+                if i != first && self.hull_dist2(i, p) <= best2 {
                     let r = self.chunk_min(i, p, from, to);
                     if r.0 < best.0 || r.0 == best.0 && i < best_chunk {
                         best = r;
@@ -555,13 +581,22 @@ impl TrueErrorIndex {
     ) -> Option<(usize, TrueError)> {
         let start = self.chunks_between(from, f64::INFINITY).start;
         let limit = tolerance * tolerance;
+        // The first chunk in path order, where a point that moves on along the path (the
+        // reference) mostly still is: found there, the tree is not searched.
+        let found = self.chunk_min(start, p, from, f64::INFINITY);
+        if found.0 <= tolerance {
+            return Some((start, self.result(found, p)));
+        }
         let mut pending = Pending::root();
         while let Some(node) = pending.pop() {
-            if self.leaves_of(node).end <= start || box_dist2(&self.tree[node], p) > limit {
+            if self.leaves_of(node).end <= start + 1 || box_dist2(&self.tree[node], p) > limit {
                 continue;
             }
             if node >= self.leaves {
                 let i = node - self.leaves;
+                if self.hull_dist2(i, p) > limit {
+                    continue;
+                }
                 let found = self.chunk_min(i, p, from, f64::INFINITY);
                 if found.0 <= tolerance {
                     return Some((i, self.result(found, p)));
@@ -679,6 +714,23 @@ impl TrueErrorIndex {
     /// Minimum distance over chunk `i` between the arc lengths `from` and `to`, and its
     /// parameter: exact on a move, a line or an arc; on a NURBS the best of the chunk's
     /// samples, then Newton in the bracket.
+    /// A lower bound of the squared distance from `p` to chunk `i` tighter than its box
+    /// where that pays: a corner blend lies in the triangle of its ends and the vertex,
+    /// and solving it costs a few dozen Fresnel sums (0 for every other chunk).
+    fn hull_dist2(&self, i: usize, p: Vector2) -> f64 {
+        let Path::Program(program) = &self.path else {
+            return 0.0;
+        };
+        let Shape::Blend(b) = &program.moves()[i].shape else {
+            return 0.0;
+        };
+        let [a, v, c] = b.hull();
+        // Rounding in the Fresnel sums: a nanometre of margin, as on the box.
+        let margin = 1e-9 * (1.0 + v.amax());
+        let d = (triangle_dist2(p, [a, v, c]).sqrt() - margin).max(0.0);
+        d * d
+    }
+
     fn chunk_min(&self, i: usize, p: Vector2, from: f64, to: f64) -> ChunkMin {
         let e = match &self.path {
             Path::Program(program) => move_true_error(program, i, p, self.move_span(i, from, to)),

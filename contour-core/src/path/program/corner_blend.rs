@@ -14,6 +14,7 @@ use crate::path::{Curve, CurvePoint, PathError};
 
 /// Two clothoids, each `half` long, turning by `turn` together.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(from = "SavedBlend", into = "SavedBlend")]
 pub struct CornerBlend {
     /// Where the blend leaves the incoming line.
     start: Vector2,
@@ -27,31 +28,75 @@ pub struct CornerBlend {
     /// Distance from the vertex to either end, mm (a function of the above, kept so that
     /// a point on the second clothoid costs one Fresnel sum).
     trim: f64,
+    /// The outgoing line's unit direction (`incoming` turned by `turn`, not saved: a
+    /// point on the second clothoid needs it, and its sine and cosine cost as much as
+    /// the Fresnel sum).
+    outgoing: Vector2,
 }
 
-/// ∫₀ˣ cos(w²) dw and ∫₀ˣ sin(w²) dw by their power series (|x| ≤ 1.3: 12 terms reach
-/// the last bit).
+/// What a [`CornerBlend`] saves: the values it is made of.
+#[derive(Serialize, Deserialize)]
+struct SavedBlend {
+    start: Vector2,
+    incoming: Vector2,
+    turn: f64,
+    half: f64,
+    trim: f64,
+}
+
+impl From<SavedBlend> for CornerBlend {
+    fn from(b: SavedBlend) -> Self {
+        CornerBlend::from_parts(b.start, b.incoming, b.turn, b.half, b.trim)
+    }
+}
+
+impl From<CornerBlend> for SavedBlend {
+    fn from(b: CornerBlend) -> Self {
+        SavedBlend {
+            start: b.start,
+            incoming: b.incoming,
+            turn: b.turn,
+            half: b.half,
+            trim: b.trim,
+        }
+    }
+}
+
+/// Terms of the Fresnel series kept: at |x| ≤ √(π/2) the first left out is below 10⁻¹⁸
+/// of the sum.
+const FRESNEL_TERMS: usize = 12;
+
+/// The series' coefficients in powers of x⁴: (−1)ⁿ / ((4n+1)(2n)!) for the cosine
+/// integral (times x) and (−1)ⁿ / ((4n+3)(2n+1)!) for the sine integral (times x³).
+const FRESNEL_COEFFICIENTS: ([f64; FRESNEL_TERMS], [f64; FRESNEL_TERMS]) = {
+    let (mut c, mut s) = ([0.0; FRESNEL_TERMS], [0.0; FRESNEL_TERMS]);
+    // (2n)! as it grows; exact in f64 up to 22!.
+    let mut factorial = 1.0;
+    let mut n = 0;
+    while n < FRESNEL_TERMS {
+        let k = n as f64;
+        let sign = if n % 2 == 0 { 1.0 } else { -1.0 };
+        c[n] = sign / ((4.0 * k + 1.0) * factorial);
+        s[n] = sign / ((4.0 * k + 3.0) * factorial * (2.0 * k + 1.0));
+        factorial *= (2.0 * k + 1.0) * (2.0 * k + 2.0);
+        n += 1;
+    }
+    (c, s)
+};
+
+/// ∫₀ˣ cos(w²) dw and ∫₀ˣ sin(w²) dw by their power series in Horner's form (|x| ≤
+/// √(π/2) here, where 12 terms reach the last bit): no division, no branch, since a blend's
+/// nearest point evaluates it a few dozen times a sample.
 fn fresnel(x: f64) -> (f64, f64) {
     let x2 = x * x;
     let x4 = x2 * x2;
+    let (cs, ss) = &FRESNEL_COEFFICIENTS;
     let (mut c, mut s) = (0.0, 0.0);
-    // Term n: (−1)ⁿ x^(4n+1) / ((4n+1)(2n)!) and (−1)ⁿ x^(4n+3) / ((4n+3)(2n+1)!).
-    let mut power = x;
-    let mut factorial = 1.0;
-    for n in 0..30 {
-        let k = n as f64;
-        let sign = if n % 2 == 0 { 1.0 } else { -1.0 };
-        let tc = sign * power / ((4.0 * k + 1.0) * factorial);
-        let ts = sign * power * x2 / ((4.0 * k + 3.0) * factorial * (2.0 * k + 1.0));
-        c += tc;
-        s += ts;
-        if tc.abs() <= 1e-18 * c.abs() && ts.abs() <= 1e-18 * s.abs().max(f64::MIN_POSITIVE) {
-            break;
-        }
-        power *= x4;
-        factorial *= (2.0 * k + 1.0) * (2.0 * k + 2.0);
+    for n in (0..FRESNEL_TERMS).rev() {
+        c = c * x4 + cs[n];
+        s = s * x4 + ss[n];
     }
-    (c, s)
+    (x * c, x * x2 * s)
 }
 
 /// The left unit normal.
@@ -60,6 +105,23 @@ fn left(t: Vector2) -> Vector2 {
 }
 
 impl CornerBlend {
+    /// The blend of its parts, with the outgoing direction they give.
+    fn from_parts(start: Vector2, incoming: Vector2, turn: f64, half: f64, trim: f64) -> Self {
+        let (sin, cos) = turn.sin_cos();
+        let outgoing = Vector2::new(
+            incoming[0] * cos - incoming[1] * sin,
+            incoming[0] * sin + incoming[1] * cos,
+        );
+        CornerBlend {
+            start,
+            incoming,
+            turn,
+            half,
+            trim,
+            outgoing,
+        }
+    }
+
     /// The blend of a corner at `vertex` from unit direction `incoming` to `outgoing`,
     /// leaving the two lines by at most `tolerance` and starting no more than `reach`
     /// before the vertex (it ends as far after it). `None` for a turn it cannot round
@@ -76,13 +138,8 @@ impl CornerBlend {
             return None;
         }
         // A unit-length half: its end's offsets along and across the incoming line.
-        let unit = CornerBlend {
-            start: Vector2::zeros(),
-            incoming: Vector2::new(1.0, 0.0),
-            turn,
-            half: 1.0,
-            trim: 0.0,
-        };
+        let unit =
+            CornerBlend::from_parts(Vector2::zeros(), Vector2::new(1.0, 0.0), turn, 1.0, 0.0);
         let (along, across) = unit.first_half(1.0);
         let across = across.abs();
         let beta = 0.5 * turn.abs();
@@ -92,13 +149,13 @@ impl CornerBlend {
         if !(half.is_finite() && half > 0.0) {
             return None;
         }
-        let blend = CornerBlend {
-            start: vertex - incoming * (trim * half),
+        let blend = CornerBlend::from_parts(
+            vertex - incoming * (trim * half),
             incoming,
             turn,
             half,
-            trim: trim * half,
-        };
+            trim * half,
+        );
         Some((blend, trim * half))
     }
 
@@ -141,8 +198,13 @@ impl CornerBlend {
         [
             self.start,
             self.start + self.incoming * self.trim,
-            self.point(1.0),
+            self.end(),
         ]
+    }
+
+    /// Where the blend joins the outgoing line (exactly its point at u = 1).
+    fn end(&self) -> Vector2 {
+        self.start + (self.incoming + self.outgoing) * self.trim
     }
 
     /// The trim the other values make: the first clothoid's end offsets, the middle on the
@@ -154,13 +216,13 @@ impl CornerBlend {
 
     /// The blend mirrored about the x axis (y → −y), travelled the mirrored way.
     pub fn mirrored(&self) -> CornerBlend {
-        CornerBlend {
-            start: Vector2::new(self.start[0], -self.start[1]),
-            incoming: Vector2::new(self.incoming[0], -self.incoming[1]),
-            turn: -self.turn,
-            half: self.half,
-            trim: self.trim,
-        }
+        CornerBlend::from_parts(
+            Vector2::new(self.start[0], -self.start[1]),
+            Vector2::new(self.incoming[0], -self.incoming[1]),
+            -self.turn,
+            self.half,
+            self.trim,
+        )
     }
 
     /// The first clothoid's point at arc length `s` ≤ `half` in the incoming frame:
@@ -171,6 +233,20 @@ impl CornerBlend {
         let scale = a * std::f64::consts::SQRT_2;
         let (c, s) = fresnel(s / scale);
         (scale * c, scale * s * self.turn.signum())
+    }
+
+    /// The point at arc length `s` from the start (what [`Curve::point`] asks, without
+    /// the tangent and the curvature).
+    fn point_at(&self, s: f64) -> Vector2 {
+        let h = self.half;
+        if s <= h {
+            let (x, y) = self.first_half(s);
+            self.start + self.incoming * x + left(self.incoming) * y
+        } else {
+            // The second clothoid from the end, backwards: the mirror image of the first.
+            let (x, y) = self.first_half(2.0 * h - s);
+            self.end() - self.outgoing * x + left(self.outgoing) * y
+        }
     }
 
     /// Tangent angle from the incoming direction at arc length `s` from the start.
@@ -192,25 +268,16 @@ impl Curve for CornerBlend {
         (0.0, 1.0)
     }
 
+    fn point(&self, u: f64) -> Vector2 {
+        self.point_at(u.clamp(0.0, 1.0) * 2.0 * self.half)
+    }
+
     fn eval(&self, u: f64) -> CurvePoint {
         let length = 2.0 * self.half;
         let s = u.clamp(0.0, 1.0) * length;
         let h = self.half;
         let n1 = left(self.incoming);
-        let p = if s <= h {
-            let (x, y) = self.first_half(s);
-            self.start + self.incoming * x + n1 * y
-        } else {
-            // The second clothoid from the end, backwards: the mirror image of the first.
-            let (sin, cos) = self.turn.sin_cos();
-            let outgoing = Vector2::new(
-                self.incoming[0] * cos - self.incoming[1] * sin,
-                self.incoming[0] * sin + self.incoming[1] * cos,
-            );
-            let end = self.start + (self.incoming + outgoing) * self.trim;
-            let (x, y) = self.first_half(2.0 * h - s);
-            end - outgoing * x + left(outgoing) * y
-        };
+        let p = self.point_at(s);
         let phi = self.angle(s);
         let (sin, cos) = phi.sin_cos();
         let tangent = self.incoming * cos + n1 * sin;
