@@ -3,7 +3,9 @@
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+
+mod common;
+use common::{contour_eval, entries, s};
 
 use contour_core::geometry::{self, Vector};
 use contour_core::kinematics::{Pose, TableTiltingAc};
@@ -27,10 +29,7 @@ fn machine() -> TableTiltingAc {
 const PIVOTS: [&str; 4] = ["--pivot-a", "0,-50", "--pivot-c", "5,-3"];
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("contour-eval-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch("contour-eval", name)
 }
 
 /// Samples of the measured run: 0.4 s, 8 mm of the helix (a debug build evaluates it
@@ -80,17 +79,6 @@ fn displaced_helix_csv() -> (String, Vec<f64>) {
         k += 1;
     }
     (text, us)
-}
-
-fn contour_eval(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_contour-eval"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 fn rows(file: &Path) -> Vec<Vec<String>> {
@@ -224,11 +212,7 @@ fn a_displaced_helix_gives_its_displacement() {
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     assert_eq!(&png[16..24], &[0, 0, 4, 176, 0, 0, 3, 32]);
     // Nothing else left in the folder.
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
+    let names = entries(&dir);
     assert_eq!(names, ["err.csv", "err.png", "ref.csv", "run.csv"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -381,11 +365,7 @@ fn bad_inputs_fail_naming_the_cause_and_write_nothing() {
         &["--pivot-a needs two"],
     );
     // Only the inputs and the untouched output remain: no temporary files.
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
+    let names = entries(&dir);
     assert_eq!(
         names,
         ["empty.cl", "good.csv", "nan.csv", "no_a.csv", "out.csv", "word.csv"]

@@ -5,8 +5,10 @@
 
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+
+mod common;
+use common::{contour_eval, entries, s};
 
 use contour_core::contour::planar::true_error;
 use contour_core::path::plan::planned_geometry;
@@ -14,22 +16,8 @@ use contour_core::path::Path as CorePath;
 
 type P2 = [f64; 2];
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("contour-eval-xy-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn contour_eval(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_contour-eval"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
+fn scratch(name: &str) -> std::path::PathBuf {
+    common::scratch("contour-eval-xy", name)
 }
 
 /// One expected sample: the measured point, the signed contour error (> 0 right of
@@ -40,6 +28,25 @@ struct Expected {
     point: P2,
     contour: f64,
     segments: Vec<usize>,
+}
+
+/// A row against its expected sample: the contour error to 1e-9 mm, the segment one
+/// of those allowed.
+fn assert_sample(k: usize, row: &Row, e: &Expected) {
+    assert!(
+        (row.contour - e.contour).abs() < 1e-9,
+        "sample {k} at {:?}: {} vs {}",
+        e.point,
+        row.contour,
+        e.contour
+    );
+    assert!(
+        e.segments.contains(&row.segment),
+        "sample {k} at {:?}: segment {} vs {:?}",
+        e.point,
+        row.segment,
+        e.segments
+    );
 }
 
 /// The right-hand normal of a direction of travel.
@@ -220,20 +227,7 @@ fn a_program_of_lines_and_arcs_gives_the_signed_distances_of_its_points() {
     let plot = dir.join("err.png");
     let (rows, stdout) = evaluate(&dir, s(&part), &points, &["--plot", s(&plot)]);
     for (k, (row, e)) in rows.iter().zip(&expected).enumerate() {
-        assert!(
-            (row.contour - e.contour).abs() < 1e-9,
-            "sample {k} at {:?}: {} vs {}",
-            e.point,
-            row.contour,
-            e.contour
-        );
-        assert!(
-            e.segments.contains(&row.segment),
-            "sample {k} at {:?}: segment {} vs {:?}",
-            e.point,
-            row.segment,
-            e.segments
-        );
+        assert_sample(k, row, e);
         // No blend asked for and none programmed: the planned contour is the programmed.
         assert_eq!(row.planned, row.contour, "sample {k}");
     }
@@ -449,19 +443,7 @@ fn a_point_nearer_the_outgoing_pass_of_a_slot_is_measured_against_its_own_pass()
     let (rows, _) = evaluate(&dir, s(&part), &points, &[]);
     let mut trapped = 0;
     for (k, (row, e)) in rows.iter().zip(&expected).enumerate() {
-        assert!(
-            (row.contour - e.contour).abs() < 1e-9,
-            "sample {k} at {:?}: {} vs {}",
-            e.point,
-            row.contour,
-            e.contour
-        );
-        assert!(
-            e.segments.contains(&row.segment),
-            "sample {k} at {:?}: {}",
-            e.point,
-            row.segment
-        );
+        assert_sample(k, row, e);
         // Where the outgoing pass is the nearer one.
         if e.segments == [2] && e.point[1].abs() < e.contour.abs() - 1e-9 {
             trapped += 1;
@@ -772,11 +754,7 @@ fn bad_xy_inputs_fail_naming_file_and_line_and_write_nothing() {
         &["unknown option '--speed'"],
     );
     // Nothing but the inputs and the untouched output.
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
+    let names = entries(&dir);
     assert_eq!(
         names,
         [

@@ -55,10 +55,9 @@ STEP = 1e-3
 # feed that keeps the drives' current demand in a realistic range.
 PATHS = [("circle", 10 * math.pi), ("infinity", 50.0), ("trident", 50.0)]
 
-VARIANTS = [
-    ("no CCC", {"ccc.enable": False}),
-    ("fuzzy-PID CCC", {}),  # the FMU's defaults: the paper's fuzzy factors (1, 1.2, 87, 8.5, 4)
-]
+# No CCC and the fuzzy-PID CCC with the FMU's defaults (the paper's fuzzy factors), the
+# part demo's variants too.
+VARIANTS = part_demo.VARIANTS
 
 
 # The tuner scores the maximum error: a part's tolerance band is about the worst point,

@@ -86,7 +86,7 @@ def default_program():
 
 VARIANTS = [
     ("no CCC", {"ccc.enable": False}),
-    ("fuzzy-PID CCC", {}),  # the FMU's defaults: the paper's fuzzy factors
+    ("fuzzy-PID CCC", {}),  # the FMU's defaults: the paper's fuzzy factors (1, 1.2, 87, 8.5, 4)
 ]
 
 SMALL_RADIUS = 1.0  # mm: an arc of at most this radius is the program's "small radius"

@@ -169,26 +169,6 @@ fn arc_box(a: &CircularArc) -> BBox {
     [b[0] - m, b[1] - m, b[2] + m, b[3] + m]
 }
 
-/// The squared distance from `p` to the triangle `t` (0 inside it).
-fn triangle_dist2(p: Vector2, t: [Vector2; 3]) -> f64 {
-    let side = |a: Vector2, b: Vector2| geometry::cross(&(b - a), &(p - a));
-    let (s0, s1, s2) = (side(t[0], t[1]), side(t[1], t[2]), side(t[2], t[0]));
-    if (s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0) || (s0 <= 0.0 && s1 <= 0.0 && s2 <= 0.0) {
-        return 0.0;
-    }
-    let edge = |a: Vector2, b: Vector2| {
-        let d = b - a;
-        let length2 = d.dot(&d);
-        let f = if length2 > 0.0 {
-            ((p - a).dot(&d) / length2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        geometry::dist2(&(a + d * f), &p)
-    };
-    edge(t[0], t[1]).min(edge(t[1], t[2])).min(edge(t[2], t[0]))
-}
-
 fn point_box(q: Vector2) -> BBox {
     [q[0], q[1], q[0], q[1]]
 }
@@ -548,7 +528,7 @@ impl TrueErrorIndex {
             }
             if node >= self.leaves {
                 let i = node - self.leaves;
-                if i != first && self.hull_dist2(i, p) <= best2 {
+                if i != first {
                     let r = self.chunk_min(i, p, from, to);
                     if r.0 < best.0 || r.0 == best.0 && i < best_chunk {
                         best = r;
@@ -594,9 +574,6 @@ impl TrueErrorIndex {
             }
             if node >= self.leaves {
                 let i = node - self.leaves;
-                if self.hull_dist2(i, p) > limit {
-                    continue;
-                }
                 let found = self.chunk_min(i, p, from, f64::INFINITY);
                 if found.0 <= tolerance {
                     return Some((i, self.result(found, p)));
@@ -714,23 +691,6 @@ impl TrueErrorIndex {
     /// Minimum distance over chunk `i` between the arc lengths `from` and `to`, and its
     /// parameter: exact on a move, a line or an arc; on a NURBS the best of the chunk's
     /// samples, then Newton in the bracket.
-    /// A lower bound of the squared distance from `p` to chunk `i` tighter than its box
-    /// where that pays: a corner blend lies in the triangle of its ends and the vertex,
-    /// and solving it costs a few dozen Fresnel sums (0 for every other chunk).
-    fn hull_dist2(&self, i: usize, p: Vector2) -> f64 {
-        let Path::Program(program) = &self.path else {
-            return 0.0;
-        };
-        let Shape::Blend(b) = &program.moves()[i].shape else {
-            return 0.0;
-        };
-        let [a, v, c] = b.hull();
-        // Rounding in the Fresnel sums: a nanometre of margin, as on the box.
-        let margin = 1e-9 * (1.0 + v.amax());
-        let d = (triangle_dist2(p, [a, v, c]).sqrt() - margin).max(0.0);
-        d * d
-    }
-
     fn chunk_min(&self, i: usize, p: Vector2, from: f64, to: f64) -> ChunkMin {
         let e = match &self.path {
             Path::Program(program) => move_true_error(program, i, p, self.move_span(i, from, to)),
