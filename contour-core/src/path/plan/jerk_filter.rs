@@ -17,6 +17,13 @@ use crate::geometry::Vector;
 /// Quanta per unit (mm or rad).
 const SCALE: f64 = (1u64 << 30) as f64;
 
+/// The most quanta a raw sample may count from the origin in a restored filter: 2⁹⁰,
+/// 10¹⁸ mm, beyond any path. A fuzzed state with samples near the i128 range, and sums
+/// that agree with them, overflowed on its next sample.
+const MAX_QUANTA: i128 = 1 << 90;
+/// The farthest origin a restored filter may count from, mm or rad (10¹⁸).
+const MAX_ORIGIN: f64 = 1e18;
+
 /// Two moving averages in series over `D`-vectors. The rings are flat, `D` numbers per
 /// sample, allocated once.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -96,12 +103,25 @@ impl<const D: usize> JerkFilter<D> {
         if !whole || m1 == 0 || m2 == 0 || self.at.0 >= m1 || self.at.1 >= m2 {
             return Err("the jerk filter's rings are empty or its slots outside them".into());
         }
+        // A new sample counts from the origin: beyond 10¹⁸ its quanta would overflow too.
+        if self.raw.iter().any(|q| q.abs() > MAX_QUANTA)
+            || self.origin.iter().any(|v| v.abs() > MAX_ORIGIN)
+        {
+            return Err("the jerk filter's samples or origin lie beyond 10^18".into());
+        }
+        // Checked: the stage-one sums are not bounded yet.
+        fn total(mut values: impl Iterator<Item = i128>) -> Option<i128> {
+            values.try_fold(0i128, |sum, v| sum.checked_add(v))
+        }
         for d in 0..D {
-            let first: i128 = (0..m1).map(|k| self.raw[k * D + d]).sum();
-            let second: i128 = (0..m2).map(|k| self.sums[k * D + d]).sum();
+            let first = total((0..m1).map(|k| self.raw[k * D + d]));
+            let second = total((0..m2).map(|k| self.sums[k * D + d]));
             // The newest stage-one sum is `first`.
             let newest = self.sums[((self.at.1 + m2 - 1) % m2) * D + d];
-            if first != self.first[d] || second != self.second[d] || newest != first {
+            if first != Some(self.first[d])
+                || second != Some(self.second[d])
+                || Some(newest) != first
+            {
                 return Err("the jerk filter's sums disagree with its rings".into());
             }
         }
@@ -112,6 +132,31 @@ impl<const D: usize> JerkFilter<D> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_restored_filter_with_samples_near_the_integer_range_is_refused() {
+        // The fuzz finding: rings and sums that agree, samples at 2^100 quanta.
+        let mut f = JerkFilter::<1>::new(2, 1, &V1::new(0.0), &V1::new(0.0));
+        let q = 1i128 << 100;
+        f.raw = vec![q, q];
+        f.first = vec![2 * q];
+        f.sums = vec![2 * q];
+        f.second = vec![2 * q];
+        assert!(f.check().unwrap_err().contains("beyond"));
+        // An origin far away makes the next sample's quanta overflow just the same.
+        let mut far = JerkFilter::<1>::new(2, 1, &V1::new(0.0), &V1::new(0.0));
+        far.origin = vec![1e300];
+        assert!(far.check().unwrap_err().contains("beyond"));
+        // Within the bound the same shape is accepted and steps.
+        let q = 1i128 << 80;
+        f.raw = vec![q, q];
+        f.first = vec![2 * q];
+        f.sums = vec![2 * q];
+        f.second = vec![2 * q];
+        assert!(f.check().is_ok());
+        let out = f.push(&V1::new(0.0));
+        assert_eq!(out[0], (q as f64) / 2.0 / SCALE);
+    }
 
     type V1 = Vector<1>;
 
