@@ -78,104 +78,136 @@ const CASES: &[Case] = &[
     },
 ];
 
-#[test]
-fn every_sample_keeps_the_limits_and_the_tolerance() {
-    for limits in [
+/// What a planned run is checked against.
+struct Expect<'a> {
+    name: String,
+    /// The programmed speeds, at most.
+    fastest: f64,
+    /// Points where the geometry may jump in curvature or kink (the jerk allowance).
+    junctions: Vec<Vector2>,
+    /// Where the motion stops.
+    stops: &'a [[f64; 2]],
+    /// How far the planned geometry may lie from the programmed path, mm.
+    tolerance: f64,
+}
+
+/// Every sample of `path` planned within `limits` against `expect` (module docs).
+fn check_samples(path: &Path, limits: XyLimits, expect: &Expect) {
+    let (p, reference) = samples(path, limits);
+    let ts = limits.ts;
+    let name = &expect.name;
+    // Start and end at rest, at the path's ends.
+    assert!(norm(p[0] - path.start_point()) < 1e-12, "{name}");
+    // From rest: the first step is at most what the jerk (or the acceleration) covers in
+    // one sample.
+    let first = if limits.jerk > 0.0 {
+        limits.jerk * ts.powi(3) / 6.0
+    } else {
+        limits.accel * ts * ts / 2.0
+    };
+    assert!(
+        norm(p[1] - p[0]) <= first * (1.0 + 1e-9),
+        "{name}: starts moving at once"
+    );
+    let n = p.len();
+    assert!(norm(p[n - 1] - path.end_point()) < 1e-9, "{name}");
+    assert!(norm(p[n - 1] - p[n - 3]) < 1e-12, "{name}");
+    let geometry = reference.geometry();
+    let near_junction =
+        |q: Vector2, reach: f64| expect.junctions.iter().any(|&j| norm(q - j) <= reach);
+    let index = TrueErrorIndex::new(path);
+    let mut max_a = 0.0f64;
+    for k in 1..n - 2 {
+        let v = norm(p[k + 1] - p[k]) / ts;
+        assert!(
+            v <= expect.fastest * (1.0 + 1e-9),
+            "{name}: {v} mm/s at sample {k}"
+        );
+        let a = norm(p[k + 1] - p[k] * 2.0 + p[k - 1]) / (ts * ts);
+        let j = norm(p[k + 2] - p[k + 1] * 3.0 + p[k] * 3.0 - p[k - 1]) / (ts * ts * ts);
+        // The samples' acceleration averages the reference's over ±Ts, so it keeps the
+        // limit; their jerk averages the jerk over three samples, where a curvature
+        // jump's step v²Δκ ≤ jerk·Ts weighs at most 3/4 (the kernel's peak): up to
+        // 1.75·jerk within three samples of a junction.
+        let reach = 3.0 * v * ts + 1e-9;
+        let j_allowed = if near_junction(p[k], reach) {
+            1.75
+        } else {
+            1.0 + 1e-6
+        } * limits.jerk;
+        assert!(
+            a <= limits.accel * (1.0 + 1e-6),
+            "{name}: {a} mm/s² at sample {k} ({:?})",
+            p[k]
+        );
+        if limits.jerk > 0.0 {
+            assert!(
+                j <= j_allowed,
+                "{name}: {j} mm/s³ at sample {k} ({:?})",
+                p[k]
+            );
+        }
+        max_a = max_a.max(a);
+        // On the planned geometry, within the tolerance of the programmed path.
+        assert!(
+            true_error(&geometry, p[k]).error.abs() < 1e-9,
+            "{name}: off at {k}"
+        );
+        let off = index.error(p[k], 0.0).error.abs();
+        assert!(
+            off <= expect.tolerance + 1e-9,
+            "{name}: {off} mm from the program at {k}"
+        );
+    }
+    // The limits are used, not just kept.
+    assert!(max_a > 0.5 * limits.accel, "{name}: {max_a}");
+    // Exact stops: the motion comes to rest there between two samples, so the samples
+    // either side are within one sample's motion from rest of it (one passing at v would
+    // be v·Ts/2 away).
+    for stop in expect.stops {
+        let stop = Vector2::from(*stop);
+        let at_rest = (1..n - 1).any(|k| {
+            norm(p[k] - stop) <= first * (1.0 + 1e-6)
+                && norm(p[k + 1] - stop) <= first * (1.0 + 1e-6)
+        });
+        assert!(at_rest, "{name}: no stop at {stop:?}");
+    }
+}
+
+/// With and without a jerk limit.
+fn both_jerks() -> [XyLimits; 2] {
+    [
         LIMITS,
         XyLimits {
             jerk: 0.0,
             ..LIMITS
         },
-    ] {
+    ]
+}
+
+#[test]
+fn every_sample_keeps_the_limits_and_the_tolerance() {
+    for limits in both_jerks() {
         for case in CASES {
             let path = program(case.text);
-            let (p, reference) = samples(&path, limits);
-            let ts = limits.ts;
-            let name = format!("{} (jerk {})", case.name, limits.jerk);
-            // Start and end at rest, at the path's ends.
-            assert!(norm(p[0] - path.start_point()) < 1e-12, "{name}");
-            // From rest: the first step is at most what the jerk (or the acceleration)
-            // covers in one sample.
-            let first = if limits.jerk > 0.0 {
-                limits.jerk * ts.powi(3) / 6.0
-            } else {
-                limits.accel * ts * ts / 2.0
+            // The geometry's junctions, where it may jump in curvature or kink.
+            let Path::Program(planned) = XyReference::new(path.clone(), limits).unwrap().geometry()
+            else {
+                panic!("a program is planned as a program")
             };
-            assert!(
-                norm(p[1] - p[0]) <= first * (1.0 + 1e-9),
-                "{name}: starts moving at once"
-            );
-            let n = p.len();
-            assert!(norm(p[n - 1] - path.end_point()) < 1e-9, "{name}");
-            assert!(norm(p[n - 1] - p[n - 3]) < 1e-12, "{name}");
-            // The geometry's junctions with a curvature jump or a kink: the derived
-            // allowance of the samples there (design §4.9).
-            let geometry = Path::Program(reference.geometry().clone());
-            let junctions: Vec<Vector2> = reference
-                .geometry()
+            let junctions = planned
                 .moves()
                 .iter()
                 .map(|m| m.shape.curve().point(1.0))
                 .collect();
-            let near_junction =
-                |q: Vector2, reach: f64| junctions.iter().any(|&j| norm(q - j) <= reach);
-            let index = TrueErrorIndex::new(&path);
-            let mut max_a = 0.0f64;
-            for k in 1..n - 2 {
-                let v = norm(p[k + 1] - p[k]) / ts;
-                assert!(
-                    v <= case.fastest * (1.0 + 1e-9),
-                    "{name}: {v} mm/s at sample {k}"
-                );
-                let a = norm(p[k + 1] - p[k] * 2.0 + p[k - 1]) / (ts * ts);
-                let j = norm(p[k + 2] - p[k + 1] * 3.0 + p[k] * 3.0 - p[k - 1]) / (ts * ts * ts);
-                // The samples' acceleration averages the reference's over ±Ts, so it
-                // keeps the limit; their jerk averages the jerk over three samples, where
-                // a curvature jump's step v²Δκ ≤ jerk·Ts weighs at most 3/4 (the kernel's
-                // peak): up to 1.75·jerk within three samples of a junction.
-                let reach = 3.0 * v * ts + 1e-9;
-                let j_allowed = if near_junction(p[k], reach) {
-                    1.75
-                } else {
-                    1.0 + 1e-6
-                } * limits.jerk;
-                assert!(
-                    a <= limits.accel * (1.0 + 1e-6),
-                    "{name}: {a} mm/s² at sample {k} ({:?})",
-                    p[k]
-                );
-                if limits.jerk > 0.0 {
-                    assert!(
-                        j <= j_allowed,
-                        "{name}: {j} mm/s³ at sample {k} ({:?})",
-                        p[k]
-                    );
-                }
-                max_a = max_a.max(a);
-                // On the planned geometry, within the tolerance of the programmed path.
-                assert!(
-                    true_error(&geometry, p[k]).error.abs() < 1e-9,
-                    "{name}: off at {k}"
-                );
-                let off = index.error(p[k], 0.0).error.abs();
-                assert!(
-                    off <= 0.05 + 1e-9,
-                    "{name}: {off} mm from the program at {k}"
-                );
-            }
-            // The limits are used, not just kept.
-            assert!(max_a > 0.5 * limits.accel, "{name}: {max_a}");
-            // Exact stops: the motion comes to rest there between two samples, so the
-            // samples either side are within one sample's motion from rest of it (one
-            // passing at v would be v·Ts/2 away).
-            for stop in case.stops {
-                let stop = Vector2::from(*stop);
-                let at_rest = (1..n - 1).any(|k| {
-                    norm(p[k] - stop) <= first * (1.0 + 1e-6)
-                        && norm(p[k + 1] - stop) <= first * (1.0 + 1e-6)
-                });
-                assert!(at_rest, "{name}: no stop at {stop:?}");
-            }
+            let expect = Expect {
+                name: format!("{} (jerk {})", case.name, limits.jerk),
+                fastest: case.fastest,
+                junctions,
+                stops: case.stops,
+                tolerance: 0.05,
+            };
+            check_samples(&path, limits, &expect);
         }
     }
 }
@@ -282,4 +314,85 @@ fn the_exact_distance_to_a_blended_program_is_the_dense_samples_nearest() {
         }
     }
     assert_eq!(compared, 600);
+}
+
+#[test]
+fn a_nurbs_is_planned_on_itself_within_the_limits() {
+    use contour_core::path::builtin;
+    use contour_core::path::{Curve, Nurbs};
+    let knots_inside = |n: &Nurbs| -> Vec<Vector2> {
+        let (a, b) = n.param_range();
+        n.knots()
+            .iter()
+            .filter(|&&u| u > a && u < b)
+            .map(|&u| n.point(u))
+            .collect()
+    };
+    // A 20 mm square as a degree-1 NURBS (issue 23's square): stops at its corners.
+    let square = Nurbs::new(
+        1,
+        vec![0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0],
+        vec![
+            [0.0, 0.0],
+            [20.0, 0.0],
+            [20.0, 20.0],
+            [0.0, 20.0],
+            [0.0, 0.0],
+        ],
+        None,
+    )
+    .unwrap();
+    // A quadratic B-spline: tangent-continuous, its curvature jumps at every knot.
+    let wave = Nurbs::new(
+        2,
+        vec![0.0, 0.0, 0.0, 1.0, 2.0, 3.0, 4.0, 4.0, 4.0],
+        vec![
+            [0.0, 0.0],
+            [10.0, 8.0],
+            [20.0, -8.0],
+            [30.0, 8.0],
+            [40.0, -8.0],
+            [50.0, 0.0],
+        ],
+        None,
+    )
+    .unwrap();
+    // The exact rational circle, 10 mm radius: curvature 0.1 everywhere.
+    let unit = builtin::rational_unit_circle();
+    let circle = Nurbs::new(
+        2,
+        unit.knots().to_vec(),
+        unit.control_points().iter().map(|p| p * 10.0).collect(),
+        Some(unit.weights().to_vec()),
+    )
+    .unwrap();
+    let cases: [(&str, Nurbs, &[[f64; 2]]); 5] = [
+        ("infinity", builtin::infinity(), &[]),
+        ("trident", builtin::trident(), &[]),
+        (
+            "square NURBS",
+            square,
+            &[[20.0, 0.0], [20.0, 20.0], [0.0, 20.0]],
+        ),
+        ("quadratic wave", wave, &[]),
+        ("rational circle", circle, &[]),
+    ];
+    for limits in both_jerks() {
+        for (name, nurbs, stops) in &cases {
+            let expect = Expect {
+                name: format!("{name} (jerk {})", limits.jerk),
+                fastest: limits.feed,
+                junctions: knots_inside(nurbs),
+                stops,
+                tolerance: 0.0,
+            };
+            check_samples(&Path::Nurbs(nurbs.clone()), limits, &expect);
+        }
+    }
+    // The mirror image runs the mirrored samples exactly.
+    let path = Path::Nurbs(builtin::trident());
+    let (p, _) = samples(&path, LIMITS);
+    let (q, _) = samples(&path.mirrored(), LIMITS);
+    assert_eq!(p.len(), q.len());
+    assert!(p.iter().zip(&q).all(|(a, b)| a[0] == b[0] && a[1] == -b[1]));
 }

@@ -27,8 +27,7 @@
 
 use contour_core::contour::planar::{TrueError, TrueErrorIndex};
 use contour_core::geometry::{self, Vector2};
-use contour_core::path::plan::planned_geometry;
-use contour_core::path::program::Shape;
+use contour_core::path::program::{blended, Shape};
 use contour_core::path::Path;
 
 /// Path length (mm) every stretch reaches beyond what the tool's move and its distance
@@ -66,7 +65,7 @@ impl Geometry {
     pub fn new(path: Path, tolerance: f64) -> Result<Geometry, String> {
         let planned = match &path {
             Path::Program(program) => {
-                let planned = planned_geometry(&path, tolerance).map_err(|e| e.to_string())?;
+                let planned = blended(program, tolerance);
                 (planned.moves() != program.moves()).then_some(Path::Program(planned))
             }
             Path::Line(_) | Path::Arc(_) | Path::Nurbs(_) => None,

@@ -341,9 +341,8 @@ fn blended_corners_change_the_planned_contour_near_them_only() {
         stdout.contains("3 corners blended (tolerance 0.05 mm)"),
         "{stdout}"
     );
-    let planned = CorePath::Program(
-        planned_geometry(&CorePath::from_spec(s(&part), None).unwrap(), tolerance).unwrap(),
-    );
+    let planned =
+        planned_geometry(&CorePath::from_spec(s(&part), None).unwrap(), tolerance).unwrap();
     // A 90° corner's blend passes P·√2 inside its vertex (its middle is P from either
     // line): outside the corner, where the programmed foot is the vertex, and between
     // the vertex and the blend, the two differ by up to that; elsewhere by up to P.

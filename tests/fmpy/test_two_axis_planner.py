@@ -35,20 +35,38 @@ def ruckig_duration(length, speed, accel, jerk):
     return trajectory.duration
 
 
-def planned_duration(fmu_dir, length, **limits):
+def planned_duration(fmu_dir, **parameters):
     s = Slave(str(fmu_dir / "PathInterpolator2D.fmu"))
     try:
-        s.set(path="line", line__x1=length, line__y1=0.0, feed=50.0, **limits)
+        s.set(**parameters)
         s.fmu.exitInitializationMode()
         return s.reals(["plannedDuration"])[0]
     finally:
         s.close()
 
 
+def line_duration(fmu_dir, length, **limits):
+    return planned_duration(fmu_dir, path="line", line__x1=length, line__y1=0.0, feed=50.0,
+                            **limits)
+
+
+def planned_closed_loops(fmu_dir, path, interpolator, controller):
+    """The closed loop on `path` planned with `interpolator`, run 0.3 s past the plan's
+    duration with the CCC and without: {name: (before, after, reference samples)}."""
+    stop = round(planned_duration(fmu_dir, path=path, **interpolator) + 0.3, 3)
+    runs = {}
+    for name, extra in [("ccc", {}), ("no ccc", {"ccc.enable": False})]:
+        before, after = closed_loop(fmu_dir, path=path, stop=stop, interpolator=interpolator,
+                                    controller={**controller, **extra})
+        reference = np.stack([before["interpolator.ref.x"], before["interpolator.ref.y"]], axis=1)
+        runs[name] = (before, after, reference)
+    return runs
+
+
 @pytest.mark.parametrize("length", [0.001, 0.01, 0.1, 0.3, 1.0, 3.0, 30.0, 300.0])
 def test_a_line_takes_the_time_optimal_time_of_the_reference_planner(fmu_dir, length):
     want = ruckig_duration(length, 50.0, 2000.0, 1e5)
-    got = planned_duration(fmu_dir, length, **LIMITS)
+    got = line_duration(fmu_dir, length, **LIMITS)
     assert abs(got - want) <= 0.01 * want, (got, want)
     # Ruckig's algorithm on both sides: far closer than the 1 % asked.
     assert abs(got - want) <= 1e-6 * want, (got, want)
@@ -58,7 +76,7 @@ def test_a_line_takes_the_time_optimal_time_of_the_reference_planner(fmu_dir, le
 def test_without_a_jerk_limit_a_line_takes_the_trapezoids_time(fmu_dir, length):
     v, a = 50.0, 2000.0
     want = length / v + v / a if length >= v * v / a else 2.0 * np.sqrt(length / a)
-    got = planned_duration(fmu_dir, length, accel=a, jerk=0.0)
+    got = line_duration(fmu_dir, length, accel=a, jerk=0.0)
     assert abs(got - want) <= 1e-9 * want, (got, want)
 
 
@@ -67,18 +85,10 @@ def test_a_gcode_part_runs_under_acceleration_and_jerk_limits_in_the_closed_loop
     part.write_text(PART)  # F1200 = 20 mm/s; corners blended (bare G64) within `tolerance`
     tolerance = 0.02
     interpolator = {"accel": 2000.0, "jerk": 1e5, "tolerance": tolerance, "feed": 50.0}
-    probe = Slave(str(fmu_dir / "PathInterpolator2D.fmu"))
-    probe.set(path=str(part), **interpolator)
-    probe.fmu.exitInitializationMode()
-    duration = probe.reals(["plannedDuration"])[0]
-    probe.close()
-    stop = round(duration + 0.3, 3)
     controller = {"estimator": ESTIMATOR["program"], "path": str(part), "tolerance": tolerance}
     runs = {}
-    for name, extra in [("ccc", {}), ("no ccc", {"ccc.enable": False})]:
-        before, after = closed_loop(fmu_dir, path=str(part), stop=stop, interpolator=interpolator,
-                                    controller={**controller, **extra})
-        reference = np.stack([before["interpolator.ref.x"], before["interpolator.ref.y"]], axis=1)
+    loops = planned_closed_loops(fmu_dir, str(part), interpolator, controller)
+    for name, (before, after, reference) in loops.items():
         # Start and end at rest; done when the plan says.
         assert np.allclose(reference[0], [0.0, 0.0]) and np.allclose(reference[-1], [0.0, 0.0])
         # By finite differences of the samples: speed within F, acceleration within accel.
@@ -150,3 +160,67 @@ def test_a_saved_planned_reference_continues_in_a_fresh_instance(fmu_dir, interp
             assert np.array_equal(interpolator.reals(names), fresh.reals(names))
     finally:
         fresh.close()
+
+
+# A user's NURBS file: a cubic B-spline hairpin, out along y = 0 and back along y = 12,
+# with a tight turn (radius 3.76 mm at u = 1.7601 and 2.2399) between long gentle stretches.
+HAIRPIN = {
+    "degree": 3,
+    "knots": [0, 0, 0, 0, 1, 2, 3, 4, 4, 4, 4],
+    "control_points": [[0, 0], [30, 0], [45, 0], [49, 6], [45, 12], [30, 12], [0, 12]],
+}
+
+
+def hairpin_distance(points):
+    """The test's own distance from each point to HAIRPIN (scipy's B-spline: the nearest of
+    4001 samples, then Newton on (C - P).C' = 0 from it, all points at once)."""
+    from scipy.interpolate import BSpline
+    curve = BSpline(np.array(HAIRPIN["knots"], float),
+                    np.array(HAIRPIN["control_points"], float), HAIRPIN["degree"])
+    d1, d2 = curve.derivative(1), curve.derivative(2)
+    u = np.linspace(0.0, 4.0, 4001)
+    dense = curve(u)
+    nearest = np.array([np.argmin(np.sum((dense - p) ** 2, axis=1)) for p in points])
+    v = u[nearest]
+    for _ in range(30):
+        q, t, c = curve(v) - points, d1(v), d2(v)
+        step = np.sum(q * t, axis=1) / (np.sum(t * t, axis=1) + np.sum(q * c, axis=1))
+        v = np.clip(v - step, 0.0, 4.0)
+    return np.linalg.norm(curve(v) - points, axis=1), curve
+
+
+def test_a_nurbs_file_runs_planned_within_the_limits_with_the_exact_estimate(fmu_dir, tmp_path):
+    import json
+    hairpin = tmp_path / "hairpin.json"
+    hairpin.write_text(json.dumps(HAIRPIN))
+    feed = 80.0
+    interpolator = {"accel": 2000.0, "jerk": 1e5, "feed": feed}
+    controller = {"estimator": ESTIMATOR["program"], "path": str(hairpin)}
+    runs = {}
+    loops = planned_closed_loops(fmu_dir, str(hairpin), interpolator, controller)
+    for name, (before, after, reference) in loops.items():
+        # From rest at the start to rest at the end, on the curve all along.
+        assert np.allclose(reference[0], [0.0, 0.0]) and np.allclose(reference[-1], [0.0, 12.0])
+        off, curve = hairpin_distance(reference[::7])
+        assert off.max() < 1e-9, off.max()
+        # By finite differences of the samples: speed within the feed, acceleration and
+        # jerk within the limits (no curvature jump on a cubic: no junction allowance).
+        velocity = np.diff(reference, axis=0) / 1e-3
+        speed = np.linalg.norm(velocity, axis=1)
+        assert feed * (1 + 1e-9) >= speed.max() > 0.99 * feed
+        acceleration = np.diff(velocity, axis=0) / 1e-3
+        assert np.linalg.norm(acceleration, axis=1).max() <= 2000.0 * (1 + 1e-6)
+        jerk = np.diff(acceleration, axis=0) / 1e-3
+        assert np.linalg.norm(jerk, axis=1).max() <= 1e5 * (1 + 1e-6)
+        # It slows for the tight turn, where the centripetal acceleration alone would
+        # exceed the limit at the feed: v^2 kappa there within the normal share accel/sqrt 2.
+        for u in [1.7601, 2.2399]:
+            tight = np.argmin(np.linalg.norm(reference[:-1] - curve(u), axis=1))
+            assert speed[tight] ** 2 * 0.26591 <= 2000.0 / np.sqrt(2) * (1 + 1e-3), speed[tight]
+        # The program estimator: the exact distance to the NURBS, every sample.
+        points = np.stack([before["plant.pos.x"], before["plant.pos.y"]], axis=1)
+        want, _ = hairpin_distance(points)
+        got = after["controller.contourError"]
+        assert np.abs(np.abs(got) - want).max() < 1e-9, name
+        runs[name] = want
+    assert runs["ccc"].max() < 0.5 * runs["no ccc"].max(), (runs["ccc"].max(), runs["no ccc"].max())

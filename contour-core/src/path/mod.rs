@@ -303,6 +303,32 @@ impl From<Nurbs> for Path {
     }
 }
 
+/// Arc length of a smooth piece [a, b] by the 5-point Gauss–Legendre rule on |C'(u)|.
+pub(crate) fn gl5<const D: usize, C: Curve<D> + ?Sized>(c: &C, a: f64, b: f64) -> f64 {
+    // Nodes and weights of the 5-point Gauss–Legendre rule on [-1, 1].
+    const X: [f64; 5] = [
+        0.0,
+        -0.538_469_310_105_683_1,
+        0.538_469_310_105_683_1,
+        -0.906_179_845_938_664,
+        0.906_179_845_938_664,
+    ];
+    const W: [f64; 5] = [
+        0.568_888_888_888_888_9,
+        0.478_628_670_499_366_5,
+        0.478_628_670_499_366_5,
+        0.236_926_885_056_189_1,
+        0.236_926_885_056_189_1,
+    ];
+    let m = 0.5 * (a + b);
+    let h = 0.5 * (b - a);
+    let mut s = 0.0;
+    for k in 0..5 {
+        s += W[k] * geometry::norm(&c.eval(m + h * X[k]).d1);
+    }
+    s * h
+}
+
 /// Arc length of a smooth piece by adaptive Gauss–Legendre quadrature of |C'(u)|.
 ///
 /// Compares a 5-point rule on the whole interval with the sum over its halves and splits
@@ -313,30 +339,6 @@ pub(crate) fn gauss_length<const D: usize, C: Curve<D> + ?Sized>(
     b: f64,
     tol: f64,
 ) -> f64 {
-    fn gl5<const D: usize, C: Curve<D> + ?Sized>(c: &C, a: f64, b: f64) -> f64 {
-        // Nodes and weights of the 5-point Gauss–Legendre rule on [-1, 1].
-        const X: [f64; 5] = [
-            0.0,
-            -0.538_469_310_105_683_1,
-            0.538_469_310_105_683_1,
-            -0.906_179_845_938_664,
-            0.906_179_845_938_664,
-        ];
-        const W: [f64; 5] = [
-            0.568_888_888_888_888_9,
-            0.478_628_670_499_366_5,
-            0.478_628_670_499_366_5,
-            0.236_926_885_056_189_1,
-            0.236_926_885_056_189_1,
-        ];
-        let m = 0.5 * (a + b);
-        let h = 0.5 * (b - a);
-        let mut s = 0.0;
-        for k in 0..5 {
-            s += W[k] * geometry::norm(&c.eval(m + h * X[k]).d1);
-        }
-        s * h
-    }
     fn rec<const D: usize, C: Curve<D> + ?Sized>(
         c: &C,
         a: f64,

@@ -275,21 +275,21 @@ impl<const D: usize> Nurbs<D> {
         out
     }
 
-    fn clamp(&self, u: f64) -> f64 {
-        let (a, b) = self.param_range();
-        clamp_param(u, a, b)
-    }
-}
-
-impl<const D: usize> Curve<D> for Nurbs<D> {
-    fn param_range(&self) -> (f64, f64) {
-        (self.knots[0], self.knots[self.knots.len() - 1])
-    }
-
-    fn eval(&self, u: f64) -> CurvePoint<D> {
+    /// Point and derivatives at `u` as the limit from below: at an interior knot those
+    /// of the span that ends there (the feed planner's view of a kink or a curvature jump).
+    pub fn eval_from_below(&self, u: f64) -> CurvePoint<D> {
         let u = self.clamp(u);
+        let mut s = self.span(u);
+        // The span that ends at u, when u starts the one `span` found.
+        while s > self.degree && self.knots[s] >= u {
+            s -= 1;
+        }
+        self.eval_in_span(s, u)
+    }
+
+    /// Point and derivatives at `u` by the basis functions of span `s`.
+    fn eval_in_span(&self, s: usize, u: f64) -> CurvePoint<D> {
         let p = self.degree;
-        let s = self.span(u);
         let t = self.basis_triangle(s, u);
         let n0 = t[p];
         let n1 = self.diff_level(s, p, &t[p - 1]);
@@ -326,6 +326,22 @@ impl<const D: usize> Curve<D> for Nurbs<D> {
             out.d2[d] = c2;
         }
         out
+    }
+
+    fn clamp(&self, u: f64) -> f64 {
+        let (a, b) = self.param_range();
+        clamp_param(u, a, b)
+    }
+}
+
+impl<const D: usize> Curve<D> for Nurbs<D> {
+    fn param_range(&self) -> (f64, f64) {
+        (self.knots[0], self.knots[self.knots.len() - 1])
+    }
+
+    fn eval(&self, u: f64) -> CurvePoint<D> {
+        let u = self.clamp(u);
+        self.eval_in_span(self.span(u), u)
     }
 
     fn point(&self, u: f64) -> Vector<D> {

@@ -201,11 +201,13 @@ pub fn curve_true_error<C: Curve + ?Sized>(c: &C, p: Vector2) -> TrueError {
         let upper = i + 1 == n || ds[i] <= ds[i + 1];
         // A true minimum inside a sample bracket is at most one chord below the samples.
         if lower && upper && ds[i] <= dmin + max_chord {
+            // Each side of the sample on its own: the sample may be a knot.
             let a = us[i.saturating_sub(1)];
             let b = us[(i + 1).min(n - 1)];
-            let r = refine(c, p, a, b, us[i]);
-            if r.0 < best.0 {
-                best = r;
+            for r in [refine(c, p, a, us[i], us[i]), refine(c, p, us[i], b, us[i])] {
+                if r.0 < best.0 {
+                    best = r;
+                }
             }
         }
     }
@@ -215,7 +217,17 @@ pub fn curve_true_error<C: Curve + ?Sized>(c: &C, p: Vector2) -> TrueError {
 /// Minimises |C(u) − P| over [a, b] starting from `u`: safeguarded Newton on
 /// f(u) = (C − P)·C' with bisection fallback; also compares the bracket ends.
 /// Returns (distance, parameter).
+///
+/// The iterates stay strictly inside the bracket (a start at an end starts from the
+/// middle): an end may be a knot where the curve kinks, and C' there is the next
+/// span's, which would stop the search at the knot (a degree-1 NURBS's corner, found
+/// planning issue 23's square as a NURBS).
 fn refine<C: Curve + ?Sized>(c: &C, p: Vector2, a0: f64, b0: f64, u0: f64) -> (f64, f64) {
+    let u0 = if u0 > a0 && u0 < b0 {
+        u0
+    } else {
+        0.5 * (a0 + b0)
+    };
     let (mut a, mut b, mut u) = (a0, b0, u0);
     for _ in 0..64 {
         let e = c.eval(u);
@@ -231,7 +243,7 @@ fn refine<C: Curve + ?Sized>(c: &C, p: Vector2, a0: f64, b0: f64, u0: f64) -> (f
             a = u;
         }
         let mut un = if fp > 0.0 { u - f / fp } else { f64::NAN };
-        if !(un >= a && un <= b) {
+        if !(un > a && un < b) {
             un = 0.5 * (a + b);
         }
         let tol = 1e-15 * (1.0 + u.abs());
@@ -782,6 +794,47 @@ mod tests {
     use super::*;
     use crate::path::builtin;
     use std::f64::consts::PI;
+
+    #[test]
+    fn a_degree_one_nurbs_is_measured_to_its_edges_near_a_corner() {
+        // A 20 mm square as a polygon NURBS: points on and just inside the bottom edge
+        // near the corner (20, 0), whose nearest sample is the knot there. The knot's
+        // derivative is the next edge's, which once stopped the search at the corner.
+        let square = Path::Nurbs(
+            crate::path::Nurbs::new(
+                1,
+                vec![0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0],
+                vec![
+                    [0.0, 0.0],
+                    [20.0, 0.0],
+                    [20.0, 20.0],
+                    [0.0, 20.0],
+                    [0.0, 0.0],
+                ],
+                None,
+            )
+            .unwrap(),
+        );
+        let index = TrueErrorIndex::new(&square);
+        for k in 0..200 {
+            let x = 19.9 + 0.0005 * k as f64;
+            for y in [0.0f64, 0.001, 0.01] {
+                // Inside the square, left of travel: negative, the edge or the right
+                // side the nearer.
+                let want = -(y.min(20.0 - x));
+                for e in [
+                    true_error(&square, Vector2::new(x, y)),
+                    index.error(Vector2::new(x, y), 0.0),
+                ] {
+                    assert!(
+                        (e.error - want).abs() < 1e-12,
+                        "({x}, {y}): {} vs {want}",
+                        e.error
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn line_and_arc_hand_cases() {

@@ -7,6 +7,7 @@
 mod feed;
 mod jerk_filter;
 mod joint_path;
+mod nurbs_pieces;
 mod piece_profile;
 mod planned_reference;
 mod xy_plan;

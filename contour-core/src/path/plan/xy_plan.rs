@@ -12,9 +12,11 @@
 //! Where the samples every Ts see a jump, the junction's speed is capped: a curvature
 //! jump Δκ makes an acceleration step v²Δκ in one sample (v²Δκ ≤ jerk·Ts), a kink of
 //! angle θ a one-sample velocity turn v·θ (v·θ ≤ accel·Ts and ≤ jerk·Ts²). A kink the
-//! geometry keeps (an exact stop, a corner into or out of an arc) of more than
-//! [`MIN_BLEND_TURN`] is a stop.
+//! geometry keeps (an exact stop, a corner into or out of an arc, a NURBS's kink) of
+//! more than [`MIN_BLEND_TURN`] is a stop. A NURBS is planned on its pieces of
+//! [`NurbsPieces`], whose curvature bounds are sampled.
 
+use super::nurbs_pieces::NurbsPieces;
 use super::piece_profile::{plan_piece, reachable, Phase, PieceLimits};
 use crate::geometry::{self, Vector2};
 use crate::path::program::{blended, Corner, Move, Program, Shape, Speed, MIN_BLEND_TURN};
@@ -40,9 +42,18 @@ pub struct XyLimits {
 /// A planned XY path: its geometry and its motion.
 #[derive(Clone, Debug, PartialEq)]
 pub struct XyPlan {
-    geometry: Program,
+    geometry: Geometry,
     phases: Vec<Phase>,
     duration: f64,
+}
+
+/// The planned geometry as the samples run along it.
+#[derive(Clone, Debug, PartialEq)]
+enum Geometry {
+    /// Moves whose own parameter is proportional to their arc length.
+    Program(Program),
+    /// A NURBS, mapped from arc length to its parameter.
+    Nurbs(NurbsPieces),
 }
 
 /// Where a plan stands at one time.
@@ -56,16 +67,52 @@ pub struct XyPoint {
     pub speed: f64,
 }
 
-/// The plan's position in its phases and pieces, for a run of increasing times.
+/// The plan's position in its phases and along its geometry (a program's move, a
+/// NURBS's cell), for a run of increasing times.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct XyCursor {
     phase: usize,
     piece: usize,
 }
 
+/// What the planner needs of one piece of the geometry.
+struct PlanPiece {
+    /// Arc length at its start and its length, mm.
+    start: f64,
+    length: f64,
+    /// The programmed speed, mm/s.
+    speed: f64,
+    /// Signed curvature at the start and the end, 1/mm.
+    kappa: [f64; 2],
+    /// The greatest |κ| (1/mm) and |κ′| (1/mm²).
+    kappa_max: f64,
+    rate_max: f64,
+    /// Unit tangent at the start and the end.
+    tangent: [Vector2; 2],
+    /// An exact stop at its end.
+    stops: bool,
+    /// Where it comes from, for messages.
+    origin: Origin,
+}
+
+#[derive(Clone, Copy)]
+enum Origin {
+    Line(usize),
+    Parameter(f64),
+}
+
+impl std::fmt::Display for Origin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Origin::Line(n) => write!(f, "the move of line {n}"),
+            Origin::Parameter(u) => write!(f, "the NURBS piece from u = {u}"),
+        }
+    }
+}
+
 /// The geometry a path is planned on: a program's blended moves, a line or an arc as a
-/// program of one move.
-pub fn planned_geometry(path: &Path, tolerance: f64) -> Result<Program, PathError> {
+/// program of one move, a NURBS itself (its kinks are exact stops, never blended).
+pub fn planned_geometry(path: &Path, tolerance: f64) -> Result<Path, PathError> {
     let one = |shape: Shape| {
         Program::new(vec![Move {
             shape,
@@ -73,15 +120,13 @@ pub fn planned_geometry(path: &Path, tolerance: f64) -> Result<Program, PathErro
             corner: Corner::ExactStop,
             line: 1,
         }])
+        .map(Path::Program)
     };
     match path {
-        Path::Program(program) => Ok(blended(program, tolerance)),
+        Path::Program(program) => Ok(Path::Program(blended(program, tolerance))),
         Path::Line(l) => one(Shape::Line(l.clone())),
         Path::Arc(a) => one(Shape::Arc(a.clone())),
-        Path::Nurbs(_) => Err(PathError::invalid(
-            "the feed planner takes G-code programs, lines and arcs; a NURBS path runs at the \
-             constant 'feed' (accel = 0)",
-        )),
+        Path::Nurbs(n) => Ok(Path::Nurbs(n.clone())),
     }
 }
 
@@ -126,7 +171,7 @@ impl XyLimits {
     }
 }
 
-/// Curvature (signed, 1/mm) at the start and the end of a piece, its greatest |κ| and
+/// Curvature (signed, 1/mm) at the start and the end of a move, its greatest |κ| and
 /// its greatest |κ′| (1/mm²).
 fn curvatures(shape: &Shape) -> ([f64; 2], f64, f64) {
     match shape {
@@ -139,10 +184,63 @@ fn curvatures(shape: &Shape) -> ([f64; 2], f64, f64) {
     }
 }
 
+/// The unit tangent at a move's start (`u` = 0) or end (1).
+fn tangent(shape: &Shape, u: f64) -> Vector2 {
+    let d = shape.curve().eval(u).d1;
+    d / geometry::norm(&d)
+}
+
+/// A program's moves as pieces; a blend goes at the slower of the moves it joins.
+fn program_pieces(program: &Program, limits: &XyLimits) -> Vec<PlanPiece> {
+    let moves = program.moves();
+    let n = moves.len();
+    (0..n)
+        .map(|i| {
+            let m = &moves[i];
+            let speed = match m.shape {
+                Shape::Blend(_) if i + 1 < n => {
+                    limits.speed_of(m).min(limits.speed_of(&moves[i + 1]))
+                }
+                _ => limits.speed_of(m),
+            };
+            let (kappa, kappa_max, rate_max) = curvatures(&m.shape);
+            PlanPiece {
+                start: program.start_of(i),
+                length: m.shape.curve().length(),
+                speed,
+                kappa,
+                kappa_max,
+                rate_max,
+                tangent: [tangent(&m.shape, 0.0), tangent(&m.shape, 1.0)],
+                stops: m.corner == Corner::ExactStop,
+                origin: Origin::Line(m.line),
+            }
+        })
+        .collect()
+}
+
+/// A NURBS's pieces, at the `feed` parameter.
+fn nurbs_pieces(cut: &NurbsPieces, limits: &XyLimits) -> Vec<PlanPiece> {
+    cut.pieces()
+        .iter()
+        .map(|p| PlanPiece {
+            start: p.s[0],
+            length: p.s[1] - p.s[0],
+            speed: limits.feed,
+            kappa: p.kappa,
+            kappa_max: p.kappa_max,
+            rate_max: p.rate_max,
+            tangent: p.tangent,
+            stops: false,
+            origin: Origin::Parameter(p.u[0]),
+        })
+        .collect()
+}
+
 /// A piece's limits along its arc length (module docs).
-fn piece_limits(speed: f64, shape: &Shape, limits: &XyLimits) -> PieceLimits {
+fn piece_limits(piece: &PlanPiece, limits: &XyLimits) -> PieceLimits {
     let jerk = limits.jerk_limit();
-    let (_, kappa, rate) = curvatures(shape);
+    let (speed, kappa, rate) = (piece.speed, piece.kappa_max, piece.rate_max);
     if kappa == 0.0 {
         return PieceLimits {
             speed,
@@ -164,55 +262,61 @@ fn piece_limits(speed: f64, shape: &Shape, limits: &XyLimits) -> PieceLimits {
     }
 }
 
-/// The unit tangent at a piece's start (`u` = 0) or end (1).
-fn tangent(shape: &Shape, u: f64) -> Vector2 {
-    let d = shape.curve().eval(u).d1;
-    d / geometry::norm(&d)
+/// The speed cap of the junction between `before` and `after` (module docs).
+fn junction_cap(before: &PlanPiece, after: &PlanPiece, limits: &XyLimits) -> f64 {
+    if before.stops {
+        return 0.0;
+    }
+    let (t0, t1) = (before.tangent[1], after.tangent[0]);
+    let turn = geometry::cross(&t0, &t1).atan2(t0.dot(&t1)).abs();
+    // A kink the geometry kept (an exact stop, a corner into an arc, a NURBS's kink) is
+    // stopped at; one below the blends' least turn is passed at its cap.
+    if turn >= MIN_BLEND_TURN || turn.is_nan() {
+        return 0.0;
+    }
+    let (ts, jerk) = (limits.ts, limits.jerk_limit());
+    let mut v = f64::INFINITY;
+    if turn > 0.0 {
+        v = (limits.accel * ts).min(jerk * ts * ts) / turn;
+    }
+    let jump = (before.kappa[1] - after.kappa[0]).abs();
+    if jump > 0.0 {
+        v = v.min((jerk * ts / jump).sqrt());
+    }
+    v
 }
 
 impl XyPlan {
     /// Plans `path` within `limits` (checked first).
     pub fn new(path: &Path, limits: &XyLimits) -> Result<Self, PathError> {
         limits.validate().map_err(PathError::invalid)?;
-        let geometry = planned_geometry(path, limits.tolerance)?;
-        let moves = geometry.moves();
-        let n = moves.len();
-        // A blend goes at the slower of the moves it joins.
-        let speeds: Vec<f64> = (0..n)
-            .map(|i| match moves[i].shape {
-                Shape::Blend(_) if i + 1 < n => limits
-                    .speed_of(&moves[i])
-                    .min(limits.speed_of(&moves[i + 1])),
-                _ => limits.speed_of(&moves[i]),
-            })
+        let (geometry, plan_pieces) = match planned_geometry(path, limits.tolerance)? {
+            Path::Program(program) => {
+                let pieces = program_pieces(&program, limits);
+                (Geometry::Program(program), pieces)
+            }
+            Path::Nurbs(nurbs) => {
+                let cut = NurbsPieces::new(&nurbs)?;
+                let pieces = nurbs_pieces(&cut, limits);
+                (Geometry::Nurbs(cut), pieces)
+            }
+            Path::Line(_) | Path::Arc(_) => {
+                return Err(PathError::invalid(
+                    "a line or an arc is planned as a program",
+                ))
+            }
+        };
+        let n = plan_pieces.len();
+        let pieces: Vec<PieceLimits> = plan_pieces
+            .iter()
+            .map(|p| piece_limits(p, limits))
             .collect();
-        let pieces: Vec<PieceLimits> = (0..n)
-            .map(|i| piece_limits(speeds[i], &moves[i].shape, limits))
-            .collect();
-        let lengths: Vec<f64> = (0..n).map(|i| moves[i].shape.curve().length()).collect();
+        let lengths: Vec<f64> = plan_pieces.iter().map(|p| p.length).collect();
         // Junction j is the start of piece j; 0 and n are the path's ends, at rest.
-        let jerk = limits.jerk_limit();
         let mut junction = vec![0.0; n + 1];
         for j in 1..n {
-            let (before, after) = (&moves[j - 1], &moves[j]);
-            let mut v = pieces[j - 1].speed.min(pieces[j].speed);
-            if before.corner == Corner::ExactStop {
-                v = 0.0;
-            }
-            let (t0, t1) = (tangent(&before.shape, 1.0), tangent(&after.shape, 0.0));
-            let turn = geometry::cross(&t0, &t1).atan2(t0.dot(&t1)).abs();
-            // A kink the geometry kept (an exact stop, or a corner into an arc) is
-            // stopped at; one below the blends' least turn is passed at its cap.
-            if turn >= MIN_BLEND_TURN {
-                v = 0.0;
-            } else if turn > 0.0 {
-                v = v.min((limits.accel * limits.ts).min(jerk * limits.ts * limits.ts) / turn);
-            }
-            let jump = (curvatures(&before.shape).0[1] - curvatures(&after.shape).0[0]).abs();
-            if jump > 0.0 {
-                v = v.min((jerk * limits.ts / jump).sqrt());
-            }
-            junction[j] = v;
+            let cap = junction_cap(&plan_pieces[j - 1], &plan_pieces[j], limits);
+            junction[j] = cap.min(pieces[j - 1].speed).min(pieces[j].speed);
         }
         // Look-ahead: slow in time for every later junction, then reach what the
         // earlier ones allow. The profiles get a margin of 10⁻⁹ of each length.
@@ -226,15 +330,14 @@ impl XyPlan {
         let mut phases = Vec::with_capacity(4 * n);
         let mut time = 0.0;
         for j in 0..n {
-            let start = geometry.start_of(j);
             time += plan_piece(
                 lengths[j],
                 (junction[j], junction[j + 1]),
                 &pieces[j],
-                (time, start),
+                (time, plan_pieces[j].start),
                 &mut phases,
             )
-            .map_err(|e| PathError::invalid(format!("the move of line {}: {e}", moves[j].line)))?;
+            .map_err(|e| PathError::invalid(format!("{}: {e}", plan_pieces[j].origin)))?;
         }
         if !(time.is_finite() && time > 0.0) {
             return Err(PathError::invalid(format!(
@@ -248,9 +351,12 @@ impl XyPlan {
         })
     }
 
-    /// The planned geometry.
-    pub fn geometry(&self) -> &Program {
-        &self.geometry
+    /// The planned geometry (a program's blended corners included).
+    pub fn geometry(&self) -> Path {
+        match &self.geometry {
+            Geometry::Program(p) => Path::Program(p.clone()),
+            Geometry::Nurbs(cut) => Path::Nurbs(cut.nurbs().clone()),
+        }
     }
 
     /// The planned duration, s.
@@ -258,10 +364,18 @@ impl XyPlan {
         self.duration
     }
 
+    /// The length of the planned geometry, mm.
+    fn length(&self) -> f64 {
+        match &self.geometry {
+            Geometry::Program(p) => p.length(),
+            Geometry::Nurbs(cut) => cut.length(),
+        }
+    }
+
     /// Where the plan stands at time `t` (clamped to the plan), moving `cursor` on from
     /// where it was: a run of increasing times costs O(1) a call, however long the path.
     pub fn at(&self, t: f64, cursor: &mut XyCursor) -> XyPoint {
-        let length = self.geometry.length();
+        let length = self.length();
         let (s, speed) = if t >= self.duration {
             (length, 0.0)
         } else {
@@ -273,14 +387,16 @@ impl XyPlan {
             let (s, v, _) = phase.at(t - phase.time);
             (s.clamp(0.0, length), v.max(0.0))
         };
-        let last = self.geometry.moves().len() - 1;
-        while cursor.piece < last && self.geometry.start_of(cursor.piece + 1) < s {
-            cursor.piece += 1;
-        }
-        XyPoint {
-            point: self.geometry.point_in(cursor.piece, s),
-            s,
-            speed,
-        }
+        let point = match &self.geometry {
+            Geometry::Program(program) => {
+                let last = program.moves().len() - 1;
+                while cursor.piece < last && program.start_of(cursor.piece + 1) < s {
+                    cursor.piece += 1;
+                }
+                program.point_in(cursor.piece, s)
+            }
+            Geometry::Nurbs(cut) => cut.point(s, &mut cursor.piece),
+        };
+        XyPoint { point, s, speed }
     }
 }

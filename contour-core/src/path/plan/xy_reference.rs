@@ -6,7 +6,6 @@
 use serde::{Deserialize, Serialize};
 
 use super::xy_plan::{XyCursor, XyLimits, XyPlan, XyPoint};
-use crate::path::program::Program;
 use crate::path::{Path, PathError};
 
 /// A planned XY reference at its latest sample.
@@ -73,7 +72,7 @@ impl XyReference {
     }
 
     /// The planned geometry (blended corners included).
-    pub fn geometry(&self) -> &Program {
+    pub fn geometry(&self) -> Path {
         self.plan.geometry()
     }
 
