@@ -338,16 +338,19 @@ fn a_planned_xy_reference_samples_without_allocating() {
         tolerance: 0.01,
         ts: 1e-3,
     };
-    let mut reference = XyReference::new(part, limits).unwrap();
-    let mut acc = 0.0;
-    let count = allocations_during(|| {
-        while !reference.done() {
-            let p = reference.step();
-            acc += black_box(p.point[0] + p.speed);
-        }
-    });
-    assert_eq!(count, 0, "a planned sample allocated");
-    assert!(acc.is_finite() && reference.duration() > 5.0);
+    // A program, and a NURBS on its arc-length map.
+    for path in [part, builtin::by_name("trident").unwrap()] {
+        let mut reference = XyReference::new(path, limits).unwrap();
+        let mut acc = 0.0;
+        let count = allocations_during(|| {
+            while !reference.done() {
+                let p = reference.step();
+                acc += black_box(p.point[0] + p.speed);
+            }
+        });
+        assert_eq!(count, 0, "a planned sample allocated");
+        assert!(acc.is_finite() && reference.duration() > 5.0);
+    }
 }
 
 #[test]
