@@ -129,20 +129,33 @@ fn blend_error_within(b: &CornerBlend, p: Vector2, (t0, t1): Span) -> TrueError 
         as usize)
         .clamp(2, BLEND_SAMPLES);
     let at = |k: usize| t0 + (t1 - t0) * k as f64 / samples as f64;
+    let mut d2 = [0.0; BLEND_SAMPLES + 1];
+    for (k, d) in d2.iter_mut().enumerate().take(samples + 1) {
+        *d = geometry::dist2(&b.point(at(k)), &p);
+    }
     let nearest = (0..=samples)
-        .min_by(|&i, &j| {
-            let (di, dj) = (
-                geometry::dist2(&b.point(at(i)), &p),
-                geometry::dist2(&b.point(at(j)), &p),
-            );
-            di.total_cmp(&dj)
-        })
+        .min_by(|&i, &j| d2[i].total_cmp(&d2[j]))
         .unwrap_or(0);
     let (lo, hi) = (
         at(nearest.saturating_sub(1)),
         at((nearest + 1).min(samples)),
     );
-    let (_, u) = refine(b, p, lo, hi, at(nearest));
+    // Newton starts at the vertex of the parabola through the squared distances of the
+    // nearest sample and its neighbours (two or three iterations fewer than from the
+    // sample itself).
+    let mut start = at(nearest);
+    if 0 < nearest && nearest < samples {
+        let (g0, g1, g2) = (d2[nearest - 1], d2[nearest], d2[nearest + 1]);
+        let curvature = g0 - 2.0 * g1 + g2;
+        if curvature > 0.0 {
+            let h = (t1 - t0) / samples as f64;
+            let vertex = start - 0.5 * h * (g2 - g0) / curvature;
+            if vertex > lo && vertex < hi {
+                start = vertex;
+            }
+        }
+    }
+    let (_, u) = refine(b, p, lo, hi, start);
     let mut e = finish(b, p, u);
     e.u = u;
     e
@@ -204,7 +217,11 @@ pub fn curve_true_error<C: Curve + ?Sized>(c: &C, p: Vector2) -> TrueError {
             // Each side of the sample on its own: the sample may be a knot.
             let a = us[i.saturating_sub(1)];
             let b = us[(i + 1).min(n - 1)];
-            for r in [refine(c, p, a, us[i], us[i]), refine(c, p, us[i], b, us[i])] {
+            let middle = |x: f64, y: f64| 0.5 * (x + y);
+            for r in [
+                refine(c, p, a, us[i], middle(a, us[i])),
+                refine(c, p, us[i], b, us[i]),
+            ] {
                 if r.0 < best.0 {
                     best = r;
                 }
@@ -218,16 +235,11 @@ pub fn curve_true_error<C: Curve + ?Sized>(c: &C, p: Vector2) -> TrueError {
 /// f(u) = (C − P)·C' with bisection fallback; also compares the bracket ends.
 /// Returns (distance, parameter).
 ///
-/// The iterates stay strictly inside the bracket (a start at an end starts from the
-/// middle): an end may be a knot where the curve kinks, and C' there is the next
-/// span's, which would stop the search at the knot (a degree-1 NURBS's corner, found
-/// planning issue 23's square as a NURBS).
+/// The iterates after the start stay strictly inside the bracket. The bracket's upper
+/// end may be a knot where the curve kinks, and C' there is the next span's, which would
+/// stop the search at the knot (a degree-1 NURBS's corner, found planning issue 23's
+/// square as a NURBS): callers never start there on a NURBS.
 fn refine<C: Curve + ?Sized>(c: &C, p: Vector2, a0: f64, b0: f64, u0: f64) -> (f64, f64) {
-    let u0 = if u0 > a0 && u0 < b0 {
-        u0
-    } else {
-        0.5 * (a0 + b0)
-    };
     let (mut a, mut b, mut u) = (a0, b0, u0);
     for _ in 0..64 {
         let e = c.eval(u);
@@ -253,14 +265,14 @@ fn refine<C: Curve + ?Sized>(c: &C, p: Vector2, a0: f64, b0: f64, u0: f64) -> (f
             break;
         }
     }
-    let mut best = (geometry::dist(&c.point(u), &p), u);
+    let mut best = (geometry::dist2(&c.point(u), &p), u);
     for v in [a0, b0] {
-        let d = geometry::dist(&c.point(v), &p);
+        let d = geometry::dist2(&c.point(v), &p);
         if d < best.0 {
             best = (d, v);
         }
     }
-    best
+    (best.0.sqrt(), best.1)
 }
 
 /// Builds the result at foot parameter `u`.
@@ -394,6 +406,8 @@ const CHUNK_LEN: f64 = 0.5;
 const CHUNK_TURN: f64 = 0.2;
 /// Sub-intervals sampled per chunk (box building and the per-chunk search).
 const CHUNK_SUB: usize = 4;
+/// A stretch of at most this many chunks is searched box by box, not through the tree.
+const SCAN_CHUNKS: usize = 64;
 
 /// Exact true contour error with a hint parameter, for closed-loop use (see module docs).
 #[derive(Clone, Debug)]
@@ -527,6 +541,22 @@ impl TrueErrorIndex {
         let mut best = self.chunk_min(first, p, from, to);
         let mut best_chunk = first;
         let mut best2 = best.0 * best.0;
+        // A short stretch (a window along the path) is scanned box by box: cheaper than
+        // descending the tree to it, and the same chunks pass the same test.
+        if chunks.len() <= SCAN_CHUNKS {
+            for i in chunks {
+                if i == first || box_dist2(&self.tree[self.leaves + i], p) > best2 {
+                    continue;
+                }
+                let r = self.chunk_min(i, p, from, to);
+                if r.0 < best.0 || r.0 == best.0 && i < best_chunk {
+                    best = r;
+                    best2 = r.0 * r.0;
+                    best_chunk = i;
+                }
+            }
+            return (best_chunk, self.result(best, p));
+        }
         let mut pending = Pending::root();
         while let Some(node) = pending.pop() {
             let leaves = self.leaves_of(node);
@@ -579,9 +609,20 @@ impl TrueErrorIndex {
         if found.0 <= tolerance {
             return Some((start, self.result(found, p)));
         }
+        // Where it has moved on to: the next few chunks in turn, then the tree beyond.
+        let scanned = (start + 1 + SCAN_CHUNKS).min(self.chunks.len());
+        for i in start + 1..scanned {
+            if box_dist2(&self.tree[self.leaves + i], p) > limit {
+                continue;
+            }
+            let found = self.chunk_min(i, p, from, f64::INFINITY);
+            if found.0 <= tolerance {
+                return Some((i, self.result(found, p)));
+            }
+        }
         let mut pending = Pending::root();
         while let Some(node) = pending.pop() {
-            if self.leaves_of(node).end <= start + 1 || box_dist2(&self.tree[node], p) > limit {
+            if self.leaves_of(node).end <= scanned || box_dist2(&self.tree[node], p) > limit {
                 continue;
             }
             if node >= self.leaves {
@@ -735,7 +776,13 @@ impl TrueErrorIndex {
         } else {
             u0 + h * (bi + 1) as f64
         };
-        refine(&self.path, p, a, b.min(u1), u0 + h * bi as f64)
+        // Not from the chunk's end, which may be a knot (see `refine`).
+        let start = if bi == CHUNK_SUB {
+            0.5 * (a + u1)
+        } else {
+            u0 + h * bi as f64
+        };
+        refine(&self.path, p, a, b.min(u1), start)
     }
 }
 
