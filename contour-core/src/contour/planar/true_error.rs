@@ -98,9 +98,15 @@ fn move_true_error(program: &Program, i: usize, p: Vector2, span: Span) -> TrueE
         _ => None,
     };
     if let Some((before, after)) = neighbour {
-        let tangent = |j: usize, u: f64| {
-            let d = moves[j].shape.curve().eval(u).d1;
-            d * (1.0 / geometry::norm(&d))
+        // The unit tangent at a move's start (u = 0) or end (1); a line's and a blend's
+        // without evaluating them.
+        let tangent = |j: usize, u: f64| match &moves[j].shape {
+            Shape::Line(l) => l.direction(),
+            Shape::Blend(b) => b.end_directions()[(u == 1.0) as usize],
+            Shape::Arc(a) => {
+                let d = a.eval(u).d1;
+                d * (1.0 / geometry::norm(&d))
+            }
         };
         let bisector = tangent(before, 1.0) + tangent(after, 0.0);
         let length = geometry::norm(&bisector);
@@ -136,10 +142,8 @@ fn blend_error_within(b: &CornerBlend, p: Vector2, (t0, t1): Span) -> TrueError 
     let nearest = (0..=samples)
         .min_by(|&i, &j| d2[i].total_cmp(&d2[j]))
         .unwrap_or(0);
-    let (lo, hi) = (
-        at(nearest.saturating_sub(1)),
-        at((nearest + 1).min(samples)),
-    );
+    let (below, above) = (nearest.saturating_sub(1), (nearest + 1).min(samples));
+    let (lo, hi) = (at(below), at(above));
     // Newton starts at the vertex of the parabola through the squared distances of the
     // nearest sample and its neighbours (two or three iterations fewer than from the
     // sample itself).
@@ -155,7 +159,7 @@ fn blend_error_within(b: &CornerBlend, p: Vector2, (t0, t1): Span) -> TrueError 
             }
         }
     }
-    let (_, u) = refine(b, p, lo, hi, start);
+    let (_, u) = refine_between(b, p, [(lo, d2[below]), (hi, d2[above])], start);
     let mut e = finish(b, p, u);
     e.u = u;
     e
@@ -240,6 +244,17 @@ pub fn curve_true_error<C: Curve + ?Sized>(c: &C, p: Vector2) -> TrueError {
 /// stop the search at the knot (a degree-1 NURBS's corner, found planning issue 23's
 /// square as a NURBS): callers never start there on a NURBS.
 fn refine<C: Curve + ?Sized>(c: &C, p: Vector2, a0: f64, b0: f64, u0: f64) -> (f64, f64) {
+    let ends = [a0, b0].map(|v| geometry::dist2(&c.point(v), &p));
+    refine_between(c, p, [(a0, ends[0]), (b0, ends[1])], u0)
+}
+
+/// [`refine`] with the squared distances at the bracket's ends already known (sampled).
+fn refine_between<C: Curve + ?Sized>(
+    c: &C,
+    p: Vector2,
+    [(a0, da), (b0, db)]: [(f64, f64); 2],
+    u0: f64,
+) -> (f64, f64) {
     let (mut a, mut b, mut u) = (a0, b0, u0);
     for _ in 0..64 {
         let e = c.eval(u);
@@ -266,8 +281,7 @@ fn refine<C: Curve + ?Sized>(c: &C, p: Vector2, a0: f64, b0: f64, u0: f64) -> (f
         }
     }
     let mut best = (geometry::dist2(&c.point(u), &p), u);
-    for v in [a0, b0] {
-        let d = geometry::dist2(&c.point(v), &p);
+    for (v, d) in [(a0, da), (b0, db)] {
         if d < best.0 {
             best = (d, v);
         }
@@ -407,7 +421,7 @@ const CHUNK_TURN: f64 = 0.2;
 /// Sub-intervals sampled per chunk (box building and the per-chunk search).
 const CHUNK_SUB: usize = 4;
 /// A stretch of at most this many chunks is searched box by box, not through the tree.
-const SCAN_CHUNKS: usize = 64;
+const SCAN_CHUNKS: usize = 16;
 
 /// Exact true contour error with a hint parameter, for closed-loop use (see module docs).
 #[derive(Clone, Debug)]
@@ -557,34 +571,40 @@ impl TrueErrorIndex {
             }
             return (best_chunk, self.result(best, p));
         }
+        // Bottom up from the hint's leaf: the sibling of each of its ancestors in turn
+        // (each searched top down), so a tool near the hint's chunk costs a box a level
+        // rather than a descent from the root to it.
+        let mut ancestor = self.leaves + first;
         let mut pending = Pending::root();
-        while let Some(node) = pending.pop() {
-            let leaves = self.leaves_of(node);
-            // Strictly farther only: a move as near as the best may be an earlier one,
-            // which wins the tie whatever the hint.
-            if leaves.end <= chunks.start
-                || leaves.start >= chunks.end
-                || box_dist2(&self.tree[node], p) > best2
-            {
-                continue;
-            }
-            if node >= self.leaves {
-                let i = node - self.leaves;
-                if i != first {
+        while ancestor > 1 {
+            pending.restart(ancestor ^ 1);
+            ancestor /= 2;
+            while let Some(node) = pending.pop() {
+                let leaves = self.leaves_of(node);
+                // Strictly farther only: a move as near as the best may be an earlier
+                // one, which wins the tie whatever the hint.
+                if leaves.end <= chunks.start
+                    || leaves.start >= chunks.end
+                    || box_dist2(&self.tree[node], p) > best2
+                {
+                    continue;
+                }
+                if node >= self.leaves {
+                    let i = node - self.leaves;
                     let r = self.chunk_min(i, p, from, to);
                     if r.0 < best.0 || r.0 == best.0 && i < best_chunk {
                         best = r;
                         best2 = r.0 * r.0;
                         best_chunk = i;
                     }
-                }
-            } else {
-                let (l, r) = (2 * node, 2 * node + 1);
-                // The nearer child is searched first.
-                if box_dist2(&self.tree[l], p) <= box_dist2(&self.tree[r], p) {
-                    pending.push(r, l);
                 } else {
-                    pending.push(l, r);
+                    let (l, r) = (2 * node, 2 * node + 1);
+                    // The nearer child is searched first.
+                    if box_dist2(&self.tree[l], p) <= box_dist2(&self.tree[r], p) {
+                        pending.push(r, l);
+                    } else {
+                        pending.push(l, r);
+                    }
                 }
             }
         }
@@ -803,6 +823,12 @@ impl Pending {
         let mut nodes = [0; 128];
         nodes[0] = 1;
         Pending { nodes, top: 1 }
+    }
+
+    /// `node` alone, the stack reused.
+    fn restart(&mut self, node: usize) {
+        self.nodes[0] = node;
+        self.top = 1;
     }
 
     fn pop(&mut self) -> Option<usize> {

@@ -193,6 +193,11 @@ impl CornerBlend {
         self.turn.abs() / (self.half * self.half)
     }
 
+    /// The unit directions at its start and its end: the lines' (no Fresnel sum).
+    pub fn end_directions(&self) -> [Vector2; 2] {
+        [self.incoming, self.outgoing]
+    }
+
     /// The three corners of the triangle the blend lies in: its ends and the vertex.
     pub fn hull(&self) -> [Vector2; 3] {
         [
