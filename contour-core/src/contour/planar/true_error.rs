@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 use crate::contour::ContourEstimate;
 use crate::geometry::{self, Vector, Vector2};
 use crate::path::program::{CornerBlend, Shape};
-use crate::path::{CircularArc, Curve, Line, Path, Program};
+use crate::path::{CircularArc, Curve, CurvePoint, Line, Path, Program};
 
 /// Exact contour error of one point.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -159,10 +159,16 @@ fn blend_error_within(b: &CornerBlend, p: Vector2, (t0, t1): Span) -> TrueError 
             }
         }
     }
-    let (_, u) = refine_between(b, p, [(lo, d2[below]), (hi, d2[above])], start);
-    let mut e = finish(b, p, u);
-    e.u = u;
-    e
+    // The iterate or a bracket end, whichever is nearer; the iterate's evaluation
+    // serves the result too.
+    let u = newton(b, p, (lo, hi), start);
+    let at = b.eval(u);
+    if geometry::dist2(&at.p, &p) <= d2[below].min(d2[above]) {
+        finish_at(b, at, p, u)
+    } else {
+        let end = if d2[below] <= d2[above] { lo } else { hi };
+        finish(b, p, end)
+    }
 }
 
 /// The box of a segment: its end points.
@@ -252,9 +258,22 @@ fn refine<C: Curve + ?Sized>(c: &C, p: Vector2, a0: f64, b0: f64, u0: f64) -> (f
 fn refine_between<C: Curve + ?Sized>(
     c: &C,
     p: Vector2,
-    [(a0, da), (b0, db)]: [(f64, f64); 2],
+    ends: [(f64, f64); 2],
     u0: f64,
 ) -> (f64, f64) {
+    let u = newton(c, p, (ends[0].0, ends[1].0), u0);
+    let mut best = (geometry::dist2(&c.point(u), &p), u);
+    for (v, d) in ends {
+        if d < best.0 {
+            best = (d, v);
+        }
+    }
+    (best.0.sqrt(), best.1)
+}
+
+/// The safeguarded Newton iteration of [`refine`] in the bracket (a0, b0) from `u0`:
+/// its last iterate.
+fn newton<C: Curve + ?Sized>(c: &C, p: Vector2, (a0, b0): (f64, f64), u0: f64) -> f64 {
     let (mut a, mut b, mut u) = (a0, b0, u0);
     // The last Newton step (not a bisection), for the convergence forecast.
     let mut last_newton = f64::NAN;
@@ -291,26 +310,25 @@ fn refine_between<C: Curve + ?Sized>(
         }
         last_newton = if newton { step } else { f64::NAN };
     }
-    let mut best = (geometry::dist2(&c.point(u), &p), u);
-    for (v, d) in [(a0, da), (b0, db)] {
-        if d < best.0 {
-            best = (d, v);
-        }
-    }
-    (best.0.sqrt(), best.1)
+    u
 }
 
 /// Builds the result at foot parameter `u`.
 fn finish<C: Curve + ?Sized>(c: &C, p: Vector2, u: f64) -> TrueError {
-    let e = c.eval(u);
+    finish_at(c, c.eval(u), p, u)
+}
+
+/// [`finish`] with the curve already evaluated at `u`.
+fn finish_at<C: Curve + ?Sized>(c: &C, e: CurvePoint, p: Vector2, u: f64) -> TrueError {
     let mut t = e.d1;
-    if geometry::norm(&t) < 1e-12 {
+    let mut tl = geometry::norm(&t);
+    if tl < 1e-12 {
         // Degenerate speed (repeated control points): use a short secant instead.
         let (lo, hi) = c.param_range();
         let h = 1e-7 * (hi - lo);
         t = c.point((u + h).min(hi)) - c.point((u - h).max(lo));
+        tl = geometry::norm(&t);
     }
-    let tl = geometry::norm(&t);
     let t = if tl > 0.0 {
         t * (1.0 / tl)
     } else {
