@@ -137,8 +137,11 @@ impl ProgramEstimator {
         let t = &mut self.track;
         let index = &self.index;
         let last = t.reference_at();
+        // Where it would be at the speed of its last step.
+        let previous = t.history[(t.newest + WINDOW - 1) % WINDOW];
+        let guess = last + (last - previous);
         let (chunk, e) = index
-            .first_within(reference, last, ON_PATH)
+            .first_within_near(reference, last, guess, ON_PATH)
             .unwrap_or_else(|| {
                 let (chunk, e) =
                     index.error_between(reference, t.reference_chunk, last, f64::INFINITY);

@@ -650,11 +650,30 @@ impl TrueErrorIndex {
         from: f64,
         tolerance: f64,
     ) -> Option<(usize, TrueError)> {
+        self.first_within_near(p, from, f64::NAN, tolerance)
+    }
+
+    /// [`TrueErrorIndex::first_within`] for a point that moves on along the path (the
+    /// reference), whose place can be guessed (the arc length `guess`): on a blend that
+    /// holds the guess, Newton from there instead of from samples. The same chunk and
+    /// foot as first_within's wherever it finds the point within `tolerance` inside the
+    /// blend; otherwise first_within's search of that chunk.
+    pub fn first_within_near(
+        &self,
+        p: Vector2,
+        from: f64,
+        guess: f64,
+        tolerance: f64,
+    ) -> Option<(usize, TrueError)> {
         let start = self.chunks_between(from, f64::INFINITY).start;
         let limit = tolerance * tolerance;
+        let chunk_min = |i: usize| {
+            self.near_guess(i, p, from, guess, tolerance)
+                .unwrap_or_else(|| self.chunk_min(i, p, from, f64::INFINITY))
+        };
         // The first chunk in path order, where a point that moves on along the path (the
         // reference) mostly still is: found there, the tree is not searched.
-        let found = self.chunk_min(start, p, from, f64::INFINITY);
+        let found = chunk_min(start);
         if found.0 <= tolerance {
             return Some((start, self.result(found, p)));
         }
@@ -664,7 +683,7 @@ impl TrueErrorIndex {
             if box_dist2(&self.tree[self.leaves + i], p) > limit {
                 continue;
             }
-            let found = self.chunk_min(i, p, from, f64::INFINITY);
+            let found = chunk_min(i);
             if found.0 <= tolerance {
                 return Some((i, self.result(found, p)));
             }
@@ -686,6 +705,40 @@ impl TrueErrorIndex {
             }
         }
         None
+    }
+
+    /// The distance from `p` to chunk `i` after the arc length `from` when the chunk is
+    /// a blend holding the arc length `guess` and Newton from there finds a foot within
+    /// `tolerance` inside it.
+    fn near_guess(
+        &self,
+        i: usize,
+        p: Vector2,
+        from: f64,
+        guess: f64,
+        tolerance: f64,
+    ) -> Option<ChunkMin> {
+        let Path::Program(program) = &self.path else {
+            return None;
+        };
+        let Shape::Blend(b) = &program.moves()[i].shape else {
+            return None;
+        };
+        let (a, end) = (self.lengths[i], self.lengths[i + 1]);
+        let (t0, t1) = self.move_span(i, from, f64::INFINITY);
+        let u = (guess - a) / (end - a);
+        if !(t0 < u && u < t1) {
+            return None;
+        }
+        let foot = newton(b, p, (t0, t1), u);
+        let at = b.eval(foot);
+        let d = geometry::dist(&at.p, &p);
+        if !(t0 < foot && foot < t1 && d <= tolerance) {
+            return None;
+        }
+        let mut e = finish_at(b, at, p, foot);
+        e.u = program.position(i, foot);
+        Some((d, e.u, Some(e)))
     }
 
     /// Arc length from the path's start to parameter `u` of chunk `i` (within the chunk
