@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 use crate::contour::ContourEstimate;
 use crate::geometry::{self, Vector, Vector2};
 use crate::path::program::{CornerBlend, Shape};
-use crate::path::{CircularArc, Curve, CurvePoint, Line, Path, Program};
+use crate::path::{CircularArc, Curve, CurvePoint, Line, Nurbs, Path, Program};
 
 /// Exact contour error of one point.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -55,7 +55,7 @@ pub fn true_error(path: &Path, p: Vector2) -> TrueError {
     match path {
         Path::Line(l) => line_true_error(l, p),
         Path::Arc(a) => arc_true_error(a, p),
-        Path::Nurbs(n) => curve_true_error(n, p),
+        Path::Nurbs(n) => at_kink(n, p, curve_true_error(n, p)),
         Path::Program(program) => (0..program.moves().len())
             .map(|i| move_true_error(program, i, p, WHOLE))
             .fold(None, |best: Option<TrueError>, e| match best {
@@ -311,6 +311,34 @@ fn newton<C: Curve + ?Sized>(c: &C, p: Vector2, (a0, b0): (f64, f64), u0: f64) -
         last_newton = if newton { step } else { f64::NAN };
     }
     u
+}
+
+/// `e` signed again where its foot is a NURBS's kink (an interior knot where the tangent
+/// turns): against the bisector of the tangents from below and above, as a program's
+/// corner is ([`move_true_error`]); the next span's tangent alone puts a point beyond a
+/// corner of more than 90° on the wrong side.
+fn at_kink(n: &Nurbs, p: Vector2, mut e: TrueError) -> TrueError {
+    let (a, b) = n.param_range();
+    if !(e.u > a && e.u < b && n.knots().contains(&e.u)) {
+        return e;
+    }
+    let unit = |d: Vector2| {
+        let l = geometry::norm(&d);
+        (l > 0.0).then(|| d * (1.0 / l))
+    };
+    let (Some(before), Some(after)) = (unit(n.eval_from_below(e.u).d1), unit(n.eval(e.u).d1))
+    else {
+        return e;
+    };
+    let bisector = before + after;
+    let length = geometry::norm(&bisector);
+    // A reversal has no bisector, and a smooth knot needs none.
+    if length > 1e-9 && geometry::cross(&before, &after).abs() > 1e-12 {
+        let here = signed(p, e.foot, bisector * (1.0 / length), e.u);
+        e.error = here.error;
+        e.normal = here.normal;
+    }
+    e
 }
 
 /// Builds the result at foot parameter `u`.
@@ -583,7 +611,10 @@ impl TrueErrorIndex {
         let first = hint.clamp(chunks.start, chunks.end - 1);
         let mut best = self.chunk_min(first, p, from, to);
         let mut best_chunk = first;
-        let mut best2 = best.0 * best.0;
+        // Squared, with a margin: a box's exact squared distance can exceed the square of
+        // a tie's rounded distance, and a tie must be evaluated (the earlier chunk wins).
+        let margin = 1.0 + 1e-12;
+        let mut best2 = best.0 * best.0 * margin;
         // A short stretch (a window along the path) is scanned box by box: cheaper than
         // descending the tree to it, and the same chunks pass the same test.
         if chunks.len() <= SCAN_CHUNKS {
@@ -594,7 +625,7 @@ impl TrueErrorIndex {
                 let r = self.chunk_min(i, p, from, to);
                 if r.0 < best.0 || r.0 == best.0 && i < best_chunk {
                     best = r;
-                    best2 = r.0 * r.0;
+                    best2 = r.0 * r.0 * margin;
                     best_chunk = i;
                 }
             }
@@ -623,7 +654,7 @@ impl TrueErrorIndex {
                     let r = self.chunk_min(i, p, from, to);
                     if r.0 < best.0 || r.0 == best.0 && i < best_chunk {
                         best = r;
-                        best2 = r.0 * r.0;
+                        best2 = r.0 * r.0 * margin;
                         best_chunk = i;
                     }
                 } else {
@@ -818,7 +849,10 @@ impl TrueErrorIndex {
     fn result(&self, found: ChunkMin, p: Vector2) -> TrueError {
         match found.2 {
             Some(e) => e,
-            None => finish(&self.path, p, found.1),
+            None => match &self.path {
+                Path::Nurbs(n) => at_kink(n, p, finish(n, p, found.1)),
+                _ => finish(&self.path, p, found.1),
+            },
         }
     }
 
@@ -988,6 +1022,45 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    #[test]
+    fn a_point_beyond_a_sharp_corner_is_signed_by_the_bisector_and_ties_go_to_the_earlier_move() {
+        // A corner of 153° as a polygon NURBS and as G-code: beyond its tip both put the
+        // point right of travel (the bisector's side; the next edge's tangent alone says
+        // left). Found in review.
+        let polygon = Path::Nurbs(
+            crate::path::Nurbs::new(
+                1,
+                vec![0.0, 0.0, 0.5, 1.0, 1.0],
+                vec![[0.0, 0.0], [10.0, 0.0], [0.0, 5.0]],
+                None,
+            )
+            .unwrap(),
+        );
+        let program = Path::Program(
+            crate::path::program::parse_program("G1 X10 F600\nX0 Y5\n", "tip.ngc").unwrap(),
+        );
+        let p = Vector2::new(11.0, -0.8);
+        let want = 1.0f64.hypot(0.8);
+        for path in [&polygon, &program] {
+            let index = TrueErrorIndex::new(path);
+            for e in [
+                true_error(path, p),
+                index.error(p, 0.0),
+                index.error(p, 1e9),
+            ] {
+                assert!((e.error - want).abs() < 1e-12, "{path:?}: {}", e.error);
+            }
+        }
+        // Equidistant from two moves (the foot their shared vertex): the earlier move,
+        // whichever the search starts from.
+        let index = TrueErrorIndex::new(&program);
+        let q = Vector2::new(10.0, 0.0) + Vector2::new(2.0, -3.0);
+        for hint in [0, 1] {
+            let (chunk, _) = index.error_between(q, hint, f64::NEG_INFINITY, f64::INFINITY);
+            assert_eq!(chunk, 0, "hint {hint}");
         }
     }
 

@@ -339,9 +339,14 @@ fn group(nurbs: &Nurbs, knots: &[f64], probes: &[Probe]) -> Vec<NurbsPiece> {
         })
         .collect();
     let mut pieces: Vec<NurbsPiece> = Vec::new();
+    let mut next_break = 0;
     let (mut turn, mut low) = (0.0f64, 0.0f64);
     for (i, p) in probes.iter().enumerate() {
-        let starts_at_break = breaks.contains(&p.cell.u[0]);
+        // Cells and breaks both come in parameter order: one pass over each.
+        while next_break < breaks.len() && breaks[next_break] < p.cell.u[0] {
+            next_break += 1;
+        }
+        let starts_at_break = breaks.get(next_break) == Some(&p.cell.u[0]);
         let joins = i > 0 && !starts_at_break && {
             let last = pieces.last().expect("a piece before");
             let high = last.kappa_max.max(p.kappa_max());
