@@ -319,7 +319,7 @@ fn the_exact_distance_to_a_blended_program_is_the_dense_samples_nearest() {
 #[test]
 fn a_nurbs_is_planned_on_itself_within_the_limits() {
     use contour_core::path::builtin;
-    use contour_core::path::{Curve, Nurbs};
+    use contour_core::path::{clamped_uniform_knots, Curve, Nurbs};
     let knots_inside = |n: &Nurbs| -> Vec<Vector2> {
         let (a, b) = n.param_range();
         n.knots()
@@ -331,7 +331,7 @@ fn a_nurbs_is_planned_on_itself_within_the_limits() {
     // A 20 mm square as a degree-1 NURBS (issue 23's square): stops at its corners.
     let square = Nurbs::new(
         1,
-        vec![0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0],
+        clamped_uniform_knots(5, 1),
         vec![
             [0.0, 0.0],
             [20.0, 0.0],

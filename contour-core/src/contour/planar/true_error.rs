@@ -98,26 +98,27 @@ fn move_true_error(program: &Program, i: usize, p: Vector2, span: Span) -> TrueE
         _ => None,
     };
     if let Some((before, after)) = neighbour {
-        // The unit tangent at a move's start (u = 0) or end (1); a line's and a blend's
-        // without evaluating them.
-        let tangent = |j: usize, u: f64| match &moves[j].shape {
-            Shape::Line(l) => l.direction(),
-            Shape::Blend(b) => b.end_directions()[(u == 1.0) as usize],
-            Shape::Arc(a) => {
-                let d = a.eval(u).d1;
-                d * (1.0 / geometry::norm(&d))
-            }
-        };
-        let bisector = tangent(before, 1.0) + tangent(after, 0.0);
-        let length = geometry::norm(&bisector);
-        // A reversal has no bisector: the move's own side stands.
-        if length > 1e-9 {
-            let signed_here = signed(p, e.foot, bisector * (1.0 / length), e.u);
-            e.error = signed_here.error;
-            e.normal = signed_here.normal;
-        }
+        let (t0, t1) = (
+            moves[before].shape.end_tangent(1),
+            moves[after].shape.end_tangent(0),
+        );
+        e = signed_at_corner(p, e, t0, t1);
     }
     e.u = program.position(i, e.u);
+    e
+}
+
+/// `e`, whose foot is a corner between unit tangents `before` and `after`, signed against
+/// their bisector: against either one alone, a point beyond a corner that turns by more
+/// than 90° would be on the wrong side. A reversal has no bisector: `e` stands.
+fn signed_at_corner(p: Vector2, mut e: TrueError, before: Vector2, after: Vector2) -> TrueError {
+    let bisector = before + after;
+    let length = geometry::norm(&bisector);
+    if length > 1e-9 {
+        let here = signed(p, e.foot, bisector * (1.0 / length), e.u);
+        e.error = here.error;
+        e.normal = here.normal;
+    }
     e
 }
 
@@ -250,20 +251,10 @@ pub fn curve_true_error<C: Curve + ?Sized>(c: &C, p: Vector2) -> TrueError {
 /// stop the search at the knot (a degree-1 NURBS's corner, found planning issue 23's
 /// square as a NURBS): callers never start there on a NURBS.
 fn refine<C: Curve + ?Sized>(c: &C, p: Vector2, a0: f64, b0: f64, u0: f64) -> (f64, f64) {
-    let ends = [a0, b0].map(|v| geometry::dist2(&c.point(v), &p));
-    refine_between(c, p, [(a0, ends[0]), (b0, ends[1])], u0)
-}
-
-/// [`refine`] with the squared distances at the bracket's ends already known (sampled).
-fn refine_between<C: Curve + ?Sized>(
-    c: &C,
-    p: Vector2,
-    ends: [(f64, f64); 2],
-    u0: f64,
-) -> (f64, f64) {
-    let u = newton(c, p, (ends[0].0, ends[1].0), u0);
+    let u = newton(c, p, (a0, b0), u0);
     let mut best = (geometry::dist2(&c.point(u), &p), u);
-    for (v, d) in ends {
+    for v in [a0, b0] {
+        let d = geometry::dist2(&c.point(v), &p);
         if d < best.0 {
             best = (d, v);
         }
@@ -317,7 +308,7 @@ fn newton<C: Curve + ?Sized>(c: &C, p: Vector2, (a0, b0): (f64, f64), u0: f64) -
 /// turns): against the bisector of the tangents from below and above, as a program's
 /// corner is ([`move_true_error`]); the next span's tangent alone puts a point beyond a
 /// corner of more than 90° on the wrong side.
-fn at_kink(n: &Nurbs, p: Vector2, mut e: TrueError) -> TrueError {
+fn at_kink(n: &Nurbs, p: Vector2, e: TrueError) -> TrueError {
     let (a, b) = n.param_range();
     if !(e.u > a && e.u < b && n.knots().contains(&e.u)) {
         return e;
@@ -330,15 +321,12 @@ fn at_kink(n: &Nurbs, p: Vector2, mut e: TrueError) -> TrueError {
     else {
         return e;
     };
-    let bisector = before + after;
-    let length = geometry::norm(&bisector);
-    // A reversal has no bisector, and a smooth knot needs none.
-    if length > 1e-9 && geometry::cross(&before, &after).abs() > 1e-12 {
-        let here = signed(p, e.foot, bisector * (1.0 / length), e.u);
-        e.error = here.error;
-        e.normal = here.normal;
+    // A smooth knot needs no bisector.
+    if geometry::cross(&before, &after).abs() > 1e-12 {
+        signed_at_corner(p, e, before, after)
+    } else {
+        e
     }
-    e
 }
 
 /// Builds the result at foot parameter `u`.
@@ -609,27 +597,16 @@ impl TrueErrorIndex {
     pub fn error_between(&self, p: Vector2, hint: usize, from: f64, to: f64) -> (usize, TrueError) {
         let chunks = self.chunks_between(from, to);
         let first = hint.clamp(chunks.start, chunks.end - 1);
-        let mut best = self.chunk_min(first, p, from, to);
-        let mut best_chunk = first;
-        // Squared, with a margin: a box's exact squared distance can exceed the square of
-        // a tie's rounded distance, and a tie must be evaluated (the earlier chunk wins).
-        let margin = 1.0 + 1e-12;
-        let mut best2 = best.0 * best.0 * margin;
+        let mut best = Nearest::new(first, self.chunk_min(first, p, from, to));
         // A short stretch (a window along the path) is scanned box by box: cheaper than
         // descending the tree to it, and the same chunks pass the same test.
         if chunks.len() <= SCAN_CHUNKS {
             for i in chunks {
-                if i == first || box_dist2(&self.tree[self.leaves + i], p) > best2 {
-                    continue;
-                }
-                let r = self.chunk_min(i, p, from, to);
-                if r.0 < best.0 || r.0 == best.0 && i < best_chunk {
-                    best = r;
-                    best2 = r.0 * r.0 * margin;
-                    best_chunk = i;
+                if i != first && box_dist2(&self.tree[self.leaves + i], p) <= best.bound2 {
+                    best.offer(i, self.chunk_min(i, p, from, to));
                 }
             }
-            return (best_chunk, self.result(best, p));
+            return (best.chunk, self.result(best.found, p));
         }
         // Bottom up from the hint's leaf: the sibling of each of its ancestors in turn
         // (each searched top down), so a tool near the hint's chunk costs a box a level
@@ -645,18 +622,13 @@ impl TrueErrorIndex {
                 // one, which wins the tie whatever the hint.
                 if leaves.end <= chunks.start
                     || leaves.start >= chunks.end
-                    || box_dist2(&self.tree[node], p) > best2
+                    || box_dist2(&self.tree[node], p) > best.bound2
                 {
                     continue;
                 }
                 if node >= self.leaves {
                     let i = node - self.leaves;
-                    let r = self.chunk_min(i, p, from, to);
-                    if r.0 < best.0 || r.0 == best.0 && i < best_chunk {
-                        best = r;
-                        best2 = r.0 * r.0 * margin;
-                        best_chunk = i;
-                    }
+                    best.offer(i, self.chunk_min(i, p, from, to));
                 } else {
                     let (l, r) = (2 * node, 2 * node + 1);
                     // The nearer child is searched first.
@@ -668,7 +640,7 @@ impl TrueErrorIndex {
                 }
             }
         }
-        (best_chunk, self.result(best, p))
+        (best.chunk, self.result(best.found, p))
     }
 
     /// The first place at or after the arc length `from`, in path order, where the path
@@ -926,6 +898,33 @@ impl TrueErrorIndex {
 /// solved exactly (a move, a line, an arc), the signed result.
 type ChunkMin = (f64, f64, Option<TrueError>);
 
+/// The nearest chunk a search has found so far.
+struct Nearest {
+    chunk: usize,
+    found: ChunkMin,
+    /// The squared distance a box must not exceed to be searched: the best's, with a
+    /// margin (a box's exact squared distance can exceed the square of a tie's rounded
+    /// distance, and a tie must be evaluated: the earlier chunk wins it).
+    bound2: f64,
+}
+
+impl Nearest {
+    fn new(chunk: usize, found: ChunkMin) -> Self {
+        Nearest {
+            chunk,
+            found,
+            bound2: found.0 * found.0 * (1.0 + 1e-12),
+        }
+    }
+
+    /// Takes chunk `i`'s result if it is nearer, or as near and earlier.
+    fn offer(&mut self, i: usize, found: ChunkMin) {
+        if found.0 < self.found.0 || found.0 == self.found.0 && i < self.chunk {
+            *self = Nearest::new(i, found);
+        }
+    }
+}
+
 /// The tree nodes still to visit, depth first: a stack of depth ≤ 2·log2(leaves) fits
 /// (a path of up to 2⁶³ chunks), so nothing is allocated.
 struct Pending {
@@ -992,7 +991,7 @@ mod tests {
         let square = Path::Nurbs(
             crate::path::Nurbs::new(
                 1,
-                vec![0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0],
+                crate::path::clamped_uniform_knots(5, 1),
                 vec![
                     [0.0, 0.0],
                     [20.0, 0.0],
@@ -1033,7 +1032,7 @@ mod tests {
         let polygon = Path::Nurbs(
             crate::path::Nurbs::new(
                 1,
-                vec![0.0, 0.0, 0.5, 1.0, 1.0],
+                crate::path::clamped_uniform_knots(3, 1),
                 vec![[0.0, 0.0], [10.0, 0.0], [0.0, 5.0]],
                 None,
             )

@@ -168,7 +168,7 @@ fn direction(e: &CurvePoint, leaving: bool) -> Vector2 {
 impl NurbsPieces {
     /// Cuts `nurbs` (module docs); refuses a curve of zero length or one that needs more
     /// than [`MAX_CELLS`] cells.
-    pub fn new(nurbs: &Nurbs) -> Result<Self, PathError> {
+    pub fn new(nurbs: Nurbs) -> Result<Self, PathError> {
         let mut knots = nurbs.breakpoints();
         knots.dedup();
         let mut probes = Vec::new();
@@ -177,7 +177,7 @@ impl NurbsPieces {
         for span in knots.windows(2) {
             let (u0, u1) = (span[0], span[1]);
             cut(
-                nurbs,
+                &nurbs,
                 (u0, u1, true),
                 MAX_DEPTH,
                 (&mut s, budget),
@@ -189,9 +189,9 @@ impl NurbsPieces {
                 "the NURBS has no length to plan a motion along ({s} mm)"
             )));
         }
-        let pieces = group(nurbs, &knots, &probes);
+        let pieces = group(&nurbs, &knots, &probes);
         Ok(NurbsPieces {
-            nurbs: nurbs.clone(),
+            nurbs,
             cells: probes.iter().map(|p| p.cell).collect(),
             pieces,
         })
@@ -387,7 +387,7 @@ mod tests {
     #[test]
     fn the_map_follows_the_arc_length_of_the_builtin_curves() {
         for nurbs in [builtin::infinity(), builtin::trident()] {
-            let cut = NurbsPieces::new(&nurbs).unwrap();
+            let cut = NurbsPieces::new(nurbs.clone()).unwrap();
             let length = nurbs.length();
             assert!((cut.length() - length).abs() < 1e-9, "{}", cut.length());
             // Points along the map against the arc length integrated to them.
@@ -411,7 +411,7 @@ mod tests {
     #[test]
     fn a_circle_as_nurbs_has_the_circle_curvature() {
         let circle = builtin::rational_unit_circle();
-        let cut = NurbsPieces::new(&circle).unwrap();
+        let cut = NurbsPieces::new(circle).unwrap();
         assert!((cut.length() - 2.0 * std::f64::consts::PI).abs() < 1e-9);
         for p in cut.pieces() {
             assert!((p.kappa_max - 1.0).abs() < 0.2, "{p:?}");
@@ -437,7 +437,7 @@ mod pathological {
             None,
         )
         .unwrap();
-        let cut = NurbsPieces::new(&cusp).unwrap();
+        let cut = NurbsPieces::new(cusp.clone()).unwrap();
         assert!((cut.length() - cusp.length()).abs() < 1e-9);
         // The pieces meet at the cusp, where the direction turns back.
         let at = cut.pieces().iter().position(|p| p.u[0] == 1.0).unwrap();
@@ -484,7 +484,7 @@ mod pathological {
             None,
         )
         .unwrap();
-        let e = NurbsPieces::new(&wild).unwrap_err().to_string();
+        let e = NurbsPieces::new(wild).unwrap_err().to_string();
         assert!(e.contains("needs more than"), "{e}");
     }
 }

@@ -184,12 +184,6 @@ fn curvatures(shape: &Shape) -> ([f64; 2], f64, f64) {
     }
 }
 
-/// The unit tangent at a move's start (`u` = 0) or end (1).
-fn tangent(shape: &Shape, u: f64) -> Vector2 {
-    let d = shape.curve().eval(u).d1;
-    d / geometry::norm(&d)
-}
-
 /// A program's moves as pieces; a blend goes at the slower of the moves it joins.
 fn program_pieces(program: &Program, limits: &XyLimits) -> Vec<PlanPiece> {
     let moves = program.moves();
@@ -211,7 +205,7 @@ fn program_pieces(program: &Program, limits: &XyLimits) -> Vec<PlanPiece> {
                 kappa,
                 kappa_max,
                 rate_max,
-                tangent: [tangent(&m.shape, 0.0), tangent(&m.shape, 1.0)],
+                tangent: [m.shape.end_tangent(0), m.shape.end_tangent(1)],
                 stops: m.corner == Corner::ExactStop,
                 origin: Origin::Line(m.line),
             }
@@ -296,7 +290,7 @@ impl XyPlan {
                 (Geometry::Program(program), pieces)
             }
             Path::Nurbs(nurbs) => {
-                let cut = NurbsPieces::new(&nurbs)?;
+                let cut = NurbsPieces::new(nurbs)?;
                 let pieces = nurbs_pieces(&cut, limits);
                 (Geometry::Nurbs(cut), pieces)
             }

@@ -14,7 +14,7 @@ pub mod reader;
 use serde::{Deserialize, Serialize};
 
 use super::{clamp_param, CircularArc, Curve, CurvePoint, Line, PathError};
-use crate::geometry::Vector2;
+use crate::geometry::{self, Vector2};
 
 pub use blending::{blended, MIN_BLEND_TURN};
 pub use corner_blend::CornerBlend;
@@ -38,6 +38,19 @@ impl Shape {
             Shape::Line(l) => l,
             Shape::Arc(a) => a,
             Shape::Blend(b) => b,
+        }
+    }
+
+    /// The unit tangent at the move's start (`end` = 0) or end (1): a line's and a
+    /// blend's without evaluating them.
+    pub fn end_tangent(&self, end: usize) -> Vector2 {
+        match self {
+            Shape::Line(l) => l.direction(),
+            Shape::Blend(b) => b.end_directions()[end.min(1)],
+            Shape::Arc(a) => {
+                let d = a.eval(end.min(1) as f64).d1;
+                d * (1.0 / geometry::norm(&d))
+            }
         }
     }
 
