@@ -310,6 +310,17 @@ fn the_exact_distance_to_a_blended_program_is_the_dense_samples_nearest() {
                 got <= sampled + 1e-12 && sampled - got <= slack,
                 "{p:?}: {got} vs {sampled}"
             );
+            // A search started from a guessed place (Newton from it on a blend whose
+            // distance is convex) finds the same, from any guess and hint.
+            let length = geometry.start_of(geometry.moves().len());
+            for (hint, guess) in [(0, length * 0.37), (k % 13, 0.0), (k % 7, length)] {
+                let (_, e) = index.error_between(p, hint, guess, f64::NEG_INFINITY, f64::INFINITY);
+                assert!(
+                    (e.error.abs() - got).abs() < 1e-12,
+                    "{p:?} from {guess}: {} vs {got}",
+                    e.error
+                );
+            }
             compared += 1;
         }
     }

@@ -143,7 +143,7 @@ impl Tracker {
 
     /// The nearest point of the stretch `from` … `to`.
     fn nearest(&self, p: Vector2, hint: usize, from: f64, to: f64, near: f64) -> Foot {
-        let (chunk, e) = self.index.error_between(p, hint, from, to);
+        let (chunk, e) = self.index.error_between(p, hint, f64::NAN, from, to);
         self.foot(chunk, e, near)
     }
 
@@ -156,7 +156,9 @@ impl Tracker {
                 let (chunk, e) = self
                     .index
                     .first_within(p, 0.0, nearest + TIE)
-                    .unwrap_or_else(|| self.index.error_between(p, 0, 0.0, f64::INFINITY));
+                    .unwrap_or_else(|| {
+                        self.index.error_between(p, 0, f64::NAN, 0.0, f64::INFINITY)
+                    });
                 (p, self.foot(chunk, e, 0.0))
             }
         };

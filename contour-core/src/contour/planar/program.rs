@@ -55,6 +55,8 @@ struct Track {
     reference_chunk: usize,
     /// The chunk of the last foot point (where the search starts).
     foot_chunk: usize,
+    /// Arc lengths of the last two foot points, the newer last (the next one's guess).
+    feet: [f64; 2],
     /// The largest distance of a reference from the path seen, when over [`ON_PATH`].
     off_path: Option<f64>,
     /// `off_path` has been taken for the log.
@@ -68,6 +70,7 @@ impl Default for Track {
             newest: 0,
             reference_chunk: 0,
             foot_chunk: 0,
+            feet: [0.0; 2],
             off_path: None,
             off_path_reported: false,
         }
@@ -141,10 +144,10 @@ impl ProgramEstimator {
         let previous = t.history[(t.newest + WINDOW - 1) % WINDOW];
         let guess = last + (last - previous);
         let (chunk, e) = index
-            .first_within_near(reference, last, guess, ON_PATH)
+            .first_within_near(reference, last, t.reference_chunk, guess, ON_PATH)
             .unwrap_or_else(|| {
                 let (chunk, e) =
-                    index.error_between(reference, t.reference_chunk, last, f64::INFINITY);
+                    index.error_between(reference, t.reference_chunk, guess, last, f64::INFINITY);
                 let off = e.error.abs();
                 t.off_path = Some(t.off_path.map_or(off, |o| o.max(off)));
                 (chunk, e)
@@ -181,9 +184,11 @@ impl ContourEstimator for ProgramEstimator {
         let oldest = self.locate_reference(reference);
         let t = &mut self.track;
         let to = t.reference_at() + geometry::dist(&actual, &reference) + ON_PATH;
+        // Where the foot would be at the speed of its last step.
+        let guess = 2.0 * t.feet[1] - t.feet[0];
         let (mut chunk, mut e) =
             self.index
-                .error_between(actual, t.foot_chunk, oldest - ON_PATH, to);
+                .error_between(actual, t.foot_chunk, guess, oldest - ON_PATH, to);
         // Held to a move the reference has left while the reference pulls back along
         // it (the path turned by more than 90° between them, at a kink or round a tight
         // arc): measure against the reference's own move (design §4.8).
@@ -193,10 +198,11 @@ impl ContourEstimator for ProgramEstimator {
                 let from = self.index.chunk_ends(t.reference_chunk)[0].0;
                 (chunk, e) = self
                     .index
-                    .error_between(actual, t.reference_chunk, from, to);
+                    .error_between(actual, t.reference_chunk, guess, from, to);
             }
         }
         t.foot_chunk = chunk;
+        t.feet = [t.feet[1], along(&self.index, chunk, &e, t.feet[1])];
         e.estimate()
     }
 
@@ -234,6 +240,7 @@ impl TryFrom<ProgramEstimatorData> for ProgramEstimator {
         if let Some(s) = t
             .history
             .iter()
+            .chain(&t.feet)
             .find(|s| !(s.is_finite() && (0.0..=length).contains(*s)))
         {
             return Err(format!(

@@ -57,7 +57,7 @@ pub fn true_error(path: &Path, p: Vector2) -> TrueError {
         Path::Arc(a) => arc_true_error(a, p),
         Path::Nurbs(n) => at_kink(n, p, curve_true_error(n, p)),
         Path::Program(program) => (0..program.moves().len())
-            .map(|i| move_true_error(program, i, p, WHOLE))
+            .map(|i| move_true_error(program, i, p, WHOLE, f64::NAN))
             .fold(None, |best: Option<TrueError>, e| match best {
                 Some(b) if b.error.abs() <= e.error.abs() => Some(b),
                 _ => Some(e),
@@ -79,12 +79,12 @@ const WHOLE: Span = (0.0, 1.0);
 /// the point is as far from both moves, and the side is judged against the bisector of
 /// the two tangents: against either one alone, a point beyond a corner that turns by
 /// more than 90° would be on the wrong side.
-fn move_true_error(program: &Program, i: usize, p: Vector2, span: Span) -> TrueError {
+fn move_true_error(program: &Program, i: usize, p: Vector2, span: Span, guess: f64) -> TrueError {
     let moves = program.moves();
     let mut e = match &moves[i].shape {
         Shape::Line(l) => line_error_within(l, p, span),
         Shape::Arc(a) => arc_error_within(a, p, span),
-        Shape::Blend(b) => blend_error_within(b, p, span),
+        Shape::Blend(b) => blend_error_within(b, p, span, guess),
     };
     let last = moves.len() - 1;
     // Only asked at an end of the first or last move.
@@ -131,7 +131,15 @@ const BLEND_SAMPLES: usize = 8;
 /// π: one minimum near the path). The samples are no farther apart in turn than a right
 /// angle's eight: a blend of a small turn, nearly straight, needs few (most of the
 /// corners of a program of short lines, where the nearest point costs mostly these).
-fn blend_error_within(b: &CornerBlend, p: Vector2, (t0, t1): Span) -> TrueError {
+///
+/// With a `guess` (the foot's expected parameter; NaN for none) on a blend where the
+/// squared distance to `p` is convex, Newton starts at the guess instead (see
+/// [`convex_around`]): one minimum, no samples needed.
+fn blend_error_within(b: &CornerBlend, p: Vector2, (t0, t1): Span, guess: f64) -> TrueError {
+    if guess.is_finite() && convex_around(b, p) {
+        let (u, at) = newton(b, p, (t0, t1), guess.clamp(t0, t1));
+        return finish_at(b, at, p, u);
+    }
     let samples = ((BLEND_SAMPLES as f64 * b.turn().abs() / std::f64::consts::FRAC_PI_2).ceil()
         as usize)
         .clamp(2, BLEND_SAMPLES);
@@ -162,14 +170,30 @@ fn blend_error_within(b: &CornerBlend, p: Vector2, (t0, t1): Span) -> TrueError 
     }
     // The iterate or a bracket end, whichever is nearer; the iterate's evaluation
     // serves the result too.
-    let u = newton(b, p, (lo, hi), start);
-    let at = b.eval(u);
+    let (u, at) = newton(b, p, (lo, hi), start);
     if geometry::dist2(&at.p, &p) <= d2[below].min(d2[above]) {
         finish_at(b, at, p, u)
     } else {
         let end = if d2[below] <= d2[above] { lo } else { hi };
         finish(b, p, end)
     }
+}
+
+/// The squared distance from `p` is convex along all of blend `b`: its second derivative
+/// along the arc length, 1 + (C − p)·C'', is at least 1 − κ·|C − p|, and |C − p| is at
+/// most the distance to the farthest corner of the triangle that holds the blend (its
+/// ends and vertex). Then the distance has one minimum on any span of the blend, which
+/// safeguarded Newton finds from anywhere in it. True for a tool near a gentle blend (a
+/// program of short lines), false near a sharp one (a tool farther than its radius).
+fn convex_around(b: &CornerBlend, p: Vector2) -> bool {
+    let far2 = b
+        .hull()
+        .iter()
+        .map(|h| geometry::dist2(h, &p))
+        .fold(0.0, f64::max);
+    let k = b.peak_curvature();
+    // κ·|C − p| below 0.87, not 1: a margin for rounding.
+    k * k * far2 < 0.75
 }
 
 /// The box of a segment: its end points.
@@ -251,7 +275,8 @@ pub fn curve_true_error<C: Curve + ?Sized>(c: &C, p: Vector2) -> TrueError {
 /// stop the search at the knot (a degree-1 NURBS's corner, found planning issue 23's
 /// square as a NURBS): callers never start there on a NURBS.
 fn refine<C: Curve + ?Sized>(c: &C, p: Vector2, a0: f64, b0: f64, u0: f64) -> (f64, f64) {
-    let u = newton(c, p, (a0, b0), u0);
+    // Evaluated again: a NURBS's knot, where it may kink, can lie within the last step.
+    let (u, _) = newton(c, p, (a0, b0), u0);
     let mut best = (geometry::dist2(&c.point(u), &p), u);
     for v in [a0, b0] {
         let d = geometry::dist2(&c.point(v), &p);
@@ -263,13 +288,27 @@ fn refine<C: Curve + ?Sized>(c: &C, p: Vector2, a0: f64, b0: f64, u0: f64) -> (f
 }
 
 /// The safeguarded Newton iteration of [`refine`] in the bracket (a0, b0) from `u0`:
-/// its last iterate.
-fn newton<C: Curve + ?Sized>(c: &C, p: Vector2, (a0, b0): (f64, f64), u0: f64) -> f64 {
+/// its last iterate and the curve there. The iteration stops once its step is below
+/// 10⁻¹⁵ of the parameter (or forecast to be): the curve there is the last evaluation
+/// carried over that step by its Taylor series to second order, off by about step³
+/// times the third derivative, far below rounding on a smooth curve (a blend), and one
+/// evaluation cheaper. A longer last step (the iteration limit) is evaluated.
+fn newton<C: Curve + ?Sized>(
+    c: &C,
+    p: Vector2,
+    (a0, b0): (f64, f64),
+    u0: f64,
+) -> (f64, CurvePoint) {
     let (mut a, mut b, mut u) = (a0, b0, u0);
+    let mut e = c.eval(u);
+    let mut evaluated_at = u;
     // The last Newton step (not a bisection), for the convergence forecast.
     let mut last_newton = f64::NAN;
-    for _ in 0..64 {
-        let e = c.eval(u);
+    for iteration in 0..64 {
+        if iteration > 0 {
+            e = c.eval(u);
+            evaluated_at = u;
+        }
         let q = e.p - p;
         let f = q.dot(&e.d1);
         if f == 0.0 {
@@ -301,7 +340,16 @@ fn newton<C: Curve + ?Sized>(c: &C, p: Vector2, (a0, b0): (f64, f64), u0: f64) -
         }
         last_newton = if newton { step } else { f64::NAN };
     }
-    u
+    let h = u - evaluated_at;
+    if h.abs() > 1e-9 * (b0 - a0) {
+        return (u, c.eval(u));
+    }
+    let carried = CurvePoint {
+        p: e.p + e.d1 * h + e.d2 * (0.5 * h * h),
+        d1: e.d1 + e.d2 * h,
+        d2: e.d2,
+    };
+    (u, carried)
 }
 
 /// `e` signed again where its foot is a NURBS's kink (an interior knot where the tangent
@@ -585,25 +633,42 @@ impl TrueErrorIndex {
             Path::Line(l) => line_true_error(l, p),
             Path::Arc(a) => arc_true_error(a, p),
             Path::Nurbs(_) | Path::Program(_) => {
-                self.error_between(p, self.locate(hint), f64::NEG_INFINITY, f64::INFINITY)
+                let any = (f64::NEG_INFINITY, f64::INFINITY);
+                self.error_between(p, self.locate(hint), f64::NAN, any.0, any.1)
                     .1
             }
         }
     }
 
     /// The exact distance from `p` to the stretch of the path between the arc lengths
-    /// `from` and `to` (clamped to the path), with the chunk of the foot; `hint` is a
-    /// chunk to try first. Equal distances go to the earlier chunk.
-    pub fn error_between(&self, p: Vector2, hint: usize, from: f64, to: f64) -> (usize, TrueError) {
+    /// `from` and `to` (clamped to the path), with the chunk of the foot. `hint` is a
+    /// chunk near the foot, `guess` an arc length near it (NaN for none): the search
+    /// starts at the chunk that holds the guess, else at the hint, and on a blend Newton
+    /// may start at the guess. Any hint and guess give the same result, to the last bits
+    /// of Newton's convergence; equal distances go to the earlier chunk.
+    pub fn error_between(
+        &self,
+        p: Vector2,
+        hint: usize,
+        guess: f64,
+        from: f64,
+        to: f64,
+    ) -> (usize, TrueError) {
         let chunks = self.chunks_between(from, to);
-        let first = hint.clamp(chunks.start, chunks.end - 1);
-        let mut best = Nearest::new(first, self.chunk_min(first, p, from, to));
+        let near = if guess.is_finite() {
+            self.chunk_at(guess, hint)
+        } else {
+            hint
+        };
+        let first = near.clamp(chunks.start, chunks.end - 1);
+        let chunk_min = |i: usize| self.chunk_min(i, p, from, to, guess);
+        let mut best = Nearest::new(first, chunk_min(first));
         // A short stretch (a window along the path) is scanned box by box: cheaper than
         // descending the tree to it, and the same chunks pass the same test.
         if chunks.len() <= SCAN_CHUNKS {
             for i in chunks {
                 if i != first && box_dist2(&self.tree[self.leaves + i], p) <= best.bound2 {
-                    best.offer(i, self.chunk_min(i, p, from, to));
+                    best.offer(i, chunk_min(i));
                 }
             }
             return (best.chunk, self.result(best.found, p));
@@ -628,7 +693,7 @@ impl TrueErrorIndex {
                 }
                 if node >= self.leaves {
                     let i = node - self.leaves;
-                    best.offer(i, self.chunk_min(i, p, from, to));
+                    best.offer(i, chunk_min(i));
                 } else {
                     let (l, r) = (2 * node, 2 * node + 1);
                     // The nearer child is searched first.
@@ -653,32 +718,37 @@ impl TrueErrorIndex {
         from: f64,
         tolerance: f64,
     ) -> Option<(usize, TrueError)> {
-        self.first_within_near(p, from, f64::NAN, tolerance)
+        self.first_within_near(p, from, 0, f64::NAN, tolerance)
     }
 
     /// [`TrueErrorIndex::first_within`] for a point that moves on along the path (the
-    /// reference), whose place can be guessed (the arc length `guess`): on a blend that
-    /// holds the guess, Newton from there instead of from samples. The same chunk and
-    /// foot as first_within's wherever it finds the point within `tolerance` inside the
-    /// blend; otherwise first_within's search of that chunk.
+    /// reference), whose place can be guessed (`hint`, a chunk near `from`; the arc
+    /// length `guess`): on a blend that
+    /// holds the guess, a Newton step from there instead of a search from samples (see
+    /// `near_guess`): the same chunk as first_within's, the foot within nanometres of
+    /// its, wherever it finds the point within `tolerance` inside the blend; otherwise
+    /// first_within's search of that chunk.
     pub fn first_within_near(
         &self,
         p: Vector2,
         from: f64,
+        hint: usize,
         guess: f64,
         tolerance: f64,
     ) -> Option<(usize, TrueError)> {
-        let start = self.chunks_between(from, f64::INFINITY).start;
+        let start = self.chunk_at(from, hint);
         let limit = tolerance * tolerance;
         let chunk_min = |i: usize| {
             self.near_guess(i, p, from, guess, tolerance)
-                .unwrap_or_else(|| self.chunk_min(i, p, from, f64::INFINITY))
+                .unwrap_or_else(|| self.chunk_min(i, p, from, f64::INFINITY, f64::NAN))
         };
         // The first chunk in path order, where a point that moves on along the path (the
         // reference) mostly still is: found there, the tree is not searched.
-        let found = chunk_min(start);
-        if found.0 <= tolerance {
-            return Some((start, self.result(found, p)));
+        if box_dist2(&self.tree[self.leaves + start], p) <= limit {
+            let found = chunk_min(start);
+            if found.0 <= tolerance {
+                return Some((start, self.result(found, p)));
+            }
         }
         // Where it has moved on to: the next few chunks in turn, then the tree beyond.
         let scanned = (start + 1 + SCAN_CHUNKS).min(self.chunks.len());
@@ -698,7 +768,7 @@ impl TrueErrorIndex {
             }
             if node >= self.leaves {
                 let i = node - self.leaves;
-                let found = self.chunk_min(i, p, from, f64::INFINITY);
+                let found = self.chunk_min(i, p, from, f64::INFINITY, f64::NAN);
                 if found.0 <= tolerance {
                     return Some((i, self.result(found, p)));
                 }
@@ -711,8 +781,11 @@ impl TrueErrorIndex {
     }
 
     /// The distance from `p` to chunk `i` after the arc length `from` when the chunk is
-    /// a blend holding the arc length `guess` and Newton from there finds a foot within
-    /// `tolerance` inside it.
+    /// a blend holding the arc length `guess` and one Newton step from there places `p`
+    /// within `tolerance` inside it. For a point on the path (the reference), guessed
+    /// from its last two places, the guess is off by its change of step (a few µm at
+    /// the planner's accelerations) and the step leaves about κ·δ², nanometres: the
+    /// place is that exact, the distance exact at it.
     fn near_guess(
         &self,
         i: usize,
@@ -733,13 +806,18 @@ impl TrueErrorIndex {
         if !(t0 < u && u < t1) {
             return None;
         }
-        let foot = newton(b, p, (t0, t1), u);
-        let at = b.eval(foot);
-        let d = geometry::dist(&at.p, &p);
-        if !(t0 < foot && foot < t1 && d <= tolerance) {
+        let at = b.eval(u);
+        let foot = u + (p - at.p).dot(&at.d1) / at.d1.dot(&at.d1);
+        if !(t0 < foot && foot < t1) {
             return None;
         }
-        let mut e = finish_at(b, at, p, foot);
+        let q = b.point(foot);
+        let d = geometry::dist(&q, &p);
+        if d > tolerance {
+            return None;
+        }
+        // Signed against the guess's tangent: the place is what the caller uses.
+        let mut e = signed(p, q, at.d1 * (1.0 / (end - a)), foot);
         e.u = program.position(i, foot);
         Some((d, e.u, Some(e)))
     }
@@ -777,6 +855,35 @@ impl TrueErrorIndex {
             (self.lengths[i], self.path.point(c.u0)),
             (self.lengths[i + 1], self.path.point(c.u1)),
         ]
+    }
+
+    /// The first chunk that ends at or after the arc length `s` (the last when none does),
+    /// sought outward from chunk `hint`: galloping, O(log distance) rather than
+    /// O(log chunks) when the hint is near.
+    fn chunk_at(&self, s: f64, hint: usize) -> usize {
+        let ends = &self.lengths[1..];
+        let n = ends.len();
+        if s.is_nan() {
+            return 0;
+        }
+        let hint = hint.min(n - 1);
+        // The answer lies in lo..=hi: widen by doubling steps from the hint.
+        let (mut lo, mut hi) = (hint, hint);
+        let mut step = 1;
+        if ends[hint] < s {
+            while hi < n - 1 && ends[hi] < s {
+                lo = hi + 1;
+                hi = (hi + step).min(n - 1);
+                step *= 2;
+            }
+        } else {
+            while lo > 0 && ends[lo - 1] >= s {
+                hi = lo - 1;
+                lo = lo.saturating_sub(step);
+                step *= 2;
+            }
+        }
+        lo + ends[lo..hi].partition_point(|&end| end < s)
     }
 
     /// The chunks that cover the arc lengths `from` … `to` (at least one).
@@ -852,9 +959,13 @@ impl TrueErrorIndex {
     /// Minimum distance over chunk `i` between the arc lengths `from` and `to`, and its
     /// parameter: exact on a move, a line or an arc; on a NURBS the best of the chunk's
     /// samples, then Newton in the bracket.
-    fn chunk_min(&self, i: usize, p: Vector2, from: f64, to: f64) -> ChunkMin {
+    fn chunk_min(&self, i: usize, p: Vector2, from: f64, to: f64, guess: f64) -> ChunkMin {
         let e = match &self.path {
-            Path::Program(program) => move_true_error(program, i, p, self.move_span(i, from, to)),
+            Path::Program(program) => {
+                let (a, b) = (self.lengths[i], self.lengths[i + 1]);
+                let local = (guess - a) / (b - a);
+                move_true_error(program, i, p, self.move_span(i, from, to), local)
+            }
             Path::Line(l) => line_error_within(l, p, self.span(i, from, to)),
             Path::Arc(a) => arc_error_within(a, p, self.span(i, from, to)),
             Path::Nurbs(_) => {
@@ -1057,9 +1168,32 @@ mod tests {
         // whichever the search starts from.
         let index = TrueErrorIndex::new(&program);
         let q = Vector2::new(10.0, 0.0) + Vector2::new(2.0, -3.0);
-        for hint in [0, 1] {
-            let (chunk, _) = index.error_between(q, hint, f64::NEG_INFINITY, f64::INFINITY);
-            assert_eq!(chunk, 0, "hint {hint}");
+        for (hint, guess) in [(0, f64::NAN), (1, f64::NAN), (0, 11.0), (1, 3.0)] {
+            let (chunk, _) = index.error_between(q, hint, guess, f64::NEG_INFINITY, f64::INFINITY);
+            assert_eq!(chunk, 0, "hint {hint}, guess {guess}");
+        }
+    }
+
+    #[test]
+    fn a_chunk_is_found_from_any_hint() {
+        let program = Path::Program(
+            crate::path::program::parse_program(
+                "G1 X1 F600\nX3\nX3.5\nX7\nX7.25\nX9\nX10\n",
+                "steps.ngc",
+            )
+            .unwrap(),
+        );
+        let index = TrueErrorIndex::new(&program);
+        let n = index.chunk_count();
+        for s in [
+            -1.0, 0.0, 0.5, 1.0, 1.5, 3.0, 3.2, 7.0, 7.1, 9.99, 10.0, 11.0,
+        ] {
+            let want = index.lengths[1..]
+                .partition_point(|&end| end < s)
+                .min(n - 1);
+            for hint in 0..n + 2 {
+                assert_eq!(index.chunk_at(s, hint), want, "{s} from {hint}");
+            }
         }
     }
 
