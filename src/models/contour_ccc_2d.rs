@@ -155,10 +155,11 @@ pub static INFO: ModelInfo = ModelInfo {
 };
 
 /// `Option<State>` as below. Version 2: the controller became N-axis (per-axis contour
-/// PIDs, unused in the plane, joined its state).
+/// PIDs, unused in the plane, joined its state). Version 3: the program estimator's track
+/// keeps its last two foot points (its next search's guess).
 const LAYOUT: StateLayout = StateLayout {
     model: "ContourCCC2D",
-    version: 2,
+    version: 3,
 };
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]

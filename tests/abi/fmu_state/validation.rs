@@ -293,11 +293,12 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
     let (_, interpolator_bytes) = interpolator.serialize(state);
     interpolator.free_state(&mut state);
 
-    // The models' current layout versions: ContourCCC2D 2 (the controller became N-axis),
+    // The models' current layout versions: ContourCCC2D 3 (the program estimator keeps its
+    // last two feet; 2: the controller became N-axis),
     // XYServoPlant 2 (each axis's lead became a transmission), PathInterpolator2D 2 (the
     // planned reference joined the constant-feed one).
     for (i, bytes, model, version) in [
-        (&controller, &controller_bytes, "ContourCCC2D", 2u16),
+        (&controller, &controller_bytes, "ContourCCC2D", 3u16),
         (&plant_instance, &plant_bytes, "XYServoPlant", 2),
         (&interpolator, &interpolator_bytes, "PathInterpolator2D", 2),
     ] {

@@ -53,7 +53,7 @@ struct Track {
     /// Index in `history` of the newest.
     newest: usize,
     reference_chunk: usize,
-    /// The chunk of the last foot point (where the search starts).
+    /// The chunk of the last foot point (the search finds its guess's chunk from it).
     foot_chunk: usize,
     /// Arc lengths of the last two foot points, the newer last (the next one's guess).
     feet: [f64; 2],
@@ -237,14 +237,15 @@ impl TryFrom<ProgramEstimatorData> for ProgramEstimator {
                 t.reference_chunk, t.foot_chunk
             ));
         }
-        if let Some(s) = t
-            .history
-            .iter()
-            .chain(&t.feet)
-            .find(|s| !(s.is_finite() && (0.0..=length).contains(*s)))
-        {
+        let on_path = |s: &&f64| s.is_finite() && (0.0..=length).contains(*s);
+        if let Some(s) = t.history.iter().find(|s| !on_path(s)) {
             return Err(format!(
                 "program estimator: a reference position {s} mm off the path (0 … {length} mm)"
+            ));
+        }
+        if let Some(s) = t.feet.iter().find(|s| !on_path(s)) {
+            return Err(format!(
+                "program estimator: a foot point's position {s} mm off the path (0 … {length} mm)"
             ));
         }
         Ok(ProgramEstimator { index, track: t })
@@ -405,6 +406,42 @@ mod tests {
         assert!((e.take_off_path().unwrap() - far).abs() < 1e-9);
         e.estimate(start + n * 0.05, start);
         assert_eq!(e.take_off_path(), None);
+    }
+
+    #[test]
+    fn a_blended_program_continues_bit_for_bit_after_a_restore() {
+        // Every corner a blend: the tool's search starts from its guessed foot, which
+        // must come back with the state.
+        let program = crate::path::program::parse_program(
+            "G64 P0.01\nG1 X2 F600\nX4 Y0.2\nX6 Y0.6\nX8 Y1.2\nX10 Y2\nX11 Y3.5\n",
+            "fan.ngc",
+        )
+        .unwrap();
+        let path = Path::Program(crate::path::program::blended(&program, 0.0));
+        let mut e = ProgramEstimator::new(&path);
+        let mut it = Interpolator::new(path.clone(), 20.0, 1e-3).unwrap();
+        let sample = |it: &Interpolator| {
+            let r = it.current().point;
+            (r, r + Vector2::new(-0.003, 0.004))
+        };
+        for _ in 0..300 {
+            it.step();
+            let (r, p) = sample(&it);
+            e.estimate(r, p);
+        }
+        let blob = postcard::to_stdvec(&e).unwrap();
+        let mut restored: ProgramEstimator = postcard::from_bytes(&blob).unwrap();
+        for _ in 0..400 {
+            it.step();
+            let (r, p) = sample(&it);
+            let (a, b) = (restored.estimate(r, p), e.estimate(r, p));
+            assert_eq!(a.error.to_bits(), b.error.to_bits());
+            assert_eq!(a.normal, b.normal);
+        }
+        // Against the brute force, the same to 1e-12.
+        let (r, p) = sample(&it);
+        let exact = true_error(&path, p).error;
+        assert!((e.estimate(r, p).error - exact).abs() < 1e-12);
     }
 
     #[test]
