@@ -3,7 +3,7 @@
 
 use std::fmt::Write;
 
-use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::framework::interface::{Interface, UnitSystem};
 use contour_fmu::framework::variables::{Causality, Start, Variability};
 
 use crate::escape;
@@ -17,9 +17,10 @@ fn start_text(start: Start) -> String {
     }
 }
 
-pub fn render(model: &ModelInfo) -> String {
+pub fn render(interface: &Interface) -> String {
+    let model = interface.model;
     let mut rows = String::new();
-    for v in model.variables {
+    for v in &interface.variables {
         let kind = match (v.causality, v.variability) {
             (Causality::Parameter, Variability::Tunable) => "tunable parameter",
             (Causality::Parameter, _) => "parameter",
@@ -60,13 +61,13 @@ pub fn render(model: &ModelInfo) -> String {
         )
         .unwrap();
     }
-    let inputs: Vec<String> = model
+    let inputs: Vec<String> = interface
         .variables
         .iter()
         .filter(|v| v.causality == Causality::Input)
         .map(|v| v.name.to_string())
         .collect();
-    let outputs: Vec<String> = model
+    let outputs: Vec<String> = interface
         .variables
         .iter()
         .filter(|v| v.causality == Causality::Output)
@@ -89,6 +90,7 @@ pre {{ background: #f4f4f4; padding: 0.8em; }}
 <body>
 <h1>{id}</h1>
 <p>{description}</p>
+<p>{units}</p>
 <p>FMI 2.0 Co-Simulation, Linux x86-64. Inputs: {inputs}. Outputs: {outputs}.
 Default experiment: {start} s to {stop} s with {step} s steps; any communication step
 size is accepted.</p>
@@ -112,7 +114,11 @@ print(result.dtype.names)</pre>
 </html>
 "#,
         id = model.identifier,
-        description = escape(model.description),
+        description = escape(&interface.description()),
+        units = match interface.units {
+            UnitSystem::Millimetre => "Lengths in mm (mm/s, mm/s², mm/s³); the SI build of this model takes and gives metres.",
+            UnitSystem::Si => "SI build: lengths in m (m/s, m/s², m/s³), angles in rad, time in s. It computes as the mm build does (lengths in mm inside) and converts at the interface, so gains, fuzzy factors and tuned files carry over unchanged; path files (NURBS JSON, G-code) keep their own units (mm, or G20 inches).",
+        },
         inputs = if inputs.is_empty() {
             "none".into()
         } else {

@@ -1,21 +1,26 @@
 //! `cargo run --release -p fmu-build [-- --bless] [--out DIR] [--resource MODEL=FILE]…`:
-//! builds the library in release mode and writes one `.fmu` per model to `target/fmu/`
-//! (or DIR). `--bless` rewrites the committed `modelDescription/<Model>.xml` files from
-//! the code; each `--resource` puts FILE into MODEL's `resources/` folder.
+//! builds the library in release mode and writes one `.fmu` per model and unit system:
+//! the mm build to `target/fmu/` (or DIR), the SI build to `target/fmu-si/` (or DIR-si).
+//! `--bless` rewrites the committed `modelDescription/<Model>.xml` (and
+//! `modelDescription/si/<Model>.xml`) files from the code; each `--resource` puts FILE
+//! into MODEL's `resources/` folder in both builds.
 //! PathInterpolator5X always carries the example CL part `examples/cl/blade.cl` as
 //! `resources/blade.cl`.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
 
+use contour_fmu::framework::interface::{Interface, UnitSystem};
 use contour_fmu::models;
 use fmu_build::model_description;
 use fmu_build::package::{self, Resource};
 
 const USAGE: &str = "usage: fmu-build [--bless] [--out DIR] [--resource MODEL=FILE]...\n\
-  builds the contour-fmu library (release) and packages target/fmu/<Model>.fmu\n\
+  builds the contour-fmu library (release) and packages target/fmu/<Model>.fmu (mm)\n\
+  and target/fmu-si/<Model>.fmu (SI)\n\
   --bless                rewrite modelDescription/<Model>.xml from the variable tables\n\
-  --out DIR              write the .fmu files to DIR instead of <target>/fmu\n\
+  --out DIR              write the .fmu files to DIR and DIR-si instead of <target>/fmu\n\
+                         and <target>/fmu-si\n\
   --resource MODEL=FILE  put FILE into MODEL's resources/ folder under its own name\n\
                          (repeatable; e.g. PathInterpolator2D=part.json, then set the\n\
                          FMU's parameter path = \"part.json\")";
@@ -92,13 +97,13 @@ fn run(args: &[String]) -> Result<(), String> {
     package::check_unique(&resources)?;
     let out = out.unwrap_or_else(|| target_dir(&root).join("fmu"));
 
-    let committed_dir = root.join("modelDescription");
     let mut stale = Vec::new();
-    for model in models::all() {
-        let xml = model_description::render(model);
-        let committed = committed_dir.join(format!("{}.xml", model.identifier));
+    for interface in packaged() {
+        let xml = model_description::render(interface);
+        let committed = committed_description(&root, interface);
         if bless {
-            std::fs::create_dir_all(&committed_dir).map_err(|e| e.to_string())?;
+            let committed_dir = committed.parent().expect("a file in a folder");
+            std::fs::create_dir_all(committed_dir).map_err(|e| e.to_string())?;
             std::fs::write(&committed, &xml)
                 .map_err(|e| format!("cannot write {}: {e}", committed.display()))?;
             println!("blessed {}", committed.display());
@@ -108,10 +113,21 @@ fn run(args: &[String]) -> Result<(), String> {
     }
 
     let library = build_library(&root)?;
-    for model in models::all() {
-        let fmu = package::write_fmu_with_resources(model, &library, &out, &resources)?;
+    for interface in packaged() {
+        let out = match interface.units {
+            UnitSystem::Millimetre => out.clone(),
+            UnitSystem::Si => {
+                let mut name = out.clone().into_os_string();
+                name.push("-si");
+                PathBuf::from(name)
+            }
+        };
+        let fmu = package::write_fmu_with_resources(interface, &library, &out, &resources)?;
         println!("wrote {}", fmu.display());
-        for r in resources.iter().filter(|r| r.model == model.identifier) {
+        for r in resources
+            .iter()
+            .filter(|r| r.model == interface.model.identifier)
+        {
             println!("  resources/{} <- {}", r.name, r.source.display());
         }
     }
@@ -123,6 +139,23 @@ fn run(args: &[String]) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// The interfaces packaged: both unit systems of every model [`models::all`] lists.
+fn packaged() -> impl Iterator<Item = &'static Interface> {
+    models::interfaces()
+        .iter()
+        .filter(|i| models::all().iter().any(|m| std::ptr::eq(*m, i.model)))
+}
+
+/// Where the committed copy of an interface's model description lives.
+fn committed_description(root: &Path, interface: &Interface) -> PathBuf {
+    let dir = root.join("modelDescription");
+    let dir = match interface.units {
+        UnitSystem::Millimetre => dir,
+        UnitSystem::Si => dir.join("si"),
+    };
+    dir.join(format!("{}.xml", interface.model.identifier))
 }
 
 fn main() -> ExitCode {

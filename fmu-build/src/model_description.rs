@@ -5,7 +5,7 @@
 use std::fmt::Write;
 
 use contour_fmu::fmi2::LogCategory;
-use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::framework::interface::Interface;
 use contour_fmu::framework::units::{self, UnitDefinition};
 use contour_fmu::framework::variables::{Causality, EnumType, Start, Variable};
 
@@ -97,8 +97,10 @@ fn unit_element(u: &UnitDefinition) -> String {
     )
 }
 
-/// The complete `modelDescription.xml` of one model.
-pub fn render(model: &ModelInfo) -> String {
+/// The complete `modelDescription.xml` of one model's interface.
+pub fn render(interface: &Interface) -> String {
+    let model = interface.model;
+    let variables = &interface.variables;
     let mut xml = String::new();
     let w = &mut xml;
     writeln!(w, r#"<?xml version="1.0" encoding="UTF-8"?>"#).unwrap();
@@ -125,13 +127,13 @@ pub fn render(model: &ModelInfo) -> String {
     canSerializeFMUstate="true"
     providesDirectionalDerivative="false"/>"#,
         id = model.identifier,
-        guid = model.guid(),
-        description = escape(model.description),
+        guid = interface.guid,
+        description = escape(&interface.description()),
         version = env!("CARGO_PKG_VERSION"),
     )
     .unwrap();
 
-    let mut used: Vec<&'static str> = model.variables.iter().filter_map(|v| v.unit).collect();
+    let mut used: Vec<&'static str> = variables.iter().filter_map(|v| v.unit).collect();
     used.sort_unstable();
     used.dedup();
     if !used.is_empty() {
@@ -144,7 +146,7 @@ pub fn render(model: &ModelInfo) -> String {
     }
 
     let mut types: Vec<&'static EnumType> = Vec::new();
-    for e in model.variables.iter().filter_map(|v| v.enumeration) {
+    for e in variables.iter().filter_map(|v| v.enumeration) {
         if !types.iter().any(|t| t.name == e.name) {
             types.push(e);
         }
@@ -180,7 +182,7 @@ pub fn render(model: &ModelInfo) -> String {
     .unwrap();
 
     writeln!(w, "  <ModelVariables>").unwrap();
-    for (index, v) in model.variables.iter().enumerate() {
+    for (index, v) in variables.iter().enumerate() {
         let initial = if v.causality == Causality::Output {
             " initial=\"calculated\""
         } else {
@@ -219,8 +221,7 @@ pub fn render(model: &ModelInfo) -> String {
     // is computed from a few parameters (the plant's position from pos0.*, the
     // interpolator's first sample from the path); the model lists them
     // (`ModelInfo::initial_dependencies`, tested by perturbing every variable).
-    let outputs: Vec<&Variable> = model
-        .variables
+    let outputs: Vec<&Variable> = variables
         .iter()
         .filter(|v| v.causality == Causality::Output)
         .collect();
@@ -243,7 +244,7 @@ pub fn render(model: &ModelInfo) -> String {
             let knowns: Vec<usize> = model
                 .initial_dependencies_of(v.vr)
                 .into_iter()
-                .map(|vr| index(&model.variables[vr]))
+                .map(|vr| index(&variables[vr]))
                 .collect();
             writeln!(
                 w,

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use zip::write::SimpleFileOptions;
 use zip::CompressionMethod;
 
-use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::framework::interface::Interface;
 use contour_fmu::models;
 
 use crate::{documentation, model_description};
@@ -119,18 +119,19 @@ pub fn check_unique(resources: &[Resource]) -> Result<(), String> {
 
 /// Writes `<out_dir>/<id>.fmu` holding `library` (the built cdylib) under the name FMI
 /// requires: `binaries/linux64/<modelIdentifier>.so`. No resources.
-pub fn write_fmu(model: &ModelInfo, library: &Path, out_dir: &Path) -> Result<PathBuf, String> {
-    write_fmu_with_resources(model, library, out_dir, &[])
+pub fn write_fmu(interface: &Interface, library: &Path, out_dir: &Path) -> Result<PathBuf, String> {
+    write_fmu_with_resources(interface, library, out_dir, &[])
 }
 
 /// As [`write_fmu`], plus every entry of `resources` whose `model` is this model's
 /// identifier as `resources/<name>` (entries for other models are skipped).
 pub fn write_fmu_with_resources(
-    model: &ModelInfo,
+    interface: &Interface,
     library: &Path,
     out_dir: &Path,
     resources: &[Resource],
 ) -> Result<PathBuf, String> {
+    let model = interface.model;
     check_unique(resources)?;
     let binary =
         std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
@@ -150,8 +151,8 @@ pub fn write_fmu_with_resources(
         File::create(&partial).map_err(|e| format!("cannot create {}: {e}", partial.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated);
-    let xml = model_description::render(model);
-    let html = documentation::render(model);
+    let xml = model_description::render(interface);
+    let html = documentation::render(interface);
     let mut entries: Vec<(String, &[u8])> = vec![
         ("modelDescription.xml".into(), xml.as_bytes()),
         (format!("binaries/linux64/{}.so", model.identifier), &binary),

@@ -1,16 +1,31 @@
-//! The committed `modelDescription/<Model>.xml` files must be exactly what the code
-//! renders: review sees every interface change, and a stale file fails here.
+//! The committed `modelDescription/<Model>.xml` (mm) and `modelDescription/si/<Model>.xml`
+//! files must be exactly what the code renders: review sees every interface change, and
+//! a stale file fails here.
 
 use std::path::Path;
 
+use contour_fmu::framework::interface::{Interface, UnitSystem};
 use contour_fmu::models;
 use fmu_build::model_description;
+
+/// Both interfaces of every packaged model.
+fn packaged() -> Vec<&'static Interface> {
+    models::all()
+        .into_iter()
+        .flat_map(|m| UnitSystem::ALL.map(|units| models::interface(m, units)))
+        .collect()
+}
 
 #[test]
 fn committed_xml_matches_the_code() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription");
-    for model in models::all() {
-        let path = dir.join(format!("{}.xml", model.identifier));
+    for interface in packaged() {
+        let folder = match interface.units {
+            UnitSystem::Millimetre => dir.clone(),
+            UnitSystem::Si => dir.join("si"),
+        };
+        let model = interface.model;
+        let path = folder.join(format!("{}.xml", model.identifier));
         let committed = std::fs::read_to_string(&path).unwrap_or_else(|e| {
             panic!(
                 "{}: {e}; run `cargo run -p fmu-build -- --bless`",
@@ -18,7 +33,7 @@ fn committed_xml_matches_the_code() {
             )
         });
         assert!(
-            committed == model_description::render(model),
+            committed == model_description::render(interface),
             "{} is stale: run `cargo run --release -p fmu-build -- --bless` and commit it",
             path.display()
         );
@@ -27,8 +42,9 @@ fn committed_xml_matches_the_code() {
 
 #[test]
 fn every_output_is_listed_once_in_outputs_and_initial_unknowns() {
-    for model in models::all() {
-        let xml = model_description::render(model);
+    for interface in packaged() {
+        let model = interface.model;
+        let xml = model_description::render(interface);
         let outputs = model
             .variables
             .iter()
@@ -55,6 +71,51 @@ fn every_output_is_listed_once_in_outputs_and_initial_unknowns() {
             section("Outputs").matches("dependencies=\"\"/>").count(),
             outputs
         );
-        assert!(xml.contains(&format!("guid=\"{}\"", model.guid())));
+        assert!(xml.contains(&format!("guid=\"{}\"", interface.guid)));
+    }
+}
+
+/// The SI build declares metres where the mm build declares millimetres, with starts and
+/// bounds scaled by exactly the unit's factor, and changes nothing else.
+#[test]
+fn the_si_interface_is_the_mm_one_in_metres() {
+    for model in models::all() {
+        let (mm, si) = (
+            models::interface(model, UnitSystem::Millimetre),
+            models::interface(model, UnitSystem::Si),
+        );
+        assert_ne!(mm.guid, si.guid);
+        for (a, b) in mm.variables.iter().zip(&si.variables) {
+            let (unit, factor) = match a.unit {
+                Some("mm") => (Some("m"), 1e-3),
+                Some("mm/s") => (Some("m/s"), 1e-3),
+                Some("mm/s2") => (Some("m/s2"), 1e-3),
+                Some("mm/s3") => (Some("m/s3"), 1e-3),
+                Some("mm/rad") => (Some("m/rad"), 1e-3),
+                other => (other, 1.0),
+            };
+            assert_eq!(b.unit, unit, "{}", a.name);
+            assert_eq!(
+                (b.name, b.causality, b.variability),
+                (a.name, a.causality, a.variability)
+            );
+            assert_eq!(b.min, a.min.map(|x| x * factor), "{}", a.name);
+            assert_eq!(b.max, a.max.map(|x| x * factor), "{}", a.name);
+            match (a.start, b.start) {
+                (
+                    contour_fmu::framework::variables::Start::Real(x),
+                    contour_fmu::framework::variables::Start::Real(y),
+                ) => {
+                    assert_eq!(y, x * factor, "{}", a.name)
+                }
+                (x, y) => assert_eq!(x, y, "{}", a.name),
+            }
+        }
+        let xml = model_description::render(si);
+        assert!(
+            !xml.contains("unit=\"mm"),
+            "{}: a length in mm",
+            model.identifier
+        );
     }
 }

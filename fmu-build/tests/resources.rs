@@ -21,11 +21,15 @@ fn scratch(test: &str) -> PathBuf {
     dir
 }
 
-fn model(identifier: &str) -> &'static contour_fmu::framework::model::ModelInfo {
-    models::all()
+fn model(identifier: &str) -> &'static contour_fmu::framework::interface::Interface {
+    let model = models::all()
         .into_iter()
         .find(|m| m.identifier == identifier)
-        .unwrap()
+        .unwrap();
+    models::interface(
+        model,
+        contour_fmu::framework::interface::UnitSystem::Millimetre,
+    )
 }
 
 /// Name → bytes of every file in the zip.

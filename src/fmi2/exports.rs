@@ -269,10 +269,10 @@ pub unsafe extern "C" fn fmi2Instantiate(
         let Some(guid) = c_str(fmuGUID) else {
             return refuse("the GUID is NULL or not UTF-8".into());
         };
-        let Some(info) = models::by_guid(guid) else {
-            let known: Vec<String> = models::all()
+        let Some(interface) = models::by_guid(guid) else {
+            let known: Vec<String> = models::interfaces()
                 .iter()
-                .map(|m| format!("{} {}", m.identifier, m.guid()))
+                .map(|i| format!("{} ({}) {}", i.model.identifier, i.units.name(), i.guid))
                 .collect();
             return refuse(format!(
                 "unknown GUID {guid}: the modelDescription.xml does not match this binary (it serves {})",
@@ -293,8 +293,12 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 ),
             }
         }
-        let instance = Instance::new(info, environment, logger, name);
-        instance.log_event(&format!("instantiated {} (GUID {guid})", info.identifier));
+        let instance = Instance::with_interface(interface, environment, logger, name);
+        instance.log_event(&format!(
+            "instantiated {} with the {} interface (GUID {guid})",
+            interface.model.identifier,
+            interface.units.name()
+        ));
         instance.logger.flush();
         match registry::add_instance(instance) {
             Ok(handle) => Some(handle as fmi2Component),

@@ -10,6 +10,7 @@ use super::logger::{to_c_string, Category, Logger};
 use super::registry::{self, StateOwner};
 use super::state_machine::{Call, Mode};
 use super::status::{Failure, Outcome, Status};
+use crate::framework::interface::Interface;
 use crate::framework::model::{Environment, Model, ModelInfo};
 use crate::framework::variables::{Causality, Value, Values, VarType, Variability, Variable, Vr};
 
@@ -60,6 +61,11 @@ pub struct Instance {
     access: Box<[Access]>,
     /// The Real outputs, in table order: checked for overflow after each step.
     real_outputs: Box<[Vr]>,
+    /// The variables as the interface declares them (units, bounds): what `fmi2Set*`
+    /// checks. `values` hold the model's units; `info.variables` checks them.
+    variables: &'static [Variable],
+    /// Interface value = model value × scale, by value reference.
+    scale: &'static [f64],
     guid: String,
     environment: Environment,
     model: Box<dyn Model>,
@@ -98,23 +104,27 @@ fn time_matches(a: f64, b: f64) -> bool {
 }
 
 impl Instance {
-    pub fn new(
-        info: &'static ModelInfo,
+    /// An instance of `interface`'s model that speaks the interface's units.
+    pub fn with_interface(
+        interface: &'static Interface,
         environment: Environment,
         logger: Logger,
         name: &str,
     ) -> Self {
+        let info = interface.model;
         Instance {
             info,
             name: name.to_owned(),
-            access: info.variables.iter().map(Access::of).collect(),
+            access: interface.variables.iter().map(Access::of).collect(),
             real_outputs: info
                 .variables
                 .iter()
                 .filter(|v| v.causality == Causality::Output && v.var_type() == VarType::Real)
                 .map(|v| v.vr)
                 .collect(),
-            guid: info.guid(),
+            variables: &interface.variables,
+            scale: &interface.scale,
+            guid: interface.guid.clone(),
             model: (info.create)(&environment),
             environment,
             values: Values::from_table(info.variables),
@@ -205,10 +215,19 @@ impl Instance {
         Ok(())
     }
 
+    /// The variable as the interface declares it.
     fn variable(&self, vr: u32) -> Outcome<&'static crate::framework::variables::Variable> {
-        self.info
-            .variable(vr as Vr)
+        self.variables
+            .get(vr as usize)
             .ok_or_else(|| Failure::error(format!("unknown value reference {vr}")))
+    }
+
+    /// A value in the interface's units from the model's.
+    fn to_interface(&self, vr: Vr, value: &Value) -> Value {
+        match *value {
+            Value::Real(x) => Value::Real(x * self.scale[vr]),
+            ref other => other.clone(),
+        }
     }
 
     /// Reads values after checking every reference and type; `emit` receives them in order.
@@ -220,7 +239,7 @@ impl Instance {
             self.variable(vr)?;
         }
         for (i, &vr) in vrs.iter().enumerate() {
-            emit(i, self.values.get(vr as Vr));
+            emit(i, &self.to_interface(vr as Vr, self.values.get(vr as Vr)));
         }
         Ok(())
     }
@@ -264,7 +283,7 @@ impl Instance {
             return None;
         }
         for (slot, &vr) in out.iter_mut().zip(vrs) {
-            *slot = self.values.real(vr as Vr);
+            *slot = self.values.real(vr as Vr) * self.scale[vr as usize];
         }
         Some(())
     }
@@ -283,7 +302,7 @@ impl Instance {
             self.initialize_if_needed()?;
         }
         for (slot, &vr) in out.iter_mut().zip(vrs) {
-            *slot = self.values.real(vr as Vr);
+            *slot = self.values.real(vr as Vr) * self.scale[vr as usize];
         }
         Ok(())
     }
@@ -307,7 +326,7 @@ impl Instance {
             return None;
         }
         for (&vr, &x) in vrs.iter().zip(values) {
-            self.values.set_real(vr as Vr, x);
+            self.values.set_real(vr as Vr, x / self.scale[vr as usize]);
         }
         if self.mode != Mode::StepComplete {
             self.needs_initialize = true;
@@ -397,7 +416,10 @@ impl Instance {
         }
         let backup = tunable_changed.then(|| self.values.clone());
         for (i, &vr) in vrs.iter().enumerate() {
-            let value = value_at(i).map_err(Failure::error)?;
+            let value = match value_at(i).map_err(Failure::error)? {
+                Value::Real(x) => Value::Real(x / self.scale[vr as usize]),
+                other => other,
+            };
             self.values.set(vr as Vr, value);
         }
         if self.mode != Mode::StepComplete {
@@ -698,8 +720,11 @@ mod tests {
 
     fn started_at(start: f64) -> Instance {
         let logger = Logger::new(None, std::ptr::null_mut(), "t", false);
-        let info = &path_interpolator_2d::INFO;
-        let mut instance = Instance::new(info, Environment::default(), logger, "t");
+        let interface = crate::models::interface(
+            &path_interpolator_2d::INFO,
+            crate::framework::interface::UnitSystem::Millimetre,
+        );
+        let mut instance = Instance::with_interface(interface, Environment::default(), logger, "t");
         instance.setup_experiment(start, None).unwrap();
         instance.enter_initialization_mode().unwrap();
         instance.exit_initialization_mode().unwrap();

@@ -4,6 +4,7 @@
 //! a [`sample_clock`], implements [`model::Model`], and saves its state through
 //! [`state_codec`], checked on restore by [`state_check`].
 
+pub mod interface;
 pub mod model;
 pub mod sample_clock;
 pub mod state_check;

@@ -98,10 +98,22 @@ impl ModelInfo {
     /// GUID: it changes whenever the interface does, so importers that cache unpacked
     /// FMUs by GUID never mix versions.
     pub fn guid(&self) -> String {
+        self.guid_of(self.variables, "")
+    }
+
+    /// [`ModelInfo::guid`] of the model with the table `variables` as its interface
+    /// named `interface` (crate::framework::interface; "" for the model's own, whose GUID
+    /// it keeps). A named interface gets a GUID of its own even where its table is the
+    /// model's (a model without lengths).
+    pub fn guid_of(&self, variables: &[Variable], interface: &str) -> String {
         let mut hash = Sha256::new();
         hash.update(b"fmi2-cs\0");
         hash.update(self.identifier.as_bytes());
-        for v in self.variables {
+        if !interface.is_empty() {
+            hash.update(b"\0interface\0");
+            hash.update(interface.as_bytes());
+        }
+        for v in variables {
             hash.update(canonical_interface(v).as_bytes());
         }
         let d = hash.finalize();

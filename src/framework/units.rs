@@ -52,8 +52,26 @@ pub const UNITS: &[UnitDefinition] = &[
     unit("rad/s", 0, 0, -1, 0, 1, 1.0),
     unit("rad/s2", 0, 0, -2, 0, 1, 1.0),
     unit("mm/rad", 0, 1, 0, 0, -1, 1e-3),
+    // The SI build's lengths (crate::framework::interface).
+    unit("m", 0, 1, 0, 0, 0, 1.0),
+    unit("m/s", 0, 1, -1, 0, 0, 1.0),
+    unit("m/s2", 0, 1, -2, 0, 0, 1.0),
+    unit("m/s3", 0, 1, -3, 0, 0, 1.0),
+    unit("m/rad", 0, 1, 0, 0, -1, 1.0),
 ];
 
 pub fn find(name: &str) -> Option<&'static UnitDefinition> {
     UNITS.iter().find(|u| u.name == name)
+}
+
+/// The SI unit of the same quantity as `unit` (factor 1: m for mm, m/s for mm/s, …),
+/// `None` for a unit that is SI already or not defined.
+pub fn si_counterpart(unit: &str) -> Option<&'static UnitDefinition> {
+    let u = find(unit)?;
+    if u.factor == 1.0 {
+        return None;
+    }
+    UNITS.iter().find(|si| {
+        si.factor == 1.0 && (si.kg, si.m, si.s, si.a, si.rad) == (u.kg, u.m, u.s, u.a, u.rad)
+    })
 }

@@ -21,6 +21,9 @@ pub mod fault_probe;
 #[cfg(feature = "test-hooks")]
 pub mod pass_through;
 
+use std::sync::OnceLock;
+
+use crate::framework::interface::{Interface, UnitSystem};
 use crate::framework::model::ModelInfo;
 
 /// Every model this library serves (the packager builds one FMU per entry).
@@ -44,9 +47,29 @@ pub fn instantiable() -> Vec<&'static ModelInfo> {
     models
 }
 
-/// The model whose GUID this is.
-pub fn by_guid(guid: &str) -> Option<&'static ModelInfo> {
-    instantiable().into_iter().find(|m| m.guid() == guid)
+/// Every interface of every instantiable model: the mm one, then the SI one, model by
+/// model (built once).
+pub fn interfaces() -> &'static [Interface] {
+    static INTERFACES: OnceLock<Vec<Interface>> = OnceLock::new();
+    INTERFACES.get_or_init(|| {
+        instantiable()
+            .into_iter()
+            .flat_map(|m| UnitSystem::ALL.map(|units| Interface::new(m, units)))
+            .collect()
+    })
+}
+
+/// `model`'s interface in `units`.
+pub fn interface(model: &ModelInfo, units: UnitSystem) -> &'static Interface {
+    interfaces()
+        .iter()
+        .find(|i| i.units == units && std::ptr::eq(i.model, model))
+        .unwrap_or_else(|| panic!("{} is not an instantiable model", model.identifier))
+}
+
+/// The interface whose GUID this is.
+pub fn by_guid(guid: &str) -> Option<&'static Interface> {
+    interfaces().iter().find(|i| i.guid == guid)
 }
 
 #[cfg(test)]
@@ -240,7 +263,12 @@ mod tests {
 
     #[test]
     fn guids_are_distinct_and_formatted() {
-        let guids: Vec<String> = instantiable().iter().map(|m| m.guid()).collect();
+        let guids: Vec<String> = interfaces().iter().map(|i| i.guid.clone()).collect();
+        assert_eq!(guids.len(), 2 * instantiable().len());
+        // The mm interface keeps the model's GUID.
+        for m in instantiable() {
+            assert_eq!(interface(m, UnitSystem::Millimetre).guid, m.guid());
+        }
         for g in &guids {
             assert_eq!(g.len(), 38);
             assert!(g.starts_with('{') && g.ends_with('}'));

@@ -35,7 +35,10 @@ pub const fn drive_fields(p: AxisParams) -> [AxisTemplate; FIELDS] {
         Transmission::Linear { lead } => drive(
             ".lead",
             lead,
-            ("Ball-screw lead of the ", " axis (mm per revolution)"),
+            (
+                "Ball-screw lead of the ",
+                " axis (travel per screw revolution)",
+            ),
             AxisUnit::Fixed("mm"),
         ),
         Transmission::Rotary { ratio } => drive(

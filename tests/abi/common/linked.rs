@@ -16,6 +16,7 @@ use contour_fmu::fmi2::bindings::{
     fmi2ComponentEnvironment, fmi2FMUstate, fmi2Integer, fmi2Real, fmi2Status, fmi2String,
     fmi2Type, fmi2Type_fmi2CoSimulation, fmi2ValueReference,
 };
+use contour_fmu::framework::interface::{Interface, UnitSystem};
 use contour_fmu::framework::model::ModelInfo;
 use contour_fmu::models;
 
@@ -192,7 +193,24 @@ pub unsafe fn instantiate_configured(
     functions: *const fmi2CallbackFunctions,
     parameters: &[(&str, Start)],
 ) -> fmi2Component {
-    let guid = std::ffi::CString::new(model.guid()).expect("GUID without NUL");
+    let interface = models::interface(model, UnitSystem::Millimetre);
+    // SAFETY: as the caller promises.
+    unsafe { instantiate_interface(interface, name, functions, parameters) }
+}
+
+/// [`instantiate_configured`] for one of the model's interfaces (its GUID; parameter
+/// values in its units).
+///
+/// # Safety
+/// As [`instantiate_started`].
+pub unsafe fn instantiate_interface(
+    interface: &Interface,
+    name: &CStr,
+    functions: *const fmi2CallbackFunctions,
+    parameters: &[(&str, Start)],
+) -> fmi2Component {
+    let model = interface.model;
+    let guid = std::ffi::CString::new(interface.guid.clone()).expect("GUID without NUL");
     // SAFETY: NUL-terminated strings that live across the call, callbacks as the caller
     // promises; no resource location (none of the models used this way needs one).
     let c = unsafe {
