@@ -25,6 +25,24 @@ from .wiring import (CLOSED_LOOP_CONNECTIONS, FIVE_AXIS_CONNECTIONS, FIVE_AXIS_P
                      PATH_START)
 
 
+def co_simulation_description(path):
+    """The model description of the FMI 2.0 Co-Simulation FMU at `path`. Anything else is
+    refused with a ValueError naming the file and saying why: a master steps its FMUs
+    through fmi2DoStep, which an FMU exported for Model Exchange only does not have (it
+    needs an ODE solver that the FMU does not carry)."""
+    md = read_model_description(str(path))
+    if md.fmiVersion != "2.0":
+        raise ValueError(f"{path}: an FMI {md.fmiVersion} FMU; these masters run FMI 2.0 "
+                         f"Co-Simulation FMUs")
+    if md.coSimulation is None:
+        raise ValueError(
+            f"{path}: exported for Model Exchange only (no <CoSimulation> in its model "
+            f"description), so a co-simulation master cannot step it: it needs an ODE solver "
+            f"the FMU does not carry. Export the model for Co-Simulation (Modelica tools "
+            f"offer it, with their solver inside), or wrap it in a Co-Simulation FMU.")
+    return md
+
+
 def set_value(slave, variable, value):
     """Sets one variable (an fmpy model variable) of an FMU2Slave, by its type."""
     vr = [variable.valueReference]
@@ -73,7 +91,7 @@ class Master:
 
     def __enter__(self):
         for u in self.units:
-            md = read_model_description(u.path)
+            md = co_simulation_description(u.path)
             directory = extract(u.path)
             self._dirs.append(directory)
             slave = FMU2Slave(guid=md.guid, unzipDirectory=directory,

@@ -80,15 +80,16 @@ class LoopInstances:
 
     def __init__(self, loop, directories):
         """directories: unit -> unzip directory."""
-        from fmpy import read_model_description
         from fmpy.fmi2 import FMU2Slave
+
+        from ..master import co_simulation_description
 
         self.loop = LOOPS[loop]
         self.log = FmuLog(least=ERROR)  # the reasons a run failed
         self.slaves, self.variables = {}, {}
         try:
             for unit in ORDER:
-                md = read_model_description(str(directories[unit]))
+                md = co_simulation_description(directories[unit])
                 self.variables[unit] = {v.name: v for v in md.modelVariables}
                 slave = FMU2Slave(guid=md.guid, unzipDirectory=str(directories[unit]),
                                   modelIdentifier=md.coSimulation.modelIdentifier, instanceName=unit)

@@ -281,7 +281,11 @@ class _Reader:
             except Exception as e:  # noqa: BLE001  fmpy raises anything on a bad archive
                 self.fail(f"{path} is not a readable FMU: {e}")
             expected = Path(default).stem
-            if md.coSimulation is None or md.modelName != expected:
+            if md.coSimulation is None:
+                self.fail(f"{path}: exported for Model Exchange only (no <CoSimulation>): a "
+                          f"co-simulation master cannot step it (it needs an ODE solver the "
+                          f"FMU does not carry); export it for Co-Simulation")
+            if md.modelName != expected:
                 self.fail(f"{path} is {md.modelName!r}, not the {unit} of the {self.loop} "
                           f"loop ({expected}, FMI 2.0 Co-Simulation)")
             variables = {v.name: Variable(v.type, v.causality, _start(v), _bound(v.min), _bound(v.max),
