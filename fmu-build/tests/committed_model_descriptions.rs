@@ -75,8 +75,9 @@ fn every_output_is_listed_once_in_outputs_and_initial_unknowns() {
     }
 }
 
-/// The SI build declares metres where the mm build declares millimetres, with starts and
-/// bounds scaled by exactly the unit's factor, and changes nothing else.
+/// The SI build declares metres where the mm build declares millimetres (per metre where
+/// it declares per millimetre), with starts and bounds scaled by exactly the unit's
+/// factor, and changes nothing else.
 #[test]
 fn the_si_interface_is_the_mm_one_in_metres() {
     for model in models::all() {
@@ -92,6 +93,8 @@ fn the_si_interface_is_the_mm_one_in_metres() {
                 Some("mm/s2") => (Some("m/s2"), 1e-3),
                 Some("mm/s3") => (Some("m/s3"), 1e-3),
                 Some("mm/rad") => (Some("m/rad"), 1e-3),
+                Some("N.s/mm") => (Some("N.s/m"), 1e3),
+                Some("N/mm") => (Some("N/m"), 1e3),
                 other => (other, 1.0),
             };
             assert_eq!(b.unit, unit, "{}", a.name);

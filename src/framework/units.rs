@@ -52,12 +52,20 @@ pub const UNITS: &[UnitDefinition] = &[
     unit("rad/s", 0, 0, -1, 0, 1, 1.0),
     unit("rad/s2", 0, 0, -2, 0, 1, 1.0),
     unit("mm/rad", 0, 1, 0, 0, -1, 1e-3),
+    // Servo drives: force and torque, and their velocity-loop gains.
+    unit("N", 1, 1, -2, 0, 0, 1.0),
+    unit("N.m", 1, 2, -2, 0, 0, 1.0),
+    unit("N.s/mm", 1, 0, -1, 0, 0, 1e3),
+    unit("N/mm", 1, 0, -2, 0, 0, 1e3),
+    unit("N.m/rad", 1, 2, -2, 0, -1, 1.0),
     // The SI build's lengths (crate::framework::interface).
     unit("m", 0, 1, 0, 0, 0, 1.0),
     unit("m/s", 0, 1, -1, 0, 0, 1.0),
     unit("m/s2", 0, 1, -2, 0, 0, 1.0),
     unit("m/s3", 0, 1, -3, 0, 0, 1.0),
     unit("m/rad", 0, 1, 0, 0, -1, 1.0),
+    unit("N.s/m", 1, 0, -1, 0, 0, 1.0),
+    unit("N/m", 1, 0, -2, 0, 0, 1.0),
 ];
 
 pub fn find(name: &str) -> Option<&'static UnitDefinition> {

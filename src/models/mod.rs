@@ -13,6 +13,7 @@ pub mod line_arc_parameters;
 pub mod path_interpolator_2d;
 pub mod path_interpolator_5x;
 pub mod path_parameter;
+pub mod servo_drive;
 pub mod servo_plant;
 pub mod xy_servo_plant;
 
@@ -35,6 +36,8 @@ pub fn all() -> Vec<&'static ModelInfo> {
         &path_interpolator_5x::INFO,
         &contour_ccc_5x::INFO,
         &five_axis_plant::INFO,
+        &servo_drive::INFO,
+        &servo_drive::INFO_ROTARY,
     ]
 }
 

@@ -2,41 +2,33 @@
 //! every FMU in SI (m, m/s, m/s², m/s³) runs the mm loop's trajectories, scaled by 10⁻³,
 //! to 10⁻¹² relative; its bounds are the mm ones in metres; its GUID is its own.
 
-use std::ffi::CString;
-
-use contour_fmu::fmi2::bindings::fmi2Component;
 use contour_fmu::framework::interface::UnitSystem;
 use contour_fmu::models;
 
 use crate::common::linked::{
-    self, fmi2DoStep, fmi2FreeInstance, fmi2GetReal, fmi2SetReal, instantiate_interface, vrs, Start,
+    self, fmi2DoStep, fmi2GetReal, fmi2SetReal, vrs, OwnedInstance, Start,
 };
 
 /// One instance of `model` in `units` with `parameters` set (values in those units).
-fn instance(model: &str, units: UnitSystem, parameters: &[(&str, Start)]) -> fmi2Component {
-    let interface = models::interface(linked::model(model), units);
-    let name = CString::new(format!("{model}-{}", units.name())).unwrap();
-    // Leaked for the test's lifetime: the instance keeps a pointer to them.
-    let functions = Box::leak(Box::new(linked::quiet_callbacks()));
-    // SAFETY: the callbacks are leaked, so they outlive the instance.
-    unsafe { instantiate_interface(interface, &name, functions, parameters) }
+fn instance(model: &str, units: UnitSystem, parameters: &[(&str, Start)]) -> OwnedInstance {
+    OwnedInstance::new(models::interface(linked::model(model), units), parameters)
 }
 
-fn get(c: fmi2Component, model: &str, names: &[&str]) -> Vec<f64> {
+fn get(i: &OwnedInstance, model: &str, names: &[&str]) -> Vec<f64> {
     let vrs = vrs(linked::model(model), names);
     let mut out = vec![0.0; vrs.len()];
     // SAFETY: a live instance; buffers of the length passed.
     assert_eq!(
-        unsafe { fmi2GetReal(c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) },
+        unsafe { fmi2GetReal(i.c, vrs.as_ptr(), vrs.len(), out.as_mut_ptr()) },
         0
     );
     out
 }
 
-fn set(c: fmi2Component, model: &str, names: &[&str], values: &[f64]) -> u32 {
+fn set(i: &OwnedInstance, model: &str, names: &[&str], values: &[f64]) -> u32 {
     let vrs = vrs(linked::model(model), names);
     // SAFETY: a live instance; buffers of the length passed.
-    unsafe { fmi2SetReal(c, vrs.as_ptr(), vrs.len(), values.as_ptr()) }
+    unsafe { fmi2SetReal(i.c, vrs.as_ptr(), vrs.len(), values.as_ptr()) }
 }
 
 /// Reference, position, command and estimated contour error of every sample of the
@@ -53,7 +45,7 @@ fn closed_loop(units: UnitSystem) -> Vec<[f64; 7]> {
             ("jerk", Start::Real(1e5 * f)),
         ],
     );
-    let reference = get(interpolator, "PathInterpolator2D", &["ref.x", "ref.y"]);
+    let reference = get(&interpolator, "PathInterpolator2D", &["ref.x", "ref.y"]);
     let plant = instance(
         "XYServoPlant",
         units,
@@ -67,12 +59,12 @@ fn closed_loop(units: UnitSystem) -> Vec<[f64; 7]> {
     let h = 1e-3;
     for k in 0..2500 {
         let t = k as f64 * h;
-        let r = get(interpolator, "PathInterpolator2D", &["ref.x", "ref.y"]);
-        let p = get(plant, "XYServoPlant", &["pos.x", "pos.y"]);
+        let r = get(&interpolator, "PathInterpolator2D", &["ref.x", "ref.y"]);
+        let p = get(&plant, "XYServoPlant", &["pos.x", "pos.y"]);
         let inputs = [r[0], r[1], p[0], p[1]];
         assert_eq!(
             set(
-                controller,
+                &controller,
                 "ContourCCC2D",
                 &["ref.x", "ref.y", "pos.x", "pos.y"],
                 &inputs
@@ -80,19 +72,15 @@ fn closed_loop(units: UnitSystem) -> Vec<[f64; 7]> {
             0
         );
         // SAFETY: live instances.
-        assert_eq!(unsafe { fmi2DoStep(controller, t, h, 1) }, 0);
-        let u = get(controller, "ContourCCC2D", &["u.x", "u.y", "contourError"]);
-        assert_eq!(set(plant, "XYServoPlant", &["u.x", "u.y"], &u[..2]), 0);
+        assert_eq!(unsafe { fmi2DoStep(controller.c, t, h, 1) }, 0);
+        let u = get(&controller, "ContourCCC2D", &["u.x", "u.y", "contourError"]);
+        assert_eq!(set(&plant, "XYServoPlant", &["u.x", "u.y"], &u[..2]), 0);
         // SAFETY: live instances.
         unsafe {
-            assert_eq!(fmi2DoStep(plant, t, h, 1), 0);
-            assert_eq!(fmi2DoStep(interpolator, t, h, 1), 0);
+            assert_eq!(fmi2DoStep(plant.c, t, h, 1), 0);
+            assert_eq!(fmi2DoStep(interpolator.c, t, h, 1), 0);
         }
         rows.push([r[0], r[1], p[0], p[1], u[0], u[1], u[2]]);
-    }
-    for c in [interpolator, plant, controller] {
-        // SAFETY: live instances, freed once.
-        unsafe { fmi2FreeInstance(c) };
     }
     rows
 }
@@ -130,8 +118,8 @@ fn si_parameters_and_bounds_are_the_mm_ones_in_metres() {
         &[("feed", Start::Real(0.04))],
     );
     // SAFETY: a live instance.
-    assert_eq!(unsafe { fmi2DoStep(si, 0.0, 1e-3, 1) }, 0);
-    let rate = get(si, "PathInterpolator2D", &["feedRate"])[0];
+    assert_eq!(unsafe { fmi2DoStep(si.c, 0.0, 1e-3, 1) }, 0);
+    let rate = get(&si, "PathInterpolator2D", &["feedRate"])[0];
     assert!((rate - 0.04).abs() <= 1e-17, "{rate}");
     let bound = |units: UnitSystem, name: &str| {
         models::interface(linked::model("PathInterpolator2D"), units)
@@ -154,12 +142,8 @@ fn si_parameters_and_bounds_are_the_mm_ones_in_metres() {
     let mm = instance("PathInterpolator2D", UnitSystem::Millimetre, &[]);
     let si_default = instance("PathInterpolator2D", UnitSystem::Si, &[]);
     let (a, b) = (
-        get(mm, "PathInterpolator2D", &["ref.x", "ref.y"]),
-        get(si_default, "PathInterpolator2D", &["ref.x", "ref.y"]),
+        get(&mm, "PathInterpolator2D", &["ref.x", "ref.y"]),
+        get(&si_default, "PathInterpolator2D", &["ref.x", "ref.y"]),
     );
     assert!((a[0] * 1e-3 - b[0]).abs() <= 1e-15 && (a[1] * 1e-3 - b[1]).abs() <= 1e-15);
-    for c in [si, mm, si_default] {
-        // SAFETY: live instances, freed once.
-        unsafe { fmi2FreeInstance(c) };
-    }
 }

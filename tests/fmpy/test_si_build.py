@@ -11,8 +11,10 @@ from fmpy.validation import validate_fmu
 
 from contour_fmu.master import closed_loop, five_axis_closed_loop
 
-# The mm build's length units and their SI counterparts (factor: SI value per mm value).
+# The mm build's length units and their SI counterparts (SI value = 1e-3 × mm value).
 SI_OF = {"mm": "m", "mm/s": "m/s", "mm/s2": "m/s2", "mm/s3": "m/s3", "mm/rad": "m/rad"}
+# Per-length units (the servo drives' gains): SI value = 1e3 × mm value.
+SI_OF_PER_LENGTH = {"N.s/mm": "N.s/m", "N/mm": "N/m"}
 
 
 @pytest.fixture(scope="module")
@@ -36,8 +38,8 @@ def test_every_si_fmu_validates_and_declares_metres(fmu_dir, si_dir):
         for a, b in zip(mm.modelVariables, si.modelVariables, strict=True):
             assert (a.name, a.valueReference, a.causality, a.variability) == (
                 b.name, b.valueReference, b.causality, b.variability)
-            factor = 1e-3 if a.unit in SI_OF else 1.0
-            assert b.unit == SI_OF.get(a.unit, a.unit), a.name
+            factor = 1e-3 if a.unit in SI_OF else 1e3 if a.unit in SI_OF_PER_LENGTH else 1.0
+            assert b.unit == {**SI_OF, **SI_OF_PER_LENGTH}.get(a.unit, a.unit), a.name
             for attribute in ("start", "min", "max"):
                 x, y = getattr(a, attribute), getattr(b, attribute)
                 if a.type == "Real" and x is not None:

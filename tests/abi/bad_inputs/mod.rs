@@ -30,7 +30,7 @@ use contour_fmu::framework::model::ModelInfo;
 use contour_fmu::framework::variables::{Causality, VarType};
 use contour_fmu::models::{
     contour_ccc_2d, contour_ccc_5x, fault_probe, five_axis_plant, path_interpolator_2d,
-    path_interpolator_5x, xy_servo_plant,
+    path_interpolator_5x, servo_drive, xy_servo_plant,
 };
 
 mod call_order;
@@ -51,6 +51,8 @@ const F5: &ModelInfo = &five_axis_plant::INFO;
 const P2: &ModelInfo = &path_interpolator_2d::INFO;
 const P5: &ModelInfo = &path_interpolator_5x::INFO;
 const XY: &ModelInfo = &xy_servo_plant::INFO;
+const SD: &ModelInfo = &servo_drive::INFO;
+const SR: &ModelInfo = &servo_drive::INFO_ROTARY;
 const PROBE: &ModelInfo = &fault_probe::INFO;
 
 /// Communication step of every run.

@@ -5,6 +5,24 @@ use super::*;
 
 pub(super) static CASES: &[Case] = &[
     case(
+        "a zero effort limit (servo drive)",
+        SD,
+        Initialization,
+        |s| s.exit_with(|s| s.set_real("effortMax", 0.0)),
+        ERROR,
+        Some("fmi2ExitInitializationMode: effortMax must be finite and > 0 (got 0)"),
+        Corrected,
+    ),
+    case(
+        "a negative integral gain (rotary servo drive)",
+        SR,
+        Initialization,
+        |s| s.set_real("Kvi", -1.0),
+        ERROR,
+        Some("fmi2SetReal: variable 'Kvi' = -1 is below its minimum 0"),
+        Usable,
+    ),
+    case(
         "Ts = 0 (controller)",
         C2,
         Initialization,

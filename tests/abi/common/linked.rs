@@ -198,6 +198,40 @@ pub unsafe fn instantiate_configured(
     unsafe { instantiate_interface(interface, name, functions, parameters) }
 }
 
+/// An instance of one of a model's interfaces with the callbacks it logs through, freed
+/// (the instance first) when dropped.
+pub struct OwnedInstance {
+    pub c: fmi2Component,
+    _functions: Box<fmi2CallbackFunctions>,
+}
+
+impl OwnedInstance {
+    /// [`instantiate_interface`] with quiet callbacks.
+    pub fn new(interface: &Interface, parameters: &[(&str, Start)]) -> Self {
+        let functions = Box::new(quiet_callbacks());
+        let name = std::ffi::CString::new(format!(
+            "{}-{}",
+            interface.model.identifier,
+            interface.units.name()
+        ))
+        .expect("a name without NUL");
+        // SAFETY: the callbacks are boxed in the returned value, which frees the instance
+        // before them.
+        let c = unsafe { instantiate_interface(interface, &name, &*functions, parameters) };
+        OwnedInstance {
+            c,
+            _functions: functions,
+        }
+    }
+}
+
+impl Drop for OwnedInstance {
+    fn drop(&mut self) {
+        // SAFETY: a live instance, freed once; nothing uses it after this.
+        unsafe { fmi2FreeInstance(self.c) };
+    }
+}
+
 /// [`instantiate_configured`] for one of the model's interfaces (its GUID; parameter
 /// values in its units).
 ///
