@@ -222,6 +222,14 @@ impl Instance {
             .ok_or_else(|| Failure::error(format!("unknown value reference {vr}")))
     }
 
+    /// A value in the model's units from the interface's.
+    fn to_model(&self, vr: Vr, value: Value) -> Value {
+        match value {
+            Value::Real(x) => Value::Real(x / self.scale[vr]),
+            other => other,
+        }
+    }
+
     /// A value in the interface's units from the model's.
     fn to_interface(&self, vr: Vr, value: &Value) -> Value {
         match *value {
@@ -314,13 +322,13 @@ impl Instance {
     /// does, returning `Some`; `None`, having changed nothing, for any other call.
     #[inline]
     pub fn set_free_reals(&mut self, vrs: &[u32], values: &[f64]) -> Option<()> {
+        // Finite in the model's units too: a finite value in m can overflow in mm.
         let free = vrs.len() == values.len()
             && vrs.iter().zip(values).all(|(&vr, x)| {
-                x.is_finite()
-                    && self
-                        .access
-                        .get(vr as usize)
-                        .is_some_and(|a| a.has(Access::FREE_REAL_INPUT))
+                self.access
+                    .get(vr as usize)
+                    .is_some_and(|a| a.has(Access::FREE_REAL_INPUT))
+                    && (x / self.scale[vr as usize]).is_finite()
             });
         if !free {
             return None;
@@ -395,6 +403,11 @@ impl Instance {
             let v = self.variable(vr)?;
             let value = value_at(i).map_err(Failure::error)?;
             v.check(&value).map_err(Failure::error)?;
+            // And in the model's units, as a saved state is checked: a finite value in m
+            // can overflow in mm, a bound can round across.
+            self.info.variables[vr as usize]
+                .check(&self.to_model(vr as Vr, value))
+                .map_err(|e| Failure::error(format!("{e} (in the model's units)")))?;
             match (v.causality, self.mode) {
                 (Causality::Output, _) => {
                     return Err(Failure::error(format!(
@@ -416,10 +429,7 @@ impl Instance {
         }
         let backup = tunable_changed.then(|| self.values.clone());
         for (i, &vr) in vrs.iter().enumerate() {
-            let value = match value_at(i).map_err(Failure::error)? {
-                Value::Real(x) => Value::Real(x / self.scale[vr as usize]),
-                other => other,
-            };
+            let value = self.to_model(vr as Vr, value_at(i).map_err(Failure::error)?);
             self.values.set(vr as Vr, value);
         }
         if self.mode != Mode::StepComplete {
@@ -546,7 +556,7 @@ impl Instance {
         let snapshot = fmu_state::decode(bytes).map_err(Failure::error)?;
         if snapshot.guid != self.guid {
             return Err(Failure::error(format!(
-                "the FMU state belongs to another model (GUID {}), not {} ({})",
+                "the FMU state belongs to another model or interface (GUID {}), not this {} ({})",
                 snapshot.guid, self.info.identifier, self.guid
             )));
         }

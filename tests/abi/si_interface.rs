@@ -138,6 +138,13 @@ fn si_parameters_and_bounds_are_the_mm_ones_in_metres() {
             Some("m/s")
         )
     );
+    // A finite value in m that overflows in mm is refused, the old value kept: fast path
+    // (an input without bounds) and checked path (a parameter).
+    let plant = instance("XYServoPlant", UnitSystem::Si, &[]);
+    assert_ne!(set(&plant, "XYServoPlant", &["u.x"], &[1e306]), 0);
+    assert_eq!(get(&plant, "XYServoPlant", &["u.x"]), [0.0]);
+    assert_eq!(set(&plant, "XYServoPlant", &["u.x"], &[0.02]), 0);
+    assert_eq!(get(&plant, "XYServoPlant", &["u.x"]), [0.02]);
     // The interpolator's first output, in m, is the circle's start in mm over 1000.
     let mm = instance("PathInterpolator2D", UnitSystem::Millimetre, &[]);
     let si_default = instance("PathInterpolator2D", UnitSystem::Si, &[]);

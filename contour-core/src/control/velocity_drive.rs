@@ -117,8 +117,14 @@ impl VelocityDrive {
     /// `velocity` sampled at its start: returns the effort for the step.
     pub fn step(&mut self, command: f64, velocity: f64, h: f64) -> f64 {
         let p = self.params;
-        self.filtered_velocity +=
-            approach(p.velocity_filter, h) * (velocity - self.filtered_velocity);
+        // Without a filter (or a lag) the value is taken as it is: x + 1·(y − x) is not
+        // always y in floating point.
+        if p.velocity_filter > 0.0 {
+            self.filtered_velocity +=
+                approach(p.velocity_filter, h) * (velocity - self.filtered_velocity);
+        } else {
+            self.filtered_velocity = velocity;
+        }
         let error = command - self.filtered_velocity;
         let demand = p.kvp * error + self.integral;
         let limited = demand.clamp(-p.effort_max, p.effort_max);
@@ -128,7 +134,14 @@ impl VelocityDrive {
         if !winding_up {
             self.integral = (self.integral + p.kvi * error * h).clamp(-p.effort_max, p.effort_max);
         }
-        self.effort += approach(p.current_lag, h) * (limited - self.effort);
+        self.effort = if p.current_lag > 0.0 {
+            // Between the last effort and the new demand, both within the limit, but for
+            // rounding.
+            (self.effort + approach(p.current_lag, h) * (limited - self.effort))
+                .clamp(-p.effort_max, p.effort_max)
+        } else {
+            limited
+        };
         self.effort
     }
 }
@@ -220,6 +233,37 @@ mod tests {
         let after = drive.step(0.0, 0.0, h);
         assert_eq!(after, drive.integral());
         assert!(after < P.effort_max && after <= held + 1e-9, "{after}");
+    }
+
+    #[test]
+    fn the_effort_never_passes_the_limit_by_rounding() {
+        // From a negative effort into positive saturation: x + 1·(max − x) rounds above
+        // max for some x (−3656.3575588759877 with max 5000, 4 % of them); the effort
+        // must stay within the limit, with and without a current lag, and be the limit
+        // exactly without one.
+        for lag in [0.0, 1e-4] {
+            let params = DriveParams {
+                current_lag: lag,
+                kvi: 0.0,
+                ..P
+            };
+            let mut drive = VelocityDrive::new(params, 0.0).unwrap();
+            for k in 0..2000 {
+                let command = if k % 2 == 0 {
+                    -(3656.3575588759877 + k as f64 * 0.37) / P.kvp
+                } else {
+                    1e6
+                };
+                let effort = drive.step(command, 0.0, 1e-3);
+                assert!(
+                    effort.abs() <= P.effort_max,
+                    "lag {lag}, step {k}: {effort}"
+                );
+                if lag == 0.0 && k % 2 == 1 {
+                    assert_eq!(effort, P.effort_max);
+                }
+            }
+        }
     }
 
     #[test]
