@@ -1,7 +1,8 @@
 //! `FiveAxisPlant`: the five-axis test plant of docs/design/five-axis.md §5.1 (the FMU: §5.6) as an FMU model —
 //! X, Y, Z ball-screw axes as the two-axis plant's, A and C on a small trunnion table
 //! (worm gears). Velocity commands in (mm/s, rad/s), positions and velocities out;
-//! integrated exactly, so the trajectory does not depend on the communication step.
+//! linear by default and then integrated exactly, so the trajectory does not depend on the
+//! communication step; friction, backlash and a current limit (§4.5b) are substepped.
 
 use super::axis_variables::{COMMAND_IN, INITIAL_POSITION, POSITION_OUT, VELOCITY_OUT};
 use super::servo_plant::{self, FIELDS};
@@ -27,13 +28,16 @@ variable_table! {
     /// J, B, CT, ratio, Kvp, Kvi of C (rotary table).
     C_PARAMS: Reals<6> = axis_block(&[XYZAC[4]], &servo_plant::drive_fields(PLANT.axes[4]));
     POS0: Reals<5> = axis_block(&XYZAC, &[INITIAL_POSITION]);
+    /// Friction, backlash and current limit of X, Y, Z, A, C (all off by default).
+    EFFECTS: Reals<25> = axis_block(&XYZAC, &servo_plant::EFFECT_TEMPLATES);
 }
 
 pub static INFO: ModelInfo = ModelInfo {
     identifier: "FiveAxisPlant",
     description: "Five-axis servo test plant (X Y Z ball screws, A C trunnion table on worm \
-                  gears): per axis a PI velocity-loop drive and a motor; velocity commands \
-                  in, positions out, integrated exactly",
+                  gears): per axis a PI velocity-loop drive and a motor, optionally with \
+                  friction, backlash and a current limit; velocity commands in, positions \
+                  out, integrated exactly when linear",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment {
         start_time: 0.0,
@@ -52,10 +56,11 @@ pub static INFO: ModelInfo = ModelInfo {
     create: |_: &Environment| Box::new(FiveAxisPlant::default()),
 };
 
-/// The [`ServoAxes`] as they serialise.
+/// The [`ServoAxes`] as they serialise. Version 2: each axis gained its effects and the
+/// table behind the play.
 const LAYOUT: StateLayout = StateLayout {
     model: "FiveAxisPlant",
-    version: 1,
+    version: 2,
 };
 
 /// The plant model; its state is the axes'.
@@ -76,11 +81,14 @@ type Vector5 = contour_core::geometry::Vector<5>;
 /// The parameters of joint `index` (X, Y, Z, A, C).
 fn axis_params(values: &Values, index: usize) -> Result<AxisParams, String> {
     let axis = &XYZAC[index];
-    match index {
+    let params = match index {
         0..=2 => servo_plant::axis_params(values, &VARIABLES, LINEAR_PARAMS, index * FIELDS, axis),
         3 => servo_plant::axis_params(values, &VARIABLES, A_PARAMS, 0, axis),
         _ => servo_plant::axis_params(values, &VARIABLES, C_PARAMS, 0, axis),
-    }
+    }?;
+    let effects =
+        servo_plant::axis_effects(values, EFFECTS, index * servo_plant::EFFECT_FIELDS, axis)?;
+    Ok(AxisParams { effects, ..params })
 }
 
 impl FiveAxisPlant {

@@ -1,12 +1,13 @@
 //! What the servo-plant models share (`XYServoPlant`, `FiveAxisPlant`): reading one
-//! axis's drive parameters from a block of six (J, B, CT, lead or ratio, Kvp, Kvi), and
+//! axis's drive parameters from a block of six (J, B, CT, lead or ratio, Kvp, Kvi) and its
+//! nonlinear effects from a block of five (friction, backlash, current limit), and
 //! checking a restored table of axes.
 
 use crate::framework::state_check;
 use crate::framework::state_codec::{decode_state, StateLayout};
 use crate::framework::variable_table::{Axis, AxisKind, AxisTemplate, AxisUnit, AxisWord, Reals};
 use crate::framework::variables::{Values, Variable};
-use contour_core::plant::{AxisParams, ServoAxes, ServoAxis, Transmission};
+use contour_core::plant::{AxisEffects, AxisParams, ServoAxes, ServoAxis, Transmission};
 
 /// Drive parameters per axis, in [`AxisParams`] field order.
 pub const FIELDS: usize = 6;
@@ -83,6 +84,91 @@ pub const fn drive_fields(p: AxisParams) -> [AxisTemplate; FIELDS] {
     ]
 }
 
+/// Nonlinear effects per axis, in [`AxisEffects`] field order.
+pub const EFFECT_FIELDS: usize = 5;
+
+/// An effect of every axis of a block, 0 (off) by default.
+const fn effect(
+    suffix: &'static str,
+    description: (&'static str, &'static str),
+    unit: AxisUnit,
+) -> AxisTemplate {
+    AxisTemplate::parameter(
+        ("", suffix),
+        (0.0, 0.0),
+        (description.0, AxisWord::Name, description.1),
+    )
+    .unit(unit)
+    .min(0.0)
+}
+
+/// The nonlinear effects of an axis (docs/design/two-axis.md §4.5b), all off (0) by
+/// default: `.coulomb`, `.stiction`, `.stribeckVelocity`, `.backlash`, `.currentMax`.
+pub const EFFECT_TEMPLATES: [AxisTemplate; EFFECT_FIELDS] = [
+    effect(
+        ".coulomb",
+        (
+            "Coulomb friction torque of the ",
+            " axis at the motor (0: none)",
+        ),
+        AxisUnit::Fixed("N.m"),
+    ),
+    effect(
+        ".stiction",
+        (
+            "Static (breakaway) friction torque of the ",
+            " axis at the motor, 0 or >= coulomb",
+        ),
+        AxisUnit::Fixed("N.m"),
+    ),
+    effect(
+        ".stribeckVelocity",
+        (
+            "Stribeck velocity of the ",
+            " axis: friction falls from static to Coulomb as exp(-(v/vs)^2) (0: at once)",
+        ),
+        AxisUnit::VELOCITY,
+    ),
+    effect(
+        ".backlash",
+        (
+            "Total play of the ",
+            " axis's transmission; pos is the table's position behind it (0: none)",
+        ),
+        AxisUnit::POSITION,
+    ),
+    effect(
+        ".currentMax",
+        (
+            "Current limit of the ",
+            " drive, with anti-windup (0: none)",
+        ),
+        AxisUnit::Fixed("A"),
+    ),
+];
+
+/// The effects of `axis` from its block `block` of [`EFFECT_FIELDS`] variables starting
+/// at offset `first`.
+pub fn axis_effects<const N: usize>(
+    values: &Values,
+    block: Reals<N>,
+    first: usize,
+    axis: &Axis,
+) -> Result<AxisEffects, String> {
+    let p = |i: usize| block.at(first + i).get(values);
+    let effects = AxisEffects {
+        coulomb: p(0),
+        stiction: p(1),
+        stribeck_velocity: p(2),
+        backlash: p(3),
+        current_max: p(4),
+    };
+    effects
+        .validate()
+        .map_err(|e| format!("axis {}: {e}", axis.name))?;
+    Ok(effects)
+}
+
 /// The parameters of `axis` from its block `block` of [`FIELDS`] variables starting at
 /// offset `first` in `table`; J, CT and the transmission must be > 0.
 pub fn axis_params<const N: usize>(
@@ -104,6 +190,7 @@ pub fn axis_params<const N: usize>(
         transmission,
         kvp: p(4),
         kvi: p(5),
+        effects: AxisEffects::NONE,
     };
     // J, CT and the transmission divide or scale the dynamics: zero is as unphysical as
     // negative.
@@ -175,6 +262,9 @@ pub fn validate<const D: usize>(table: &ServoAxes<D>, axes: &[Axis; D]) -> Resul
             ));
         }
         state_check::all_finite(servo).map_err(|e| format!("axis {name}: {e}"))?;
+        servo
+            .check_play()
+            .map_err(|e| format!("axis {name}: {e}"))?;
         check_cached_transition(name, servo)?;
     }
     Ok(())

@@ -1,6 +1,7 @@
 //! `XYServoPlant`: the two-axis test plant of docs/design/two-axis.md §4.5 as an FMU model. Velocity
-//! commands in, positions and velocities out; integrated exactly, so the trajectory does
-//! not depend on the communication step.
+//! commands in, positions and velocities out. Linear by default and then integrated exactly,
+//! so the trajectory does not depend on the communication step; friction, backlash and a
+//! current limit (§4.5b) are substepped.
 
 use super::axis_variables::{COMMAND_IN, INITIAL_POSITION, POSITION_OUT, VELOCITY_OUT};
 use super::servo_plant;
@@ -22,13 +23,16 @@ variable_table! {
     /// J, B, CT, lead, Kvp, Kvi of X, then of Y.
     AXIS_PARAMS: Reals<12> = axis_block(&XY, &AXIS_FIELDS);
     POS0: Reals<2> = axis_block(&XY, &[INITIAL_POSITION]);
+    /// Friction, backlash and current limit of X, then of Y (all off by default).
+    EFFECTS: Reals<10> = axis_block(&XY, &servo_plant::EFFECT_TEMPLATES);
 }
 
 pub static INFO: ModelInfo = ModelInfo {
     identifier: "XYServoPlant",
     description:
         "Two-axis servo test plant: per axis a PI velocity-loop drive, a motor (J, B, CT) \
-                  and a ball screw; velocity commands in, positions out, integrated exactly",
+                  and a ball screw, optionally with friction, backlash and a current limit; \
+                  velocity commands in, positions out, integrated exactly when linear",
     variables: &VARIABLES,
     default_experiment: DefaultExperiment {
         start_time: 0.0,
@@ -45,10 +49,11 @@ pub static INFO: ModelInfo = ModelInfo {
 };
 
 /// The [`XyTable`] as it serialises. Version 2: each axis's lead became a
-/// [`Transmission`] (linear or rotary).
+/// [`Transmission`] (linear or rotary); 3: each axis gained its effects and the table
+/// behind the play.
 const LAYOUT: StateLayout = StateLayout {
     model: "XYServoPlant",
-    version: 2,
+    version: 3,
 };
 
 /// The plant model; its state is the table's.
@@ -66,13 +71,20 @@ impl Default for XYServoPlant {
 
 /// The parameters of axis `index` (0 = x, 1 = y).
 fn axis_params(values: &Values, index: usize) -> Result<AxisParams, String> {
-    servo_plant::axis_params(
+    let params = servo_plant::axis_params(
         values,
         &VARIABLES,
         AXIS_PARAMS,
         index * AXIS_FIELDS.len(),
         &XY[index],
-    )
+    )?;
+    let effects = servo_plant::axis_effects(
+        values,
+        EFFECTS,
+        index * servo_plant::EFFECT_FIELDS,
+        &XY[index],
+    )?;
+    Ok(AxisParams { effects, ..params })
 }
 
 impl XYServoPlant {

@@ -19,6 +19,7 @@ mod instantiation;
 mod logging;
 mod models_vs_sim;
 mod no_alloc;
+mod plant_effects;
 mod servo_drive;
 mod si_interface;
 #[cfg(feature = "test-hooks")]

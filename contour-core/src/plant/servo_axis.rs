@@ -16,8 +16,10 @@
 //! command is held constant over a step (zero-order hold), so the exact discretisation
 //! by the matrix exponential makes the trajectory independent of the step size.
 
-use nalgebra::{Matrix3, Matrix4, Vector3};
+use nalgebra::{Matrix3, Matrix4, Matrix5, Vector3};
 use serde::{Deserialize, Serialize};
+
+use super::axis_effects::AxisEffects;
 
 /// How motor revolutions become axis motion.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -71,6 +73,9 @@ pub struct AxisParams {
     pub kvp: f64,
     /// Drive velocity-loop integral gain, A/rad.
     pub kvi: f64,
+    /// Friction beyond the viscous, backlash and the current limit; none by default.
+    #[serde(default)]
+    pub effects: AxisEffects,
 }
 
 impl AxisParams {
@@ -83,6 +88,7 @@ impl AxisParams {
         transmission: Transmission::Linear { lead: 10.0 },
         kvp: 8.26,
         kvi: 661.0,
+        effects: AxisEffects::NONE,
     };
 
     /// Tilt (A) axis of a small trunnion table: the same 0.57 N·m/A servo motor through a
@@ -107,6 +113,7 @@ impl AxisParams {
             transmission: Transmission::Rotary { ratio: 90.0 },
             kvp: 314.0 * inertia / 0.57,
             kvi: 80.0 * 314.0 * inertia / 0.57,
+            effects: AxisEffects::NONE,
         }
     }
 
@@ -132,7 +139,8 @@ impl AxisParams {
                 return Err(format!("{name} must be finite and >= 0 (got {value})"));
             }
         }
-        self.transmission.validate()
+        self.transmission.validate()?;
+        self.effects.validate()
     }
 
     /// Continuous-time system matrices (A, b) of the state (x, ẋ, z) with input v.
@@ -154,6 +162,23 @@ impl AxisParams {
     }
 }
 
+/// exp(M·h) of a system matrix M scaled by h, or NaN where h·M is beyond 1e25.
+///
+/// nalgebra's exp squares s times, s from the norms of the matrix's powers up to the
+/// 10th: past ~1e30 an entry makes them infinite and s = u64::MAX, a loop for ever (found
+/// by fuzz/deserialize_state). Such a step has no useful answer: NaN, which the FMI layer
+/// refuses as an overflow.
+fn guarded_exp<const N: usize>(scaled: nalgebra::SMatrix<f64, N, N>) -> nalgebra::SMatrix<f64, N, N>
+where
+    nalgebra::Const<N>: nalgebra::DimMin<nalgebra::Const<N>, Output = nalgebra::Const<N>>,
+{
+    if scaled.iter().all(|x| x.abs() <= 1e25) {
+        scaled.exp()
+    } else {
+        nalgebra::SMatrix::from_element(f64::NAN)
+    }
+}
+
 /// Exact zero-order-hold transition for one step length: s ← Φ·s + Γ·v.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 struct Discretisation {
@@ -169,16 +194,7 @@ impl Discretisation {
         let mut augmented = Matrix4::zeros();
         augmented.fixed_view_mut::<3, 3>(0, 0).copy_from(&a);
         augmented.fixed_view_mut::<3, 1>(0, 3).copy_from(&b);
-        let scaled = augmented * step;
-        // nalgebra's exp squares s times, s from the norms of the matrix's powers up to
-        // the 10th: past ~1e30 an entry makes them infinite and s = u64::MAX, a loop for
-        // ever (found by fuzz/deserialize_state). Such a step (h·A beyond 1e25) has no
-        // useful answer: NaN, which the FMI layer refuses as an overflow.
-        let exp = if scaled.iter().all(|x| x.abs() <= 1e25) {
-            scaled.exp()
-        } else {
-            Matrix4::from_element(f64::NAN)
-        };
+        let exp = guarded_exp(augmented * step);
         Discretisation {
             step,
             phi: exp.fixed_view::<3, 3>(0, 0).into_owned(),
@@ -187,23 +203,151 @@ impl Discretisation {
     }
 }
 
+/// The longest substep of an axis with [`AxisEffects`], s. Friction's direction, sticking,
+/// contact in the play and the current limit are decided at the start of each substep,
+/// so events are placed to within one; 1 ms, 0.5 ms, 0.25 ms, 0.1 ms and 2 ms are whole
+/// numbers of it, so those communication steps share the substep grid.
+pub const MAX_SUBSTEP: f64 = 1e-5;
+
+/// The most substeps in one communication step (a step beyond 10 s gets longer
+/// substeps, and beyond ~1e25 s NaN).
+const MAX_SUBSTEPS: u32 = 1_000_000;
+
+/// One substep's exact transition with the command v and an external motor torque τ
+/// held: s ← Φ·s + Γv·v + Γτ·τ.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+struct HeldInputs {
+    phi: Matrix3<f64>,
+    gamma_command: Vector3<f64>,
+    gamma_torque: Vector3<f64>,
+}
+
+impl HeldInputs {
+    fn new(a: Matrix3<f64>, b_command: Vector3<f64>, b_torque: Vector3<f64>, h: f64) -> Self {
+        let mut augmented = Matrix5::zeros();
+        augmented.fixed_view_mut::<3, 3>(0, 0).copy_from(&a);
+        augmented.fixed_view_mut::<3, 1>(0, 3).copy_from(&b_command);
+        augmented.fixed_view_mut::<3, 1>(0, 4).copy_from(&b_torque);
+        let exp = guarded_exp(augmented * h);
+        HeldInputs {
+            phi: exp.fixed_view::<3, 3>(0, 0).into_owned(),
+            gamma_command: exp.fixed_view::<3, 1>(0, 3).into_owned(),
+            gamma_torque: exp.fixed_view::<3, 1>(0, 4).into_owned(),
+        }
+    }
+
+    fn apply(&self, state: &Vector3<f64>, command: f64, torque: f64) -> Vector3<f64> {
+        self.phi * state + self.gamma_command * command + self.gamma_torque * torque
+    }
+}
+
+/// The substeps of one communication step of an axis with effects: the transitions with
+/// the drive's PI loop closed (`linear`) and with its current at the limit (`saturated`,
+/// the current then an external torque).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+struct SubstepDiscretisation {
+    /// The communication step these substeps make up, s.
+    step: f64,
+    substeps: u32,
+    linear: HeldInputs,
+    saturated: HeldInputs,
+}
+
+impl SubstepDiscretisation {
+    fn new(params: &AxisParams, step: f64) -> Self {
+        let substeps = ((step / MAX_SUBSTEP) * (1.0 - 1e-12))
+            .ceil()
+            .clamp(1.0, MAX_SUBSTEPS as f64);
+        let substeps = if substeps.is_nan() {
+            1
+        } else {
+            substeps as u32
+        };
+        let h = step / f64::from(substeps);
+        let (a, b) = params.continuous();
+        // A torque τ at the motor accelerates the axis by τ/(J·k) in axis units.
+        let b_torque = Vector3::new(
+            0.0,
+            1.0 / (params.inertia * params.transmission.motor_per_axis_unit()),
+            0.0,
+        );
+        // At the limit the current no longer depends on the state: only the viscous
+        // friction acts on ẋ, and the command reaches the integral alone.
+        let a_saturated = Matrix3::new(
+            0.0,
+            1.0,
+            0.0, //
+            0.0,
+            -params.friction / params.inertia,
+            0.0, //
+            0.0,
+            -1.0,
+            0.0,
+        );
+        SubstepDiscretisation {
+            step,
+            substeps,
+            linear: HeldInputs::new(a, b, b_torque, h),
+            saturated: HeldInputs::new(a_saturated, Vector3::new(0.0, 0.0, 1.0), b_torque, h),
+        }
+    }
+
+    fn substep(&self) -> f64 {
+        self.step / f64::from(self.substeps)
+    }
+}
+
+/// Where the motor is in the transmission's play: pushing the table forward, backward,
+/// or in between (the table held by its friction).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Contact {
+    /// In the play, the table left where the motor last pushed it.
+    Gap,
+    /// Pushing the table toward +.
+    Forward,
+    /// Pushing the table toward −.
+    Backward,
+}
+
+/// The table behind the transmission's play (backlash only).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+struct Table {
+    /// mm or rad.
+    position: f64,
+    /// mm/s or rad/s: the motor's while it pushes, 0 in the play.
+    velocity: f64,
+    contact: Contact,
+}
+
 /// State and parameters of one axis.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ServoAxis {
     params: AxisParams,
-    /// (x mm, ẋ mm/s, z mm).
+    /// The motor side in axis units: (x mm, ẋ mm/s, z mm).
     state: Vector3<f64>,
+    /// The table, which follows the motor through the play (with backlash; otherwise
+    /// the motor's position is the table's).
+    table: Table,
     /// The last step length's transition, reused while the step length stays the same.
     cached: Option<Discretisation>,
+    /// The same with effects: the last step length's substeps.
+    cached_substeps: Option<SubstepDiscretisation>,
 }
 
 impl ServoAxis {
-    /// An axis at rest at `position` (mm or rad).
+    /// An axis at rest at `position` (mm or rad); with backlash the motor is in the
+    /// middle of the play.
     pub fn new(params: AxisParams, position: f64) -> Self {
         ServoAxis {
             params,
             state: Vector3::new(position, 0.0, 0.0),
+            table: Table {
+                position,
+                velocity: 0.0,
+                contact: Contact::Gap,
+            },
             cached: None,
+            cached_substeps: None,
         }
     }
 
@@ -212,36 +356,178 @@ impl ServoAxis {
         &self.params
     }
 
-    /// Position, mm or rad.
+    /// Position of the table, mm or rad (as a linear scale measures it): the motor's
+    /// but for backlash.
     pub fn position(&self) -> f64 {
-        self.state[0]
+        if self.params.effects.backlash > 0.0 {
+            self.table.position
+        } else {
+            self.state[0]
+        }
     }
 
-    /// Velocity, mm/s or rad/s.
+    /// Velocity of the table, mm/s or rad/s: the motor's but for backlash, where the
+    /// table stands still in the play.
     pub fn velocity(&self) -> f64 {
-        self.state[1]
+        if self.params.effects.backlash > 0.0 {
+            self.table.velocity
+        } else {
+            self.state[1]
+        }
     }
 
-    /// Motor current demanded by the drive, A.
+    /// The motor's position and velocity in axis units (what the drive's encoder
+    /// measures and its velocity loop feeds back).
+    pub fn motor(&self) -> (f64, f64) {
+        (self.state[0], self.state[1])
+    }
+
+    /// Where the motor is in the play.
+    pub fn contact(&self) -> Contact {
+        self.table.contact
+    }
+
+    /// Motor current demanded by the drive, A (within the current limit).
     pub fn current(&self, command: f64) -> f64 {
         let p = &self.params;
         let scale = p.transmission.motor_per_axis_unit();
-        scale * (p.kvp * (command - self.state[1]) + p.kvi * self.state[2])
+        let limit = p.effects.current_limit();
+        (scale * (p.kvp * (command - self.state[1]) + p.kvi * self.state[2])).clamp(-limit, limit)
     }
 
     /// Advances by `step` seconds with the velocity command `command` (mm/s or rad/s) held.
-    /// No heap allocation; the matrix exponential is only recomputed when the step
-    /// length changes.
+    /// No heap allocation; the transitions are only recomputed when the step length
+    /// changes. A linear axis takes one exact step; one with effects [`MAX_SUBSTEP`]s.
     pub fn step(&mut self, command: f64, step: f64) {
-        let d = match self.cached {
+        if self.params.effects.is_none() {
+            let d = match self.cached {
+                Some(d) if d.step == step => d,
+                _ => {
+                    let d = Discretisation::new(&self.params, step);
+                    self.cached = Some(d);
+                    d
+                }
+            };
+            self.state = d.phi * self.state + d.gamma * command;
+            return;
+        }
+        let d = match self.cached_substeps {
             Some(d) if d.step == step => d,
             _ => {
-                let d = Discretisation::new(&self.params, step);
-                self.cached = Some(d);
+                let d = SubstepDiscretisation::new(&self.params, step);
+                self.cached_substeps = Some(d);
                 d
             }
         };
-        self.state = d.phi * self.state + d.gamma * command;
+        for _ in 0..d.substeps {
+            self.substep(command, &d);
+        }
+    }
+
+    /// One substep: the current, its limit and the friction decided at its start and
+    /// held over it (docs/design/two-axis.md §4.5b).
+    fn substep(&mut self, command: f64, d: &SubstepDiscretisation) {
+        let p = self.params;
+        let effects = p.effects;
+        let [x, velocity, integral] = [self.state[0], self.state[1], self.state[2]];
+        let demand = p.transmission.motor_per_axis_unit()
+            * (p.kvp * (command - velocity) + p.kvi * integral);
+        let limit = effects.current_limit();
+        let current = demand.clamp(-limit, limit);
+        let saturated = current != demand;
+        // Conditional integration: the integral holds while the current is at the limit
+        // and the error drives it further in.
+        let winding_up = saturated && (command - velocity) * demand > 0.0;
+        // Friction reaches the motor only through a closed play.
+        let no_play = effects.backlash == 0.0;
+        let engaged_forward = no_play || self.table.contact == Contact::Forward;
+        let engaged_backward = no_play || self.table.contact == Contact::Backward;
+        let drive_torque = p.torque_constant * current;
+        let friction = if velocity > 0.0 {
+            if engaged_forward {
+                effects.sliding_friction(velocity)
+            } else {
+                0.0
+            }
+        } else if velocity < 0.0 {
+            if engaged_backward {
+                -effects.sliding_friction(-velocity)
+            } else {
+                0.0
+            }
+        } else {
+            let engaged = if drive_torque >= 0.0 {
+                engaged_forward
+            } else {
+                engaged_backward
+            };
+            let breakaway = effects.breakaway();
+            if engaged && breakaway > 0.0 && drive_torque.abs() <= breakaway {
+                // Stuck: nothing moves; the integral sees the whole command as error.
+                if !winding_up {
+                    self.state[2] = integral + d.substep() * command;
+                }
+                self.table.velocity = 0.0;
+                return;
+            }
+            if engaged {
+                breakaway.copysign(drive_torque)
+            } else {
+                0.0
+            }
+        };
+        let mut next = if saturated {
+            d.saturated
+                .apply(&self.state, command, drive_torque - friction)
+        } else {
+            d.linear.apply(&self.state, command, -friction)
+        };
+        if winding_up {
+            next[2] = integral;
+        }
+        // Friction stops a motion; it never reverses one.
+        if friction * next[1] < 0.0 {
+            next[1] = 0.0;
+        }
+        self.state = next;
+        if !no_play {
+            self.follow_through_play(x);
+        }
+    }
+
+    /// Moves the table where the motor, now at `state[0]` (from `before`), pushes it.
+    fn follow_through_play(&mut self, before: f64) {
+        let half = 0.5 * self.params.effects.backlash;
+        let (motor, velocity) = (self.state[0], self.state[1]);
+        let table = &mut self.table;
+        if motor - half > table.position {
+            table.position = motor - half;
+            table.contact = Contact::Forward;
+            table.velocity = velocity;
+        } else if motor + half < table.position {
+            table.position = motor + half;
+            table.contact = Contact::Backward;
+            table.velocity = velocity;
+        } else {
+            if motor != before {
+                table.contact = Contact::Gap;
+            }
+            table.velocity = 0.0;
+        }
+    }
+
+    /// Checks what a restored axis's parameters cannot: the table within the play of
+    /// the motor (to a rounding of its position).
+    pub fn check_play(&self) -> Result<(), String> {
+        let half = 0.5 * self.params.effects.backlash;
+        let offset = (self.state[0] - self.table.position).abs();
+        let slack = 1e-9 * (1.0 + self.state[0].abs());
+        if half > 0.0 && offset > half + slack {
+            return Err(format!(
+                "the table is {offset} from the motor, beyond half the play ({half})"
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -261,5 +547,223 @@ mod tests {
         let mut axis = ServoAxis::new(AxisParams::PAPER, 0.0);
         axis.step(1.0, 1e-3);
         assert!(axis.position().is_finite());
+    }
+
+    const K: f64 = 2.0 * std::f64::consts::PI / 10.0; // motor rad per mm, 10 mm lead
+
+    fn with(effects: AxisEffects) -> AxisParams {
+        AxisParams {
+            effects,
+            ..AxisParams::PAPER
+        }
+    }
+
+    /// Velocities of an axis from rest under a command step, every 1 ms for `samples`.
+    fn step_response(params: AxisParams, command: f64, samples: usize) -> Vec<f64> {
+        let mut axis = ServoAxis::new(params, 0.0);
+        (0..samples)
+            .map(|_| {
+                axis.step(command, 1e-3);
+                axis.velocity()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn at_the_current_limit_the_motor_accelerates_as_the_closed_form_says() {
+        // 100 mm/s asks 520 A at once and 132 A to hold: at 20 A the drive stays at the
+        // limit, so J·k·ẍ = CT·Imax − B·k·ẋ: ẋ = w·(1 − e^(−t·B/J)) with w = CT·Imax/(B·k),
+        // and the integral, which would push further in, holds at 0.
+        let p = with(AxisEffects {
+            current_max: 20.0,
+            ..AxisEffects::NONE
+        });
+        let (b_j, w) = (
+            p.friction / p.inertia,
+            p.torque_constant * 20.0 / (p.friction * K),
+        );
+        let mut axis = ServoAxis::new(p, 0.0);
+        for k in 1..=200 {
+            axis.step(100.0, 1e-3);
+            let t = k as f64 * 1e-3;
+            let v = w * -(-b_j * t).exp_m1();
+            let x = w * (t + (-b_j * t).exp_m1() / b_j);
+            assert!((axis.velocity() - v).abs() < 1e-9 * w, "t={t}");
+            assert!((axis.position() - x).abs() < 1e-9 * w, "t={t}");
+            assert_eq!(axis.state[2], 0.0);
+            assert_eq!(axis.current(100.0), 20.0);
+        }
+    }
+
+    #[test]
+    fn anti_windup_keeps_a_saturated_step_from_overshooting() {
+        // The loop is first order when linear (no overshoot). Steps that saturate the
+        // 60 A limit for longer and longer (10 mm/s does not, 20 and 40 do; 40 needs
+        // 53 A to hold) overshoot by no more than a small step does: the integral did
+        // not wind up while the current was at the limit.
+        let p = with(AxisEffects {
+            current_max: 60.0,
+            ..AxisEffects::NONE
+        });
+        let overshoot = |command: f64| {
+            let v = step_response(p, command, 500);
+            let peak = v.iter().cloned().fold(f64::MIN, f64::max);
+            assert!(
+                (v[499] - command).abs() < 1e-6 * command,
+                "settles at {command}"
+            );
+            (peak - command) / command
+        };
+        let small = overshoot(10.0);
+        let overshoots: Vec<f64> = [20.0, 40.0].map(overshoot).into();
+        for o in &overshoots {
+            assert!(*o <= small + 0.002, "{overshoots:?} against {small}");
+        }
+        // The small step is the linear loop's (nearly first order: the paper's rounded
+        // gains leave the PI zero a little off the pole).
+        let linear = step_response(AxisParams::PAPER, 10.0, 500);
+        let linear_peak = linear.iter().cloned().fold(f64::MIN, f64::max);
+        assert!((linear_peak / 10.0 - 1.0 - small).abs() < 1e-12);
+        println!("overshoot: 10 mm/s {small}, 20 and 40 mm/s {overshoots:?}");
+    }
+
+    #[test]
+    fn coulomb_friction_is_held_by_the_integral_and_stiction_breaks_away_on_time() {
+        // Sliding at a constant 20 mm/s the drive's current carries the viscous and the
+        // Coulomb torque: i = (B·k·v + Tc)/CT.
+        let friction = AxisEffects {
+            coulomb: 0.5,
+            stiction: 1.0,
+            stribeck_velocity: 2.0,
+            ..AxisEffects::NONE
+        };
+        let p = with(friction);
+        let mut axis = ServoAxis::new(p, 0.0);
+        for _ in 0..1000 {
+            axis.step(20.0, 1e-3);
+        }
+        let want = (p.friction * K * 20.0 + 0.5) / p.torque_constant;
+        assert!((axis.current(20.0) - want).abs() < 1e-6 * want);
+        assert!((axis.velocity() - 20.0).abs() < 1e-6);
+        // From rest with 0.1 mm/s the drive's torque CT·k·(Kvp·v + Kvi·v·t) grows with the
+        // integral and passes the 1 N·m of stiction at t_b = (1/(CT·k·v) − Kvp)/Kvi; the
+        // axis does not move a nanometre before.
+        let v = 0.1;
+        let t_b = (1.0 / (p.torque_constant * K * v) - p.kvp) / p.kvi;
+        let mut axis = ServoAxis::new(p, 0.0);
+        let mut t = 0.0;
+        while t < t_b - MAX_SUBSTEP {
+            assert_eq!(axis.position(), 0.0, "t={t}");
+            axis.step(v, MAX_SUBSTEP);
+            t += MAX_SUBSTEP;
+        }
+        for _ in 0..3 {
+            axis.step(v, MAX_SUBSTEP);
+        }
+        assert!(axis.velocity() > 0.0, "moving after {t_b} s");
+    }
+
+    #[test]
+    fn the_table_follows_the_motor_through_the_play() {
+        // No friction: the motor is the linear axis; the table starts in the middle of the
+        // 0.1 mm play, moves once the motor has taken up half of it, stays while the motor
+        // crosses the play after a reversal, and is then b/2 ahead of it.
+        let b = 0.1;
+        let p = with(AxisEffects {
+            backlash: b,
+            ..AxisEffects::NONE
+        });
+        let mut axis = ServoAxis::new(p, 0.0);
+        let mut motor = ServoAxis::new(AxisParams::PAPER, 0.0);
+        let mut table_path = Vec::new();
+        for k in 0..600 {
+            let command = if k < 300 { 10.0 } else { -10.0 };
+            axis.step(command, 1e-3);
+            motor.step(command, 1e-3);
+            assert!((axis.motor().0 - motor.position()).abs() < 1e-9, "k={k}");
+            table_path.push((axis.motor().0, axis.position(), axis.contact()));
+        }
+        // The play operator from its definition, on the motor's samples.
+        let mut table = 0.0f64;
+        for &(m, got, _) in &table_path {
+            table = table.clamp(m - b / 2.0, m + b / 2.0);
+            // Between samples the motor turns back at its extreme, which the samples miss
+            // by at most a·Δt² / 8 (a ≤ 20/0.0032 mm/s²).
+            assert!((got - table).abs() < 1e-3, "{got} vs {table}");
+        }
+        assert_eq!(table_path[250].2, Contact::Forward);
+        assert_eq!(table_path[599].2, Contact::Backward);
+        assert!((table_path[599].1 - (table_path[599].0 + b / 2.0)).abs() < 1e-12);
+        assert!((axis.velocity() - motor.velocity()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn with_effects_the_trajectory_hardly_depends_on_the_step() {
+        // Steps that are whole numbers of the substep share its grid: the same run to
+        // rounding. A step that is not (1/3 ms: 34 substeps of 9.8 µs) places events
+        // within one substep instead: first order in the substep.
+        let p = with(AxisEffects {
+            coulomb: 0.3,
+            stiction: 0.5,
+            stribeck_velocity: 1.0,
+            backlash: 0.01,
+            current_max: 80.0,
+        });
+        let command = |t: f64| 30.0 * (2.0 * std::f64::consts::PI * t).sin();
+        let run = |step: f64, every: usize| {
+            let mut axis = ServoAxis::new(p, 0.0);
+            let mut samples = Vec::new();
+            for k in 0..(3000 * every) {
+                // The command changes only every 1 ms: the same input for every step size.
+                let t = (k / every) as f64 * 1e-3;
+                axis.step(command(t), step);
+                if (k + 1) % every == 0 {
+                    samples.push(axis.position());
+                }
+            }
+            samples
+        };
+        let max_difference = |a: &[f64], b: &[f64]| {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max)
+        };
+        let base = run(1e-3, 1);
+        let quarter = run(2.5e-4, 4);
+        assert!(max_difference(&base, &quarter) < 1e-9);
+        let third = run(1e-3 / 3.0, 3);
+        let off_grid = max_difference(&base, &third);
+        assert!(off_grid < 2e-4, "{off_grid}");
+        assert!(
+            base.iter().cloned().fold(0.0, f64::max) > 9.0,
+            "the axis moves"
+        );
+    }
+
+    #[test]
+    fn effects_are_validated_by_name() {
+        let mut effects = AxisEffects {
+            coulomb: 0.5,
+            stiction: 0.4,
+            ..AxisEffects::NONE
+        };
+        assert_eq!(
+            with(effects).validate().unwrap_err(),
+            "stiction (0.4) must be 0 or at least coulomb (0.5)"
+        );
+        effects.stiction = 0.0;
+        assert!(with(effects).validate().is_ok());
+        effects.backlash = -1e-3;
+        assert!(with(effects)
+            .validate()
+            .unwrap_err()
+            .starts_with("backlash"));
+        effects.backlash = 0.0;
+        effects.current_max = f64::NAN;
+        assert!(with(effects)
+            .validate()
+            .unwrap_err()
+            .starts_with("currentMax"));
     }
 }

@@ -23,6 +23,33 @@ pub(super) static CASES: &[Case] = &[
         Usable,
     ),
     case(
+        "stiction below the Coulomb friction (XY plant)",
+        XY,
+        Initialization,
+        |s| {
+            s.exit_with(|s| {
+                let status = s.set_real("y.coulomb", 0.2);
+                s.ok(status);
+                s.set_real("y.stiction", 0.1)
+            })
+        },
+        ERROR,
+        Some(
+            "fmi2ExitInitializationMode: axis y: stiction (0.1) must be 0 or at least coulomb \
+             (0.2)",
+        ),
+        Corrected,
+    ),
+    case(
+        "a negative backlash (five-axis plant)",
+        F5,
+        Initialization,
+        |s| s.set_real("A.backlash", -1e-4),
+        ERROR,
+        Some("fmi2SetReal: variable 'A.backlash' = -0.0001 is below its minimum 0"),
+        Usable,
+    ),
+    case(
         "Ts = 0 (controller)",
         C2,
         Initialization,

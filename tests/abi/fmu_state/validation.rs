@@ -281,6 +281,41 @@ fn plant_states_with_bad_axis_values_are_refused() {
 }
 
 #[test]
+fn plant_states_with_the_table_beyond_the_play_are_refused() {
+    // X with 0.0625 mm of backlash, pushed forward: the table is 0.03125 mm behind the
+    // motor. Moved a millimetre further, it would be outside the play.
+    let i = Instance::new(&plant::INFO);
+    assert_eq!(i.setup(0.0, None), OK);
+    let backlash = plant::EFFECTS.at(3).vr() as u32;
+    assert_eq!(i.set_reals(&[backlash], &[0.0625]), OK);
+    assert_eq!(i.enter_init(), OK);
+    assert_eq!(i.exit_init(), OK, "{}", i.last_error());
+    assert_eq!(i.set_reals(&[plant::U.at(0).vr() as u32], &[12.5]), OK);
+    for k in 0..5 {
+        assert_eq!(i.step(k as f64 * 0.01, 0.01), OK);
+    }
+    let pos_x = i.get_real(plant::POS.at(0).vr() as u32);
+    let (_, mut state) = i.get_state();
+    let (_, bytes) = i.serialize(state);
+    resealed_is_accepted(&i, &bytes);
+    let model = open_state(&bytes).1.model;
+    let (at, play) = (unique(&model, pos_x), unique(&model, 0.0625));
+    refused(
+        &i,
+        &bytes,
+        |e| put_f64(&mut e.model, at, pos_x - 1.0),
+        "axis x: the table is 1.03125",
+    );
+    refused(
+        &i,
+        &bytes,
+        |e| put_f64(&mut e.model, play, -0.0625),
+        "axis x: backlash must be finite and >= 0 (got -0.0625)",
+    );
+    assert_eq!(i.free_state(&mut state), OK);
+}
+
+#[test]
 fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
     let (controller, controller_bytes) = controller_state(false);
     let plant_instance = Instance::new(&plant::INFO);
@@ -295,11 +330,12 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
 
     // The models' current layout versions: ContourCCC2D 3 (the program estimator keeps its
     // last two feet; 2: the controller became N-axis),
-    // XYServoPlant 2 (each axis's lead became a transmission), PathInterpolator2D 2 (the
+    // XYServoPlant 3 (each axis gained its effects and the table behind the play; 2: the
+    // lead became a transmission), PathInterpolator2D 2 (the
     // planned reference joined the constant-feed one).
     for (i, bytes, model, version) in [
         (&controller, &controller_bytes, "ContourCCC2D", 3u16),
-        (&plant_instance, &plant_bytes, "XYServoPlant", 2),
+        (&plant_instance, &plant_bytes, "XYServoPlant", 3),
         (&interpolator, &interpolator_bytes, "PathInterpolator2D", 2),
     ] {
         let (_, envelope) = open_state(bytes);
