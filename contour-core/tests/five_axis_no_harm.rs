@@ -11,6 +11,7 @@ use contour_core::geometry::{self, Vector};
 use contour_core::kinematics::Pose;
 use contour_core::path::cam_examples::{dome_raster, tilting_pass};
 use contour_core::path::ToolPath;
+use contour_core::plant::AxisEffects;
 use contour_core::sim::{simulate_five_axis, FiveAxisMetrics, FiveAxisSimConfig};
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
@@ -52,6 +53,11 @@ enum Reference {
     ForAFasterMachine,
     /// At constant feed, unplanned (`accel` = 0).
     ConstantFeed,
+    /// Planned within the limits, on a plant whose drives' current limits are `share` of
+    /// what holding every joint's speed limit at its acceleration limit takes (and, with
+    /// `friction`, Coulomb friction of a tenth of that): the machine saturates below the
+    /// limits the controller and the plan are told about.
+    CurrentLimited { share: f64, friction: bool },
 }
 
 fn run(path: &ToolPath, feed: f64, reference: Reference, mode: CccMode) -> FiveAxisMetrics {
@@ -67,6 +73,19 @@ fn run(path: &ToolPath, feed: f64, reference: Reference, mode: CccMode) -> FiveA
             config.path_limits.jerk *= 3.0;
         }
         Reference::ConstantFeed => config = config.unplanned(),
+        Reference::CurrentLimited { share, friction } => {
+            let limits = config.joint_limits;
+            for (i, axis) in config.plant.axes.iter_mut().enumerate() {
+                let k = axis.transmission.motor_per_axis_unit();
+                let (v, a) = (limits.velocity[i], limits.acceleration[i]);
+                let torque = axis.friction * k * v + axis.inertia * k * a;
+                axis.effects = AxisEffects {
+                    coulomb: if friction { 0.1 * share * torque } else { 0.0 },
+                    current_max: share * torque / axis.torque_constant,
+                    ..AxisEffects::NONE
+                };
+            }
+        }
     }
     simulate_five_axis(&config, false).unwrap().0
 }
@@ -172,5 +191,60 @@ fn on_a_reference_at_constant_feed_the_ccc_is_no_worse() {
         ("line beyond X's speed", line(), 800.0),
     ] {
         assert_no_worse(name, &compare(name, &path, feed, Reference::ConstantFeed));
+    }
+}
+
+#[test]
+fn on_a_plant_that_saturates_below_its_limits_the_ccc_is_no_worse() {
+    // From drives that just manage the limits (share 1) to ones a tenth as strong: the
+    // guard sees the joints fall short of their commands (`Hold::disobeyed`) and stands
+    // the correction aside. Before it did, the figure-eight at 0.25 had 1.85 times the
+    // tip error of no CCC.
+    let eight = ToolPath::builtin("figure_eight").unwrap();
+    for share in [1.0, 0.5, 0.25, 0.1] {
+        for (name, path) in [
+            ("through vertical", vertical()),
+            ("beside vertical", beside()),
+            ("dome", dome()),
+            ("figure-eight", eight.clone()),
+        ] {
+            let limited = Reference::CurrentLimited {
+                share,
+                friction: false,
+            };
+            assert_no_worse(name, &compare(name, &path, 50.0, limited));
+        }
+    }
+}
+
+#[test]
+fn with_coulomb_friction_the_guarantee_holds_but_on_the_dome() {
+    // Coulomb friction of a tenth of the drives' torque as well. The guarantee holds on
+    // every path but the dome with drives that just manage the limits, where the CCC's
+    // maxima exceed 1.1 times those without it (docs/design/five-axis.md §5.4b records
+    // it as open); this test says when that changes, so the docs can too.
+    let eight = ToolPath::builtin("figure_eight").unwrap();
+    for share in [1.0, 0.5] {
+        for (name, path) in [
+            ("through vertical", vertical()),
+            ("beside vertical", beside()),
+            ("dome", dome()),
+            ("figure-eight", eight.clone()),
+        ] {
+            let limited = Reference::CurrentLimited {
+                share,
+                friction: true,
+            };
+            let runs = compare(name, &path, 50.0, limited);
+            if name == "dome" && share == 1.0 {
+                let [off, fixed, _] = &runs;
+                assert!(
+                    fixed.max_orientation > RATIO * off.max_orientation + ORIENTATION_FLOOR,
+                    "the dome with friction now keeps the guarantee: update §5.4b"
+                );
+            } else {
+                assert_no_worse(name, &runs);
+            }
+        }
     }
 }

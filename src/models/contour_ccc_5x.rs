@@ -227,7 +227,8 @@ variable_table! {
         "ccc.weight",
         "Weight of the correction this sample: 1 at full weight, 0 while it stands aside \
          (a reference beyond the joints' limits, a position loop far beyond its joint's \
-         speed, a mapping that lost the tool), rising over `recovery` when none holds",
+         speed, a joint falling short of its commands, a mapping that lost the tool), \
+         rising over `recovery` when none holds",
     );
 }
 
@@ -250,10 +251,11 @@ pub static INFO: ModelInfo = ModelInfo {
 };
 
 /// Version 1: `Option<State>` as below. Version 2: the controller carries the machine's
-/// limits and the guard of its correction.
+/// limits and the guard of its correction. Version 3: the guard also remembers the
+/// commands sent and the joints' shortfall of travel.
 const LAYOUT: StateLayout = StateLayout {
     model: "ContourCCC5X",
-    version: 2,
+    version: 3,
 };
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]

@@ -39,12 +39,16 @@ pub struct Hold {
     pub saturated: bool,
     /// The mapping has lost the tool (at the tail of its band).
     pub lost: bool,
+    /// A joint does not do what it was told: its travel falls short of its commands by
+    /// more than a velocity loop's lag explains (a drive at its current limit, an axis
+    /// stuck in friction).
+    pub disobeyed: bool,
 }
 
 impl Hold {
     /// Whether any reason holds.
     pub fn any(&self) -> bool {
-        self.beyond_limits || self.saturated || self.lost
+        self.beyond_limits || self.saturated || self.lost || self.disobeyed
     }
 }
 
@@ -60,7 +64,28 @@ pub struct CorrectionGuard {
     seen: bool,
     since: f64,
     weight: f64,
+    /// The joints measured last (`measured`), and when: travel is measured between
+    /// distinct measurements (an FMU's input is held over a communication step).
+    from: Joints,
+    measured_at: f64,
+    measured: bool,
+    /// The commands sent since that measurement, summed, and how many.
+    sent: Joints,
+    sent_count: u32,
+    /// Each joint's travel short of its commands, forgotten over [`OBEY_WINDOW`].
+    shortfall: Joints,
+    /// Whether a joint fell short at the last measurement.
+    short: bool,
 }
+
+/// How long a shortfall of travel is remembered, s: long against a velocity loop's lag,
+/// short against a path's features.
+pub const OBEY_WINDOW: f64 = 0.02;
+
+/// The slowest velocity loop the guard expects, s (its time constant). A first-order
+/// loop of lag τ travels ∫v = ∫u − τ·Δv: it falls short of its commands by τ·(v − v̄)
+/// with v̄ the speed averaged over the window, at most τ·amax·window within the limits.
+pub const OBEY_LAG: f64 = 0.01;
 
 impl CorrectionGuard {
     /// A guard for a machine with `limits`, sampled every `ts` s, that returns to full
@@ -74,7 +99,47 @@ impl CorrectionGuard {
             seen: false,
             since: 0.0,
             weight: 1.0,
+            from: Joints::zeros(),
+            measured_at: 0.0,
+            measured: false,
+            sent: Joints::zeros(),
+            sent_count: 0,
+            short: false,
+            shortfall: Joints::zeros(),
         }
+    }
+
+    /// Records the command sent this sample.
+    pub fn commanded(&mut self, command: &Joints) {
+        self.sent += command;
+        self.sent_count += 1;
+    }
+
+    /// Whether a joint has fallen short of its commands by more than a velocity loop of
+    /// lag [`OBEY_LAG`] would (a drive at its current limit, an axis held by friction),
+    /// given the joints `actual` measured at `at` (s). Travel is compared with the mean
+    /// command since the last distinct measurement over the time between the two, so a
+    /// measurement held over several samples is judged once.
+    pub fn disobeyed(&mut self, actual: &Joints, at: f64) -> bool {
+        if self.measured && at == self.measured_at {
+            return self.short;
+        }
+        let dt = at - self.measured_at;
+        if self.measured && self.sent_count > 0 && dt > 0.0 {
+            let keep = (-dt / OBEY_WINDOW).exp();
+            let mean = self.sent / f64::from(self.sent_count);
+            let l = &self.limits;
+            self.short = false;
+            for i in 0..5 {
+                let short = mean[i] * dt - (actual[i] - self.from[i]);
+                self.shortfall[i] = keep * self.shortfall[i] + short;
+                let allowed = OBEY_LAG * (l.acceleration[i] * OBEY_WINDOW).min(2.0 * l.velocity[i]);
+                self.short |= self.shortfall[i].abs() > allowed;
+            }
+        }
+        (self.from, self.measured_at, self.measured) = (*actual, at, true);
+        (self.sent, self.sent_count) = (Joints::zeros(), 0);
+        self.short
     }
 
     /// What the guard was built with: the limits, the sample period and the rise per
@@ -129,6 +194,12 @@ impl CorrectionGuard {
     pub fn check(&self) -> Result<(), String> {
         if !(self.last.iter().all(|x| x.is_finite()) && self.since.is_finite()) {
             return Err("the guard's last reference or its time is not finite".into());
+        }
+        let memories = [self.from, self.sent, self.shortfall];
+        if !(memories.iter().all(|m| m.iter().all(|x| x.is_finite()))
+            && self.measured_at.is_finite())
+        {
+            return Err("the guard's last measurement, commands or shortfall is not finite".into());
         }
         if !((0.0..=1.0).contains(&self.weight) && self.rise > 0.0 && self.rise <= 1.0) {
             return Err(format!(
@@ -207,5 +278,64 @@ mod tests {
             last = w;
         }
         assert!((last - 1.0).abs() < 1e-12);
+    }
+
+    /// X's commands and measurements for 0.3 s: a command of up to `peak` mm/s
+    /// changing at up to 4000 mm/s² (within X's 5000), a first-order velocity loop of lag
+    /// `lag` whose speed the drive caps at `cap`, measured every `every` samples (an FMU's
+    /// input held over a communication step of that many samples). Which samples were
+    /// judged disobeyed.
+    fn disobedience(peak: f64, lag: f64, cap: f64, every: usize) -> Vec<usize> {
+        let mut g = guard();
+        let (ts, substeps) = (1e-3, 100);
+        let (mut x, mut v) = (0.0, 0.0);
+        let (mut measured, mut at) = (0.0, 0.0);
+        let mut short = Vec::new();
+        for k in 0..300 {
+            if k % every == 0 {
+                (measured, at) = (x, k as f64 * ts);
+            }
+            if g.disobeyed(&Joints::new(measured, 0.0, 0.0, 0.0, 0.0), at) {
+                short.push(k);
+            }
+            let t = k as f64 * ts;
+            let u = peak * (4000.0 / peak * t).sin();
+            g.commanded(&Joints::new(u, 0.0, 0.0, 0.0, 0.0));
+            for _ in 0..substeps {
+                let h = ts / substeps as f64;
+                v = (v + h / lag * (u - v)).clamp(-cap, cap);
+                x += v * h;
+            }
+        }
+        short
+    }
+
+    #[test]
+    fn a_velocity_loop_that_lags_within_the_limits_obeys() {
+        // Lags of 3.2 ms (the test plant's 50 Hz loop) and 10 ms, every sample or held
+        // over 2.5 ms (measured every 2 or 3 samples: judged once per measurement).
+        for lag in [0.0032, 0.01] {
+            for every in [1, 3] {
+                assert!(
+                    disobedience(450.0, lag, f64::INFINITY, every).is_empty(),
+                    "{lag}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn an_axis_its_drive_cannot_move_as_told_disobeys() {
+        // The drive tops out at 150 mm/s (a current limit) against commands of 450: not
+        // judged short before the command passes the cap (at t = asin(1/3)·450/4000 =
+        // 38 ms), then once the shortfall ∫(u − 150) ≈ 2000 mm/s²·Δt² (less what the
+        // window forgets) passes X's 1 mm (0.01 s · 5000 mm/s² · 0.02 s): Δt ≈ 25 ms.
+        for every in [1, 3] {
+            let short = disobedience(450.0, 0.0032, 150.0, every);
+            let first = *short.first().expect("never judged short");
+            assert!((58..75).contains(&first), "{first}");
+            // The command stays above the cap to the end (450·sin(2.67) = 203 mm/s).
+            assert_eq!(short, (first..300).collect::<Vec<_>>());
+        }
     }
 }

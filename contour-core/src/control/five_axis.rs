@@ -437,6 +437,7 @@ impl FiveAxisController {
             beyond_limits: self.guard.beyond_limits(reference, set_at),
             saturated: self.guard.saturated(&asked),
             lost: false,
+            disobeyed: self.guard.disobeyed(actual, set_at),
         };
 
         let machine = &self.config.machine;
@@ -452,8 +453,9 @@ impl FiveAxisController {
         // While the machine cannot follow, the tool may move along the reference faster
         // than the mapping's `max_skip` segments per sample: it is mapped afresh (to its
         // nearest segment) every such sample, so the mapping is on the tool's segment
-        // when the correction comes back.
-        if hold.any() {
+        // when the correction comes back. A joint short of its commands moves slower,
+        // not faster: the mapping keeps its history (the evaluation needs it).
+        if hold.beyond_limits || hold.saturated {
             self.mapper.restart();
         }
         let segment = self.mapper.push_sample(pose.tip, pose.axis);
@@ -513,6 +515,7 @@ impl FiveAxisController {
             clamped = limited;
         }
         self.clamped = clamped;
+        self.guard.commanded(&output.u);
         self.taken += 1;
         Ok(output)
     }
