@@ -28,3 +28,26 @@ FIVE_AXIS_CONNECTIONS = (
 
 # The plant starts at the path's start joints.
 FIVE_AXIS_PATH_START = [("interpolator", f"ref.{j}", "plant", f"pos0.{j}") for j in FIVE_AXIS_JOINTS]
+
+# NC -> drive -> the user's mechanics, for each of X and Y: the interpolator and the
+# controller, one ServoDrive per axis ("drive_x", "drive_y") and one mechanical axis FMU
+# per axis ("axis_x", "axis_y": force or torque in as `force_input`, position and velocity
+# out as `position_output`, `velocity_output`). Nothing is computed between the FMUs.
+def drive_loop_connections(force_input="F", position_output="x", velocity_output="v"):
+    connections = [
+        ("interpolator", "ref.x", "controller", "ref.x"),
+        ("interpolator", "ref.y", "controller", "ref.y"),
+    ]
+    for a in ("x", "y"):
+        connections += [
+            (f"axis_{a}", position_output, "controller", f"pos.{a}"),
+            ("controller", f"u.{a}", f"drive_{a}", "u"),
+            (f"axis_{a}", velocity_output, f"drive_{a}", "vel"),
+            (f"drive_{a}", "effort", f"axis_{a}", force_input),
+        ]
+    return connections
+
+
+def drive_loop_start(position_start="x0"):
+    """The mechanics start where the path does."""
+    return [("interpolator", f"ref.{a}", f"axis_{a}", position_start) for a in ("x", "y")]
