@@ -29,6 +29,8 @@ use planar_run::PlanarOptions;
 use reference::Reference;
 use staged::{commit, Staged};
 
+mod circular_run;
+mod circular_test;
 mod measured;
 mod planar;
 mod planar_run;
@@ -44,6 +46,9 @@ usage: contour-eval --path PART.cl|PART.apt|PART.json|tilted_helix|figure_eight
                     [--reference straight|smooth]
        contour-eval --path PART.ngc|NURBS.json|line|arc|circle|infinity|trident
                     --measured RUN.csv --out ERR.csv [--tolerance P] [--plot ERR.png]
+       contour-eval --circle CX,CY,R --measured RUN.csv [--reverse RUN.csv]
+                    [--from T0] [--to T1] [--out DEV.csv] [--plot BALLBAR.png]
+                    [--magnification M]
 
 The run's columns say what it is: time,X,Y,Z,A,C a five-axis run, time,X,Y and none of
 Z, A, C a run of the XY table. A --path of the other kind is refused.
@@ -78,7 +83,17 @@ along the path so that a pass that comes back near itself is not confused.
             move, from 0; 0 on a line, an arc or a NURBS)
   --tolerance  P, mm: the corners of bare G64 (and of the start) blended within P as
                PathInterpolator2D plans them (its 'tolerance'); default 0: only the
-               program's own G64 P corners are blended";
+               program's own G64 P corners are blended
+
+Circular test (ISO 230-4) of XY runs around the nominal circle CX,CY,R (mm): the
+least-squares circle, the circular deviation G, the radial deviation F (min, max) of each
+run and, with a --reverse run (the other direction), the bidirectional circular
+deviation G(b).
+  --from, --to   the samples of the circle itself (s), without lead-in and lead-out
+  DEV.csv        run,time,angle,deviation per sample (rad from the nominal centre, mm
+                 from the nominal circle, > 0 outside)
+  BALLBAR.png    the polar plot of the deviation, magnified M times (default: the
+                 largest deviation drawn as a quarter of the radius)";
 
 /// The options that apply to five-axis runs only.
 const FIVE_AXIS_ONLY: [&str; 8] = [
@@ -115,7 +130,7 @@ enum Failure {
     Run(String),
 }
 
-fn pair(text: &str, what: &str) -> Result<(f64, f64), String> {
+pub(crate) fn pair(text: &str, what: &str) -> Result<(f64, f64), String> {
     let values: Vec<&str> = text.split(',').collect();
     let parse = |v: &str| {
         v.trim()
@@ -381,27 +396,47 @@ fn five_axis(
     Ok(())
 }
 
+/// The exit code of a finished run: 2 for a wrong input, 1 for a failed run or write.
+fn finish(result: Result<(), Failure>) -> ExitCode {
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Input(message)) => {
+            eprintln!("contour-eval: {message}");
+            ExitCode::from(2)
+        }
+        Err(Failure::Run(message)) => {
+            eprintln!("contour-eval: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    match parse(&args) {
+    let help = args.iter().any(|a| a == "-h" || a == "--help");
+    let parsed = if args.iter().any(|a| a == "--circle") && !help {
+        circular_run::parse(&args).map(|o| Some(Mode::Circular(o)))
+    } else {
+        parse(&args).map(|o| o.map(Mode::Contour))
+    };
+    match parsed {
         Ok(None) => {
             println!("{USAGE}");
             ExitCode::SUCCESS
         }
-        Ok(Some(options)) => match run(options) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(Failure::Input(message)) => {
-                eprintln!("contour-eval: {message}");
-                ExitCode::from(2)
-            }
-            Err(Failure::Run(message)) => {
-                eprintln!("contour-eval: {message}");
-                ExitCode::FAILURE
-            }
-        },
+        Ok(Some(Mode::Circular(options))) => finish(circular_run::run(options)),
+        Ok(Some(Mode::Contour(options))) => finish(run(options)),
         Err(message) => {
             eprintln!("contour-eval: {message}\n{USAGE}");
             ExitCode::from(2)
         }
     }
+}
+
+/// What the command line asks for.
+enum Mode {
+    /// A run's contour errors against its path.
+    Contour(Options),
+    /// The circular test of ISO 230-4.
+    Circular(circular_run::CircularOptions),
 }

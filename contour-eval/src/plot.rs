@@ -2,13 +2,16 @@
 //! panel each; an XY run's contour errors to the programmed and the planned contour,
 //! against time and along the path. Long runs are drawn as their per-pixel-column
 //! envelope (min and max of each bucket), so a million samples cost no more to draw than
-//! two thousand.
+//! two thousand. `--circle`: the ballbar plot of the ISO 230-4 circular test.
 
 use std::path::Path;
 
 use contour_core::contour::five_axis::run_evaluation::SampleContourError;
 use plotters::prelude::*;
 
+use contour_core::geometry::Vector2;
+
+use crate::circular_test::Circle;
 use crate::planar::PlanarSample;
 
 /// Buckets across the plot (about one per pixel column).
@@ -46,6 +49,21 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     } else {
         (0.0, 1.0)
     }
+}
+
+/// The series' legend at `position`, boxed on white, in the labels' font.
+fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(|e| e.to_string())
 }
 
 fn register_font() -> Result<(), String> {
@@ -163,14 +181,86 @@ pub fn contour_errors(file: &Path, times: &[f64], samples: &[PlanarSample]) -> R
                 .label(name)
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour));
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(|e| fail(&e))?;
+        draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
     }
+    root.present().map_err(|e| fail(&e))?;
+    Ok(())
+}
+
+/// The ballbar plot of ISO 230-4: each run's radial deviation from the `nominal` circle,
+/// magnified `magnification` times (0: so that the largest deviation is a quarter of the
+/// radius), drawn around the nominal circle; the first run blue, the second red.
+pub fn ballbar(
+    file: &Path,
+    runs: &[Vec<Vector2>],
+    nominal: &Circle,
+    magnification: f64,
+) -> Result<(), String> {
+    register_font()?;
+    let fail = |e: &dyn std::fmt::Display| e.to_string();
+    let deviation = |p: &Vector2| (p - nominal.centre).norm() - nominal.radius;
+    let largest = runs
+        .iter()
+        .flatten()
+        .map(|p| deviation(p).abs())
+        .fold(0.0f64, f64::max);
+    let m = if magnification > 0.0 {
+        magnification
+    } else if largest > 0.0 {
+        0.25 * nominal.radius / largest
+    } else {
+        1.0
+    };
+    let drawn = |p: &Vector2| {
+        let d = p - nominal.centre;
+        let r = nominal.radius + m * deviation(p);
+        let a = d.y.atan2(d.x);
+        (r * a.cos(), r * a.sin())
+    };
+    let extent = 1.4 * nominal.radius;
+    let root = BitMapBackend::new(file, (900, 900)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let caption = format!(
+        "circular test (ISO 230-4): radial deviation x{m:.0} ({:.2} um per mm of the plot)",
+        1e3 / m
+    );
+    let mut chart = ChartBuilder::on(&root)
+        .caption(caption, ("sans-serif", 20))
+        .margin(16)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(-extent..extent, -extent..extent)
+        .map_err(|e| fail(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("x - centre (mm, deviation magnified)")
+        .y_desc("y - centre (mm)")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(|e| fail(&e))?;
+    let nominal_circle = (0..=720).map(|k| {
+        let a = std::f64::consts::PI * k as f64 / 360.0;
+        (nominal.radius * a.cos(), nominal.radius * a.sin())
+    });
+    chart
+        .draw_series(LineSeries::new(nominal_circle, BLACK.mix(0.4)))
+        .map_err(|e| fail(&e))?
+        .label("nominal circle")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.mix(0.4)));
+    for (index, run) in runs.iter().enumerate() {
+        let (colour, name) = if index == 0 {
+            (BLUE, "run")
+        } else {
+            (RED, "reverse run")
+        };
+        chart
+            .draw_series(LineSeries::new(run.iter().map(drawn), colour))
+            .map_err(|e| fail(&e))?
+            .label(name)
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour));
+    }
+    // In a corner: the glitches at 0°, 90°, 180° and 270° stay clear.
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     root.present().map_err(|e| fail(&e))?;
     Ok(())
 }
