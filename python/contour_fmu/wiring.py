@@ -5,6 +5,9 @@ use it without loading fmpy."""
 CLOSED_LOOP_CONNECTIONS = [
     ("interpolator", "ref.x", "controller", "ref.x"),
     ("interpolator", "ref.y", "controller", "ref.y"),
+    # The reference's velocity, for the controller's feed-forward (feedForward > 0).
+    ("interpolator", "vref.x", "controller", "vref.x"),
+    ("interpolator", "vref.y", "controller", "vref.y"),
     ("plant", "pos.x", "controller", "pos.x"),
     ("plant", "pos.y", "controller", "pos.y"),
     ("controller", "u.x", "plant", "u.x"),
@@ -35,8 +38,9 @@ FIVE_AXIS_PATH_START = [("interpolator", f"ref.{j}", "plant", f"pos0.{j}") for j
 # out as `position_output`, `velocity_output`). Nothing is computed between the FMUs.
 def drive_loop_connections(force_input="F", position_output="x", velocity_output="v"):
     connections = [
-        ("interpolator", "ref.x", "controller", "ref.x"),
-        ("interpolator", "ref.y", "controller", "ref.y"),
+        (source, output, "controller", input)
+        for source, output, destination, input in CLOSED_LOOP_CONNECTIONS
+        if source == "interpolator"
     ]
     for a in ("x", "y"):
         connections += [

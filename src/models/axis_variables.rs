@@ -9,6 +9,28 @@ pub const REFERENCE_OUT: AxisTemplate =
     AxisTemplate::output(("ref.", ""), ("Reference position, ", AxisWord::Name, ""))
         .unit(AxisUnit::POSITION);
 
+/// An interpolator's reference velocity output: `vref.<axis>`.
+pub const REFERENCE_VELOCITY_OUT: AxisTemplate = AxisTemplate::output(
+    ("vref.", ""),
+    (
+        "Reference velocity at the sample, ",
+        AxisWord::Name,
+        " (for feed-forward)",
+    ),
+)
+.unit(AxisUnit::VELOCITY);
+
+/// A controller's reference velocity input: `vref.<axis>`.
+pub const REFERENCE_VELOCITY_IN: AxisTemplate = AxisTemplate::input(
+    ("vref.", ""),
+    (
+        "Reference velocity, ",
+        AxisWord::Name,
+        ", from the interpolator's vref (feed-forward; 0 when unconnected)",
+    ),
+)
+.unit(AxisUnit::VELOCITY);
+
 /// A controller's reference input: `ref.<axis>`.
 pub const REFERENCE_IN: AxisTemplate = AxisTemplate::input(
     ("ref.", ""),

@@ -3,7 +3,9 @@
 //! fuzzy-adapted PID gains (docs/design/two-axis.md §4.2, 4.3). The control law runs every `Ts` inside
 //! `fmi2DoStep` on the inputs held over the step, whatever the communication step.
 
-use super::axis_variables::{COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_IN};
+use super::axis_variables::{
+    COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_IN, REFERENCE_VELOCITY_IN,
+};
 use super::controller_parameters::{self, axis_gain, nonnegative};
 use super::line_arc_parameters;
 use super::path_parameter;
@@ -129,6 +131,8 @@ variable_table! {
         path_parameter::DESCRIPTION,
     );
     TOLERANCE: Real = path_parameter::TOLERANCE;
+    VREF: Reals<2> = axis_block(&XY, &[REFERENCE_VELOCITY_IN]);
+    FEED_FORWARD: Real = controller_parameters::FEED_FORWARD;
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -156,16 +160,19 @@ pub static INFO: ModelInfo = ModelInfo {
 
 /// `Option<State>` as below. Version 2: the controller became N-axis (per-axis contour
 /// PIDs, unused in the plane, joined its state). Version 3: the program estimator's track
-/// keeps its last two foot points (its next search's guess).
+/// keeps its last two foot points (its next search's guess). Version 4: the velocity
+/// feed-forward gain.
 const LAYOUT: StateLayout = StateLayout {
     model: "ContourCCC2D",
-    version: 3,
+    version: 4,
 };
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct State {
     controller: CrossCoupledController<Estimator>,
     clock: SampleClock,
+    /// The velocity feed-forward gain (`feedForward`).
+    feed_forward: f64,
 }
 
 impl SavedState for State {
@@ -173,6 +180,12 @@ impl SavedState for State {
     /// the offending value.
     fn validate(&self, time: f64) -> Result<(), String> {
         self.clock.validate_at(time)?;
+        if !(self.feed_forward.is_finite() && self.feed_forward >= 0.0) {
+            return Err(format!(
+                "feed-forward gain {} must be finite and >= 0",
+                self.feed_forward
+            ));
+        }
         let controller = &self.controller;
         let config = controller.config();
         config
@@ -323,6 +336,7 @@ impl Model for ContourCCC2D {
         self.state = Some(State {
             controller,
             clock: SampleClock::new(start_time, config.ts),
+            feed_forward: FEED_FORWARD.get(values),
         });
         U.set(values, &Vector2::zeros());
         CONTOUR_ERROR.set(values, 0.0);
@@ -335,8 +349,11 @@ impl Model for ContourCCC2D {
         let state = self.state.as_mut().ok_or("not initialized")?;
         let reference = REF.vector(values);
         let actual = POS.vector(values);
+        let feed_forward = VREF.vector(values) * state.feed_forward;
         while state.clock.take_before(time + step) {
-            let out = state.controller.sample(reference, actual);
+            let out = state
+                .controller
+                .sample_with(reference, actual, feed_forward);
             U.set(values, &out.u);
             CONTOUR_ERROR.set(values, out.contour.error);
             ERR.set(values, &out.following_error);

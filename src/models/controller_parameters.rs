@@ -11,6 +11,15 @@ pub const fn nonnegative(name: &'static str, start: f64, description: &'static s
     Variable::parameter(name, Start::Real(start), description).min(0.0)
 }
 
+/// The velocity feed-forward gain: the command gains `feedForward`·vref (1 adds the
+/// reference's own velocity; 0, the default, none).
+pub const FEED_FORWARD: Variable = nonnegative(
+    "feedForward",
+    0.0,
+    "Velocity feed-forward gain: the command adds feedForward * vref (0: none, 1: the \
+     reference's velocity)",
+);
+
 /// A position-loop gain of every axis (`axis.x.Kp`, `axis.C.Kd`, …), ≥ 0.
 pub const fn axis_gain(
     suffix: &'static str,

@@ -7,7 +7,7 @@
 
 use std::f64::consts::PI;
 
-use super::axis_variables::REFERENCE_OUT;
+use super::axis_variables::{REFERENCE_OUT, REFERENCE_VELOCITY_OUT};
 use super::line_arc_parameters;
 use super::path_parameter;
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
@@ -78,6 +78,7 @@ variable_table! {
         "Time from the start to the end of the path (known after initialization)",
     )
     .unit("s");
+    VREF: Reals<2> = axis_block(&XY, &[REFERENCE_VELOCITY_OUT]);
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -257,7 +258,7 @@ fn path(values: &Values, environment: &Environment) -> Result<Path, String> {
 impl PathInterpolator2D {
     fn write_outputs(&self, values: &mut Values) {
         let Some(state) = &self.state else { return };
-        let (point, done, speed, duration) = match &state.reference {
+        let (point, done, speed, duration, velocity) = match &state.reference {
             Reference::ConstantFeed(it) => {
                 let sample = it.current();
                 let speed = if sample.done { 0.0 } else { it.feed() };
@@ -266,6 +267,7 @@ impl PathInterpolator2D {
                     sample.done,
                     speed,
                     it.path().length() / it.feed(),
+                    it.velocity(),
                 )
             }
             Reference::Planned(planned) => {
@@ -275,10 +277,12 @@ impl PathInterpolator2D {
                     planned.done(),
                     sample.speed,
                     planned.duration(),
+                    sample.direction * sample.speed,
                 )
             }
         };
         REF.set(values, &point);
+        VREF.set(values, &velocity);
         DONE.set(values, done);
         FEED_RATE.set(values, speed);
         DURATION.set(values, duration);

@@ -140,6 +140,20 @@ impl<E: ContourEstimator<D>, const D: usize> CrossCoupledController<E, D> {
         }
     }
 
+    /// [`CrossCoupledController::sample`] with a velocity feed-forward `feed_forward`
+    /// (mm/s, the gain applied) added to the commands: the reference's velocity that a
+    /// position loop alone only follows with a lag.
+    pub fn sample_with(
+        &mut self,
+        reference: Vector<D>,
+        actual: Vector<D>,
+        feed_forward: Vector<D>,
+    ) -> ControlOutput<D> {
+        let mut out = self.sample(reference, actual);
+        out.u += feed_forward;
+        out
+    }
+
     /// Back to the initial state: axis and contour integrators, previous errors and the
     /// estimator's history are cleared; the configuration is kept.
     pub fn reset(&mut self) {

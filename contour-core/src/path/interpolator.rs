@@ -169,6 +169,14 @@ impl<const D: usize, C: Curve<D>> Interpolator<D, C> {
     pub fn is_done(&self) -> bool {
         self.done
     }
+    /// The reference's velocity at the current sample, mm/s: the feed along the curve's
+    /// tangent there; zero at the end (and where the curve has no tangent).
+    pub fn velocity(&self) -> Vector<D> {
+        match geometry::unit(&self.cur.d1) {
+            Some(t) if !self.done => t * self.feed,
+            _ => Vector::zeros(),
+        }
+    }
     /// Number of steps taken since the start (the current point is at time samples·Ts).
     pub fn samples(&self) -> u64 {
         self.samples

@@ -227,6 +227,15 @@ impl NurbsPieces {
     }
 }
 
+impl NurbsPieces {
+    /// The unit tangent at arc length `s` in cell `cell` (as [`NurbsPieces::point`] left
+    /// it); zero where the curve has none.
+    pub fn direction(&self, s: f64, cell: usize) -> Vector2 {
+        let d1 = self.nurbs.eval(self.cells[cell].parameter(s)).d1;
+        crate::geometry::unit(&d1).unwrap_or_else(Vector2::zeros)
+    }
+}
+
 /// Measures the cell (u0, u1) starting at arc length `*s`, keeps it (appending to
 /// `out`, advancing `*s`, at most `budget` cells in all) or splits it. `at_knot`: u1
 /// ends a knot span.

@@ -65,6 +65,8 @@ pub struct XyPoint {
     pub s: f64,
     /// Path speed, mm/s.
     pub speed: f64,
+    /// The unit tangent of the planned geometry there (the direction of travel).
+    pub direction: Vector2,
 }
 
 /// The plan's position in its phases and along its geometry (a program's move, a
@@ -381,16 +383,27 @@ impl XyPlan {
             let (s, v, _) = phase.at(t - phase.time);
             (s.clamp(0.0, length), v.max(0.0))
         };
-        let point = match &self.geometry {
+        let (point, direction) = match &self.geometry {
             Geometry::Program(program) => {
                 let last = program.moves().len() - 1;
                 while cursor.piece < last && program.start_of(cursor.piece + 1) < s {
                     cursor.piece += 1;
                 }
-                program.point_in(cursor.piece, s)
+                (
+                    program.point_in(cursor.piece, s),
+                    program.direction_in(cursor.piece, s),
+                )
             }
-            Geometry::Nurbs(cut) => cut.point(s, &mut cursor.piece),
+            Geometry::Nurbs(cut) => {
+                let point = cut.point(s, &mut cursor.piece);
+                (point, cut.direction(s, cursor.piece))
+            }
         };
-        XyPoint { point, s, speed }
+        XyPoint {
+            point,
+            s,
+            speed,
+            direction,
+        }
     }
 }

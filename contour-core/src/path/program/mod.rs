@@ -181,6 +181,13 @@ impl Program {
         self.moves[i].shape.curve().point(self.local(i, s))
     }
 
+    /// The unit tangent of move `i` at path position `s` (clamped into the move), in the
+    /// direction of travel; zero where the move has none (a point).
+    pub fn direction_in(&self, i: usize, s: f64) -> Vector2 {
+        let d1 = self.moves[i].shape.curve().eval(self.local(i, s)).d1;
+        crate::geometry::unit(&d1).unwrap_or_else(Vector2::zeros)
+    }
+
     /// The mirror image about the x axis, travelled in the mirrored sense.
     pub fn mirrored(&self) -> Program {
         let moves = self
