@@ -122,6 +122,9 @@ pub static INFO: ModelInfo = ModelInfo {
         // At rest with a plan, the feed without.
         (FEED_RATE.vr(), &[FEED.vr(), ACCEL.vr()]),
         (DURATION.vr(), &DURATION_KNOWNS),
+        // The feed along the start's tangent without a plan, at rest with one.
+        (VREF.at(0).vr(), &DURATION_KNOWNS),
+        (VREF.at(1).vr(), &DURATION_KNOWNS),
     ],
     create: |environment: &Environment| {
         Box::new(PathInterpolator2D {

@@ -7,7 +7,7 @@ use crate::framework::state_check;
 use crate::framework::state_codec::{decode_state, StateLayout};
 use crate::framework::variable_table::{Axis, AxisKind, AxisTemplate, AxisUnit, AxisWord, Reals};
 use crate::framework::variables::{Values, Variable};
-use contour_core::plant::{AxisEffects, AxisParams, ServoAxes, ServoAxis, Transmission};
+use contour_core::plant::{AxisEffects, AxisParams, ServoAxes, Transmission};
 
 /// Drive parameters per axis, in [`AxisParams`] field order.
 pub const FIELDS: usize = 6;
@@ -265,43 +265,9 @@ pub fn validate<const D: usize>(table: &ServoAxes<D>, axes: &[Axis; D]) -> Resul
         servo
             .check_play()
             .map_err(|e| format!("axis {name}: {e}"))?;
-        check_cached_transition(name, servo)?;
-    }
-    Ok(())
-}
-
-/// An axis keeps the transition matrices of its last step length; they must be the ones
-/// its parameters give for that length (recomputed the same way, so bit for bit), or the
-/// restored axis would follow other dynamics than its parameters say.
-fn check_cached_transition(name: &str, axis: &ServoAxis) -> Result<(), String> {
-    let cached = |a: &ServoAxis| -> Vec<(String, f64)> {
-        state_check::floats(a)
-            .into_iter()
-            .filter(|(path, _)| path.starts_with("cached"))
-            .collect()
-    };
-    let saved = cached(axis);
-    let Some(&(_, step)) = saved.iter().find(|(path, _)| path == "cached.step") else {
-        return Ok(()); // nothing cached yet
-    };
-    if !(step.is_finite() && step > 0.0) {
-        return Err(format!(
-            "axis {name}: cached step length {step} s must be finite and > 0"
-        ));
-    }
-    let mut reference = ServoAxis::new(*axis.params(), 0.0);
-    reference.step(0.0, step);
-    let expected = cached(&reference);
-    if saved.len() != expected.len()
-        || saved
-            .iter()
-            .zip(&expected)
-            .any(|(a, b)| a.0 != b.0 || a.1.to_bits() != b.1.to_bits())
-    {
-        return Err(format!(
-            "axis {name}: the cached transition for steps of {step} s does not match the \
-             axis parameters"
-        ));
+        servo
+            .check_caches()
+            .map_err(|e| format!("axis {name}: {e}"))?;
     }
     Ok(())
 }

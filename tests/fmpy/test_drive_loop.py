@@ -11,8 +11,9 @@ in force units (Kvp_d = CT Kvp k^2, Kvi_d = CT Kvi k^2: the motor current times 
 force at the table). The two loops then differ only in one thing: ServoDrive samples its
 inputs once per communication step h and holds its force over the step, where the
 plant's drive is continuous. The difference is first order in h (the drive's effort lags
-the continuous law by about h/2): halving h halves it, and at h = 0.1 ms it is below 1 um,
-a third of what the friction itself moves the loop.
+the continuous law by about h/2): halving h halves it, and at h = 0.1 ms it is below 1 um.
+What the friction does to each loop (with it less without) is compared on its own, so the
+slide's friction is checked, not only the drive's sampling.
 """
 
 import subprocess
@@ -86,15 +87,20 @@ def test_the_nc_drives_a_foreign_si_plant_through_servo_drives(fmu_dir, slide_fm
     assert with_ccc < 0.1 * without
     gaps = {}
     for (h, ccc), positions in runs.items():
-        reference = plant_loop(fmu_dir, h, ccc)
-        gaps[h, ccc] = largest_gap(positions, reference)
-        # Contour errors differ by no more than the positions do.
-        assert abs(contour_error(positions).max() - contour_error(reference).max()) <= gaps[h, ccc]
+        gaps[h, ccc] = largest_gap(positions, plant_loop(fmu_dir, h, ccc))
     print("largest gap to the XYServoPlant loop (um):",
           {f"{h * 1e3} ms, CCC {ccc}": round(float(g) * 1e3, 3) for (h, ccc), g in gaps.items()})
     for ccc in (False, True):
         assert gaps[fine, ccc] <= 0.55 * gaps[coarse, ccc], "first order in the step"
         assert gaps[fine, ccc] < 1e-3
-    # The friction is in both: without it the reference loop moves by three times the gap.
-    frictionless = plant_loop(fmu_dir, fine, True, coulomb=0.0)
-    assert largest_gap(frictionless, plant_loop(fmu_dir, fine, True)) > 3 * gaps[fine, True]
+    # The slide's friction against the plant's: what friction does to each loop (the run
+    # with it less the run without), the sampling's share cancelled. Friction moves the
+    # loop by 2.7 um at its reversals; the two agree to a small part of that.
+    slide_effect = runs[fine, True] - drive_loop(fmu_dir, slide_fmu, fine, True, coulomb=0.0)
+    plant_effect = plant_loop(fmu_dir, fine, True) - plant_loop(fmu_dir, fine, True, coulomb=0.0)
+    effect = np.max(np.hypot(*plant_effect.T))
+    mismatch = np.max(np.hypot(*(slide_effect - plant_effect).T))
+    print(f"friction moves the loop by {effect * 1e3:.3f} um; the two loops' friction effects "
+          f"differ by {mismatch * 1e3:.3f} um")
+    assert effect > 2e-3
+    assert mismatch < 0.05 * effect

@@ -69,7 +69,8 @@ pub struct CorrectionGuard {
     from: Joints,
     measured_at: f64,
     measured: bool,
-    /// The commands sent since that measurement, summed, and how many.
+    /// The command sent last (what a plant holds over a communication step), and how many
+    /// were sent since that measurement.
     sent: Joints,
     sent_count: u32,
     /// Each joint's travel short of its commands, forgotten over [`OBEY_WINDOW`].
@@ -85,6 +86,9 @@ pub const OBEY_WINDOW: f64 = 0.02;
 /// The slowest velocity loop the guard expects, s (its time constant). A first-order
 /// loop of lag τ travels ∫v = ∫u − τ·Δv: it falls short of its commands by τ·(v − v̄)
 /// with v̄ the speed averaged over the window, at most τ·amax·window within the limits.
+/// The guard allows τ plus the time between measurements: which command a plant held
+/// over that time depends on the master (Gauss-Seidel: the last one sent; Jacobi: the one
+/// before), so it is known to within one such interval of command change.
 pub const OBEY_LAG: f64 = 0.01;
 
 impl CorrectionGuard {
@@ -111,15 +115,16 @@ impl CorrectionGuard {
 
     /// Records the command sent this sample.
     pub fn commanded(&mut self, command: &Joints) {
-        self.sent += command;
+        self.sent = *command;
         self.sent_count += 1;
     }
 
     /// Whether a joint has fallen short of its commands by more than a velocity loop of
     /// lag [`OBEY_LAG`] would (a drive at its current limit, an axis held by friction),
-    /// given the joints `actual` measured at `at` (s). Travel is compared with the mean
-    /// command since the last distinct measurement over the time between the two, so a
-    /// measurement held over several samples is judged once.
+    /// given the joints `actual` measured at `at` (s). Travel between distinct
+    /// measurements Δt apart is compared with the last command sent over Δt (a measurement
+    /// held over several samples is judged once), and the allowance grows by Δt (see
+    /// [`OBEY_LAG`]).
     pub fn disobeyed(&mut self, actual: &Joints, at: f64) -> bool {
         if self.measured && at == self.measured_at {
             return self.short;
@@ -127,18 +132,18 @@ impl CorrectionGuard {
         let dt = at - self.measured_at;
         if self.measured && self.sent_count > 0 && dt > 0.0 {
             let keep = (-dt / OBEY_WINDOW).exp();
-            let mean = self.sent / f64::from(self.sent_count);
             let l = &self.limits;
             self.short = false;
             for i in 0..5 {
-                let short = mean[i] * dt - (actual[i] - self.from[i]);
+                let short = self.sent[i] * dt - (actual[i] - self.from[i]);
                 self.shortfall[i] = keep * self.shortfall[i] + short;
-                let allowed = OBEY_LAG * (l.acceleration[i] * OBEY_WINDOW).min(2.0 * l.velocity[i]);
+                let allowed =
+                    (OBEY_LAG + dt) * (l.acceleration[i] * OBEY_WINDOW).min(2.0 * l.velocity[i]);
                 self.short |= self.shortfall[i].abs() > allowed;
             }
         }
         (self.from, self.measured_at, self.measured) = (*actual, at, true);
-        (self.sent, self.sent_count) = (Joints::zeros(), 0);
+        self.sent_count = 0;
         self.short
     }
 
@@ -282,25 +287,29 @@ mod tests {
 
     /// X's commands and measurements for 0.3 s: a command of up to `peak` mm/s
     /// changing at up to 4000 mm/s² (within X's 5000), a first-order velocity loop of lag
-    /// `lag` whose speed the drive caps at `cap`, measured every `every` samples (an FMU's
-    /// input held over a communication step of that many samples). Which samples were
-    /// judged disobeyed.
+    /// `lag` whose speed the drive caps at `cap`, measured every `every` samples as an
+    /// FMU's input held over a communication step of that many samples, the plant holding
+    /// over each step the last command of the step before (a Jacobi master: the largest
+    /// delay). Which samples were judged disobeyed.
     fn disobedience(peak: f64, lag: f64, cap: f64, every: usize) -> Vec<usize> {
         let mut g = guard();
         let (ts, substeps) = (1e-3, 100);
         let (mut x, mut v) = (0.0, 0.0);
         let (mut measured, mut at) = (0.0, 0.0);
+        let (mut held, mut last) = (0.0, 0.0);
         let mut short = Vec::new();
         for k in 0..300 {
             if k % every == 0 {
                 (measured, at) = (x, k as f64 * ts);
+                held = last;
             }
             if g.disobeyed(&Joints::new(measured, 0.0, 0.0, 0.0, 0.0), at) {
                 short.push(k);
             }
             let t = k as f64 * ts;
-            let u = peak * (4000.0 / peak * t).sin();
-            g.commanded(&Joints::new(u, 0.0, 0.0, 0.0, 0.0));
+            last = peak * (4000.0 / peak * t).sin();
+            g.commanded(&Joints::new(last, 0.0, 0.0, 0.0, 0.0));
+            let u = if every == 1 { last } else { held };
             for _ in 0..substeps {
                 let h = ts / substeps as f64;
                 v = (v + h / lag * (u - v)).clamp(-cap, cap);
@@ -312,10 +321,11 @@ mod tests {
 
     #[test]
     fn a_velocity_loop_that_lags_within_the_limits_obeys() {
-        // Lags of 3.2 ms (the test plant's 50 Hz loop) and 10 ms, every sample or held
-        // over 2.5 ms (measured every 2 or 3 samples: judged once per measurement).
+        // Lags of 3.2 ms (the test plant's 50 Hz loop) and 10 ms, every sample or through
+        // a Jacobi master with communication steps of 3, 5 and 10 samples (judged once per
+        // measurement).
         for lag in [0.0032, 0.01] {
-            for every in [1, 3] {
+            for every in [1, 3, 5, 10] {
                 assert!(
                     disobedience(450.0, lag, f64::INFINITY, every).is_empty(),
                     "{lag}"

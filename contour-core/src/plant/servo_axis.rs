@@ -485,9 +485,16 @@ impl ServoAxis {
         if winding_up {
             next[2] = integral;
         }
-        // Friction stops a motion; it never reverses one.
+        // Friction stops a motion; it never reverses one, nor carries the motor back past
+        // where the substep started (which would open the play under a stuck motor and
+        // let it go free).
         if friction * next[1] < 0.0 {
             next[1] = 0.0;
+            next[0] = if friction > 0.0 {
+                next[0].max(x)
+            } else {
+                next[0].min(x)
+            };
         }
         self.state = next;
         if !no_play {
@@ -513,6 +520,36 @@ impl ServoAxis {
                 table.contact = Contact::Gap;
             }
             table.velocity = 0.0;
+        }
+    }
+
+    /// Checks that the cached transitions are the ones the parameters give for their step
+    /// lengths (recomputed the same way, so equal to the bit), the substep count included:
+    /// a restored axis must follow its parameters' dynamics, and a count from elsewhere
+    /// could make a step run for ever.
+    pub fn check_caches(&self) -> Result<(), String> {
+        let step = match (&self.cached, &self.cached_substeps) {
+            (Some(d), _) => d.step,
+            (None, Some(d)) => d.step,
+            (None, None) => return Ok(()),
+        };
+        if !(step.is_finite() && step > 0.0) {
+            return Err(format!(
+                "cached step length {step} s must be finite and > 0"
+            ));
+        }
+        let matches = self
+            .cached
+            .is_none_or(|d| d == Discretisation::new(&self.params, d.step))
+            && self
+                .cached_substeps
+                .is_none_or(|d| d == SubstepDiscretisation::new(&self.params, d.step));
+        if matches {
+            Ok(())
+        } else {
+            Err(format!(
+                "the cached transition for steps of {step} s does not match the axis parameters"
+            ))
         }
     }
 
@@ -765,5 +802,75 @@ mod tests {
             .validate()
             .unwrap_err()
             .starts_with("currentMax"));
+    }
+
+    #[test]
+    fn a_restored_substep_cache_must_be_the_parameters_own() {
+        // The count of substeps and the matrices, edited in a saved axis, are refused:
+        // 4e9 substeps would make one step run for minutes.
+        let p = with(AxisEffects {
+            coulomb: 0.3,
+            ..AxisEffects::NONE
+        });
+        let mut axis = ServoAxis::new(p, 0.0);
+        axis.step(5.0, 1e-3);
+        assert_eq!(axis.check_caches(), Ok(()));
+        let saved = serde_json::to_value(&axis).unwrap();
+        assert_eq!(saved["cached_substeps"]["substeps"], 100);
+        for (field, value) in [
+            ("substeps", serde_json::json!(4_000_000_000u32)),
+            ("step", serde_json::json!(2e-3)),
+        ] {
+            let mut edited = saved.clone();
+            edited["cached_substeps"][field] = value;
+            let restored: ServoAxis = serde_json::from_value(edited).unwrap();
+            assert!(restored
+                .check_caches()
+                .unwrap_err()
+                .contains("does not match"));
+        }
+        let mut edited = saved.clone();
+        edited["cached_substeps"]["linear"]["phi"][0] = serde_json::json!(0.5);
+        let restored: ServoAxis = serde_json::from_value(edited).unwrap();
+        assert!(restored.check_caches().is_err());
+    }
+
+    #[test]
+    fn a_motor_friction_stops_in_contact_stays_in_contact() {
+        // Pushing the table at 5 mm/s, then told to stop: friction stops the motor while it
+        // pushes, and the drive's torque that remains is below the breakaway torque, so
+        // nothing moves again: the table does not creep and the contact stays closed (a
+        // stop that carried the motor back into the play used to let it go free).
+        let p = with(AxisEffects {
+            coulomb: 0.5,
+            stiction: 1.0,
+            backlash: 0.02,
+            ..AxisEffects::NONE
+        });
+        let mut axis = ServoAxis::new(p, 0.0);
+        for _ in 0..200 {
+            axis.step(5.0, 1e-3);
+        }
+        assert_eq!(axis.contact(), Contact::Forward);
+        let mut stopped = None;
+        for k in 0..50_000 {
+            axis.step(0.0, MAX_SUBSTEP);
+            if axis.motor().1 == 0.0 && stopped.is_none() {
+                stopped = Some((k, axis.position()));
+            }
+            if let Some((_, table)) = stopped {
+                assert_eq!(axis.position(), table, "substep {k}: the table crept");
+                assert_eq!(axis.contact(), Contact::Forward, "substep {k}");
+            }
+        }
+        assert!(
+            stopped.is_some(),
+            "the motor never stopped: {:?} {:?} {}",
+            axis.motor(),
+            axis.contact(),
+            axis.current(0.0)
+        );
+        // The torque left is below breakaway (the test's premise).
+        assert!(p.torque_constant * axis.current(0.0).abs() <= 1.0);
     }
 }
