@@ -140,7 +140,7 @@ fn write_deviations(
                 w,
                 "{index},{t},{},{}",
                 d.y.atan2(d.x),
-                d.norm() - nominal.radius
+                contour_core::geometry::norm(&d) - nominal.radius
             )?;
         }
     }

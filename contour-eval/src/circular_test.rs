@@ -12,7 +12,8 @@
 //!   centre and radius, where a ballbar's pivots are set): F_max = max (|pᵢ − c₀| − R₀),
 //!   F_min = min (|pᵢ − c₀| − R₀).
 
-use contour_core::geometry::Vector2;
+use contour_core::geometry::{norm, Vector2};
+use nalgebra::{Matrix3, Vector3};
 
 /// A circle in the plane, mm.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,31 +33,19 @@ pub struct CircularFigures {
     pub radial_deviation: (f64, f64),
 }
 
-/// Solves the 3 × 3 system `a·x = b` by Gaussian elimination with partial pivoting;
-/// `None` when it is singular (the points are collinear or too few).
-fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
-    let scale = a.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-    for col in 0..3 {
-        let pivot = (col..3).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
-        if !(a[pivot][col].abs() > 1e-14 * scale) {
-            return None;
-        }
-        a.swap(col, pivot);
-        b.swap(col, pivot);
-        for row in col + 1..3 {
-            let f = a[row][col] / a[col][col];
-            for k in col..3 {
-                a[row][k] -= f * a[col][k];
-            }
-            b[row] -= f * b[col];
-        }
+/// Solves the 3 × 3 system `a·x = b` by LU with partial pivoting; `None` when it is
+/// singular (the points are collinear or too few).
+fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
+    let matrix = Matrix3::from_fn(|i, j| a[i][j]);
+    let scale = matrix.amax();
+    let lu = matrix.lu();
+    // A pivot this small against the entries: no unique solution in f64.
+    let u = lu.u();
+    if (0..3).any(|i| u[(i, i)].abs() <= 1e-14 * scale) {
+        return None;
     }
-    let mut x = [0.0; 3];
-    for row in (0..3).rev() {
-        let rest: f64 = (row + 1..3).map(|k| a[row][k] * x[k]).sum();
-        x[row] = (b[row] - rest) / a[row][row];
-    }
-    Some(x)
+    let x = lu.solve(&Vector3::from(b))?;
+    Some([x[0], x[1], x[2]])
 }
 
 /// The least-squares circle of `points` (at least three, not on one line).
@@ -90,7 +79,7 @@ pub fn least_squares_circle(points: &[Vector2]) -> Result<Circle, String> {
         let (mut jtj, mut jtr) = ([[0.0; 3]; 3], [0.0; 3]);
         for p in points {
             let d = p - mean - centre;
-            let distance = d.norm();
+            let distance = norm(&d);
             if distance == 0.0 {
                 continue;
             }
@@ -125,7 +114,7 @@ pub fn figures(points: &[Vector2], nominal: &Circle) -> Result<CircularFigures, 
     let extremes = |centre: &Vector2, radius: f64| {
         points
             .iter()
-            .map(|p| (p - centre).norm() - radius)
+            .map(|p| norm(&(p - centre)) - radius)
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
                 (lo.min(r), hi.max(r))
             })
@@ -162,7 +151,7 @@ mod tests {
             radius: 10.0,
         };
         let f = figures(&on(&circle, |_| 0.0, 3600), &nominal).unwrap();
-        assert!((f.lsc.centre - circle.centre).norm() < 1e-12);
+        assert!(norm(&(f.lsc.centre - circle.centre)) < 1e-12);
         assert!((f.lsc.radius - circle.radius).abs() < 1e-12);
         assert!(f.circular_deviation < 1e-12);
         // About the nominal centre the offset circle swings by ±|offset| around
@@ -183,7 +172,7 @@ mod tests {
             radius: 25.0,
         };
         let f = figures(&on(&circle, |t| 0.004 * (2.0 * t).cos(), 720), &circle).unwrap();
-        assert!((f.lsc.centre - circle.centre).norm() < 1e-9);
+        assert!(norm(&(f.lsc.centre - circle.centre)) < 1e-9);
         assert!((f.lsc.radius - 25.0).abs() < 1e-9);
         assert!((f.circular_deviation - 0.008).abs() < 1e-9);
         assert!((f.radial_deviation.0 + 0.004).abs() < 1e-9);

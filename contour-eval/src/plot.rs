@@ -198,7 +198,8 @@ pub fn ballbar(
 ) -> Result<(), String> {
     register_font()?;
     let fail = |e: &dyn std::fmt::Display| e.to_string();
-    let deviation = |p: &Vector2| (p - nominal.centre).norm() - nominal.radius;
+    let deviation =
+        |p: &Vector2| contour_core::geometry::norm(&(p - nominal.centre)) - nominal.radius;
     let largest = runs
         .iter()
         .flatten()
