@@ -124,10 +124,14 @@ def run(rust_json):
 
 def test_parameters_are_the_documented_machine(run):
     axes = run["axes"]
+    # Linear: none of the effects of §4.5b (friction, backlash, current limit) on any axis.
+    none = dict(coulomb=0.0, stiction=0.0, stribeck_velocity=0.0, backlash=0.0, current_max=0.0)
+    assert all(p["effects"] == none for p in axes)
     # X, Y, Z: the paper's motor, 10 mm lead, the §4.5 drive.
     for p in axes[:3]:
         assert p == dict(inertia=0.015, friction=1.2, torque_constant=0.57,
-                         transmission={"Linear": {"lead": 10.0}}, kvp=8.26, kvi=661.0)
+                         transmission={"Linear": {"lead": 10.0}}, kvp=8.26, kvi=661.0,
+                         effects=none)
     # A and C: the same motor through a 90:1 worm gear; PI zero on the mechanical pole
     # (B/J = 80 1/s), velocity loop closed at 314 rad/s: Kvp = 314 J/CT, Kvi = 80 Kvp.
     rotor = 1.0e-4
