@@ -12,12 +12,12 @@ PYTHON := $(VENV)/bin/python
 PIP    := $(PYTHON) -m pip install --quiet --disable-pip-version-check
 CARGO  ?= cargo
 
-.PHONY: demo test check fmus ccc-tune bindings lint bench pso-claim setup libclang libtbb valgrind leak-check \
+.PHONY: demo test check fmus ccc-tune contour-eval bindings lint bench pso-claim setup libclang libtbb valgrind leak-check \
         asan fuzz-smoke fuzz-long cargo-fuzz
 
 # --- demo: cargo and python3 only ---------------------------------------------------------
 
-demo: fmus ccc-tune $(VENV)/.run-installed
+demo: fmus ccc-tune contour-eval $(VENV)/.run-installed
 	MPLBACKEND=Agg $(PYTHON) -m contour_fmu.demo --tune
 
 fmus:
@@ -25,6 +25,10 @@ fmus:
 
 ccc-tune:
 	$(CARGO) build --release -p contour-tune --bin ccc-tune
+
+# The demo's ballbar test runs the circular test of ISO 230-4 with it.
+contour-eval:
+	$(CARGO) build --release -p contour-eval
 
 # --- the Python venv ----------------------------------------------------------------------
 # The package is installed in editable mode: python/contour_fmu is what runs. The test set

@@ -16,7 +16,9 @@ _ref.opt) from the fuzzy circle run.
 
 Then the part demo (contour_fmu.part_demo): the G-code part examples/parts/bracket.ngc
 planned within acceleration and jerk limits, without and with the CCC, on the part and on
-its mirror image; a table, CSVs and out/part_bracket.png. Then the five-axis demo.
+its mirror image; a table, CSVs and out/part_bracket.png. Then the ballbar test of ISO 230-4
+on the plant with friction (contour_fmu.ballbar_demo: no CCC, CCC, CCC + feed-forward;
+out/ballbar_*.png). Then the five-axis demo.
 
 usage: python -m contour_fmu.demo [--fmu-dir DIR] [--out DIR]
                                   [--tune | --params tuned.json] [--ccc-tune PROGRAM]
@@ -38,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import five_axis_demo, part_demo, repo
+from . import ballbar_demo, five_axis_demo, part_demo, repo
 from .extras import needs
 from .master import closed_loop
 from .output_files import write_csv
@@ -190,6 +192,9 @@ def parse_args(argv=None, prog="python -m contour_fmu.demo"):
                      "or give --ccc-tune")
     if args.params and not args.params.is_file():
         parser.error(f"no parameter file {args.params}")
+    if not ballbar_demo.contour_eval().is_file():
+        parser.error(f"no contour-eval at {ballbar_demo.contour_eval()} (the ballbar test runs "
+                     "it): build it with `cargo build --release -p contour-eval`")
     return args
 
 
@@ -242,6 +247,8 @@ def main(argv=None, prog="python -m contour_fmu.demo"):
         print(f"the part demo skipped: no checkout holds {part_demo.PROGRAM.as_posix()}")
     else:
         part_demo.print_table(part_demo.part_demo(args.fmu_dir, args.out, program))
+    print()
+    ballbar_demo.print_table(ballbar_demo.ballbar_demo(args.fmu_dir, args.out))
     print()
     five_axis_rows = five_axis_demo.main(args.fmu_dir, args.out)
     five_axis_demo.print_table(five_axis_rows)
