@@ -194,20 +194,24 @@ fn on_a_reference_at_constant_feed_the_ccc_is_no_worse() {
     }
 }
 
+/// The paths of the saturation checks, planned at 50 mm/s.
+fn planned_paths() -> [(&'static str, ToolPath); 4] {
+    [
+        ("through vertical", vertical()),
+        ("beside vertical", beside()),
+        ("dome", dome()),
+        ("figure-eight", ToolPath::builtin("figure_eight").unwrap()),
+    ]
+}
+
 #[test]
 fn on_a_plant_that_saturates_below_its_limits_the_ccc_is_no_worse() {
     // From drives that just manage the limits (share 1) to ones a tenth as strong: the
     // guard sees the joints fall short of their commands (`Hold::disobeyed`) and stands
     // the correction aside. Before it did, the figure-eight at 0.25 had 1.85 times the
     // tip error of no CCC.
-    let eight = ToolPath::builtin("figure_eight").unwrap();
     for share in [1.0, 0.5, 0.25, 0.1] {
-        for (name, path) in [
-            ("through vertical", vertical()),
-            ("beside vertical", beside()),
-            ("dome", dome()),
-            ("figure-eight", eight.clone()),
-        ] {
+        for (name, path) in planned_paths() {
             let limited = Reference::CurrentLimited {
                 share,
                 friction: false,
@@ -223,14 +227,8 @@ fn with_coulomb_friction_the_guarantee_holds_but_on_the_dome() {
     // every path but the dome with drives that just manage the limits, where the CCC's
     // maxima exceed 1.1 times those without it (docs/design/five-axis.md §5.4b records
     // it as open); this test says when that changes, so the docs can too.
-    let eight = ToolPath::builtin("figure_eight").unwrap();
     for share in [1.0, 0.5] {
-        for (name, path) in [
-            ("through vertical", vertical()),
-            ("beside vertical", beside()),
-            ("dome", dome()),
-            ("figure-eight", eight.clone()),
-        ] {
+        for (name, path) in planned_paths() {
             let limited = Reference::CurrentLimited {
                 share,
                 friction: true,

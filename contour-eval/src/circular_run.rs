@@ -135,13 +135,8 @@ fn write_deviations(
     writeln!(w, "run,time,angle,deviation")?;
     for (index, run) in runs.iter().enumerate() {
         for (t, p) in run {
-            let d = p - nominal.centre;
-            writeln!(
-                w,
-                "{index},{t},{},{}",
-                d.y.atan2(d.x),
-                contour_core::geometry::norm(&d) - nominal.radius
-            )?;
+            let (angle, deviation) = (nominal.angle(p), nominal.deviation(p));
+            writeln!(w, "{index},{t},{angle},{deviation}")?;
         }
     }
     w.into_inner().map_err(|e| e.into_error())?.sync_all()

@@ -22,6 +22,19 @@ pub struct Circle {
     pub radius: f64,
 }
 
+impl Circle {
+    /// How far `p` lies outside the circle (< 0 inside), mm.
+    pub fn deviation(&self, p: &Vector2) -> f64 {
+        norm(&(p - self.centre)) - self.radius
+    }
+
+    /// The angle of `p` seen from the centre, rad.
+    pub fn angle(&self, p: &Vector2) -> f64 {
+        let d = p - self.centre;
+        d.y.atan2(d.x)
+    }
+}
+
 /// What ISO 230-4 reports of one run (or of two runs together), mm.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CircularFigures {
@@ -111,19 +124,19 @@ pub fn least_squares_circle(points: &[Vector2]) -> Result<Circle, String> {
 /// G, F and the LSC of `points` (one run, or two runs' points together for G(b)).
 pub fn figures(points: &[Vector2], nominal: &Circle) -> Result<CircularFigures, String> {
     let lsc = least_squares_circle(points)?;
-    let extremes = |centre: &Vector2, radius: f64| {
+    let extremes = |circle: &Circle| {
         points
             .iter()
-            .map(|p| norm(&(p - centre)) - radius)
+            .map(|p| circle.deviation(p))
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
                 (lo.min(r), hi.max(r))
             })
     };
-    let (lo, hi) = extremes(&lsc.centre, 0.0);
+    let (lo, hi) = extremes(&lsc);
     Ok(CircularFigures {
         lsc,
         circular_deviation: hi - lo,
-        radial_deviation: extremes(&nominal.centre, nominal.radius),
+        radial_deviation: extremes(nominal),
     })
 }
 

@@ -198,8 +198,7 @@ pub fn ballbar(
 ) -> Result<(), String> {
     register_font()?;
     let fail = |e: &dyn std::fmt::Display| e.to_string();
-    let deviation =
-        |p: &Vector2| contour_core::geometry::norm(&(p - nominal.centre)) - nominal.radius;
+    let deviation = |p: &Vector2| nominal.deviation(p);
     let largest = runs
         .iter()
         .flatten()

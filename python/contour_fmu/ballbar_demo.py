@@ -44,10 +44,6 @@ def program(clockwise):
             f"{g} X{r} Y0 I{-r} J0\n{g} X0 Y0 I{-r / 2} J0\nM2\n%\n")
 
 
-def contour_eval():
-    return repo.target_dir() / "release" / "contour-eval"
-
-
 def run(fmu_dir, file, controller):
     """The closed loop on `file`; (before, the first and last time the reference is on
     the circle)."""
@@ -63,18 +59,19 @@ def run(fmu_dir, file, controller):
 
 def figures(text):
     """The figures contour-eval printed, in um (and the LSC radius in mm)."""
-    numbers = [[float(x) for x in re.findall(r"-?\d+\.\d+", line)] for line in text.splitlines()]
-    g = [n[0] for line, n in zip(text.splitlines(), numbers) if "circular deviation G:" in line]
-    f = [n for line, n in zip(text.splitlines(), numbers) if "radial deviation F" in line]
-    radius = [n[2] for line, n in zip(text.splitlines(), numbers) if "least-squares circle" in line]
-    gb = [n[0] for line, n in zip(text.splitlines(), numbers) if "G(b)" in line]
-    return dict(G=g, F=f, radius=radius, Gb=gb[0])
+    def numbers(label):
+        return [[float(x) for x in re.findall(r"-?\d+\.\d+", line)]
+                for line in text.splitlines() if label in line]
+    return dict(G=[n[0] for n in numbers("circular deviation G:")],
+                F=numbers("radial deviation F"),
+                radius=[n[2] for n in numbers("least-squares circle")],
+                Gb=numbers("G(b)")[0][0])
 
 
 def ballbar_demo(fmu_dir, out, tool=None):
     """Runs every controller both ways; {controller: figures}. Writes the runs' CSVs and
     plots to `out`."""
-    tool = tool or contour_eval()
+    tool = tool or repo.contour_eval()
     if not Path(tool).exists():
         raise FileNotFoundError(f"{tool} is missing: cargo build --release -p contour-eval")
     out.mkdir(parents=True, exist_ok=True)

@@ -192,8 +192,8 @@ def parse_args(argv=None, prog="python -m contour_fmu.demo"):
                      "or give --ccc-tune")
     if args.params and not args.params.is_file():
         parser.error(f"no parameter file {args.params}")
-    if not ballbar_demo.contour_eval().is_file():
-        parser.error(f"no contour-eval at {ballbar_demo.contour_eval()} (the ballbar test runs "
+    if not repo.contour_eval().is_file():
+        parser.error(f"no contour-eval at {repo.contour_eval()} (the ballbar test runs "
                      "it): build it with `cargo build --release -p contour-eval`")
     return args
 

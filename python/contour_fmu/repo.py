@@ -84,6 +84,11 @@ def ccc_tune():
     return target_dir() / "release" / "ccc-tune"
 
 
+def contour_eval():
+    """The release build of the offline evaluation (the ballbar demo's circular test)."""
+    return target_dir() / "release" / "contour-eval"
+
+
 # The workspace crates that hold the cargo targets the Python side runs: the library
 # (the FMUs, the dump examples) and the tuner (ccc-tune, the PSO examples).
 LIBRARY_PACKAGE = "contour-fmu"

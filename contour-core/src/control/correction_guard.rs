@@ -69,10 +69,10 @@ pub struct CorrectionGuard {
     from: Joints,
     measured_at: f64,
     measured: bool,
-    /// The command sent last (what a plant holds over a communication step), and how many
-    /// were sent since that measurement.
+    /// The command sent last (what a plant holds over a communication step), and whether
+    /// one was sent since that measurement.
     sent: Joints,
-    sent_count: u32,
+    sent_since: bool,
     /// Each joint's travel short of its commands, forgotten over [`OBEY_WINDOW`].
     shortfall: Joints,
     /// Whether a joint fell short at the last measurement.
@@ -107,7 +107,7 @@ impl CorrectionGuard {
             measured_at: 0.0,
             measured: false,
             sent: Joints::zeros(),
-            sent_count: 0,
+            sent_since: false,
             short: false,
             shortfall: Joints::zeros(),
         }
@@ -116,7 +116,7 @@ impl CorrectionGuard {
     /// Records the command sent this sample.
     pub fn commanded(&mut self, command: &Joints) {
         self.sent = *command;
-        self.sent_count += 1;
+        self.sent_since = true;
     }
 
     /// Whether a joint has fallen short of its commands by more than a velocity loop of
@@ -130,7 +130,7 @@ impl CorrectionGuard {
             return self.short;
         }
         let dt = at - self.measured_at;
-        if self.measured && self.sent_count > 0 && dt > 0.0 {
+        if self.measured && self.sent_since && dt > 0.0 {
             let keep = (-dt / OBEY_WINDOW).exp();
             let l = &self.limits;
             self.short = false;
@@ -143,7 +143,7 @@ impl CorrectionGuard {
             }
         }
         (self.from, self.measured_at, self.measured) = (*actual, at, true);
-        self.sent_count = 0;
+        self.sent_since = false;
         self.short
     }
 

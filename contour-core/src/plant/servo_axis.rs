@@ -389,10 +389,15 @@ impl ServoAxis {
 
     /// Motor current demanded by the drive, A (within the current limit).
     pub fn current(&self, command: f64) -> f64 {
+        let limit = self.params.effects.current_limit();
+        self.demand(command).clamp(-limit, limit)
+    }
+
+    /// The drive's PI law before its current limit, A.
+    fn demand(&self, command: f64) -> f64 {
         let p = &self.params;
-        let scale = p.transmission.motor_per_axis_unit();
-        let limit = p.effects.current_limit();
-        (scale * (p.kvp * (command - self.state[1]) + p.kvi * self.state[2])).clamp(-limit, limit)
+        p.transmission.motor_per_axis_unit()
+            * (p.kvp * (command - self.state[1]) + p.kvi * self.state[2])
     }
 
     /// Advances by `step` seconds with the velocity command `command` (mm/s or rad/s) held.
@@ -430,10 +435,8 @@ impl ServoAxis {
         let p = self.params;
         let effects = p.effects;
         let [x, velocity, integral] = [self.state[0], self.state[1], self.state[2]];
-        let demand = p.transmission.motor_per_axis_unit()
-            * (p.kvp * (command - velocity) + p.kvi * integral);
-        let limit = effects.current_limit();
-        let current = demand.clamp(-limit, limit);
+        let demand = self.demand(command);
+        let current = self.current(command);
         let saturated = current != demand;
         // Conditional integration: the integral holds while the current is at the limit
         // and the error drives it further in.
