@@ -79,12 +79,22 @@ impl Interface {
 
     /// The model's description, with the interface's units when they are not its own.
     pub fn description(&self) -> String {
-        match self.units {
-            UnitSystem::Millimetre => self.model.description.to_string(),
-            UnitSystem::Si => format!(
+        match (self.units, self.converts()) {
+            (UnitSystem::Millimetre, _) => self.model.description.to_string(),
+            (UnitSystem::Si, true) => format!(
                 "{} (SI interface: lengths in m, m/s, m/s2, m/s3)",
                 self.model.description
             ),
+            // A rotary drive has no length: its SI build is the mm build's units.
+            (UnitSystem::Si, false) => format!(
+                "{} (SI interface: every unit as in the mm build, already SI)",
+                self.model.description
+            ),
         }
+    }
+
+    /// Whether any value is scaled at the interface.
+    pub fn converts(&self) -> bool {
+        self.scale.iter().any(|s| *s != 1.0)
     }
 }
