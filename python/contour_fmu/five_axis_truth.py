@@ -62,9 +62,12 @@ def _densify(tips, axes):
     return dense, turn / np.linalg.norm(turn, axis=1, keepdims=True), n
 
 
-def contour_errors(reference_joints, measured_joints, a_pivot=(0, 0, 0), c_pivot=(0, 0, 0)):
+def contour_errors(reference_joints, measured_joints, a_pivot=(0, 0, 0), c_pivot=(0, 0, 0),
+                   ahead=0):
     """(tip mm, orientation rad) per measured sample k; reference_joints[k] is the
-    reference at the same instant (later reference samples are never searched)."""
+    reference at the same instant. Later reference samples are searched up to `ahead`
+    samples past it: a loop with feed-forward may lead its reference (braking), and a
+    tool ahead of the newest point is not off the path."""
     tips, axes = forward(reference_joints, a_pivot, c_pivot)
     # Repeated samples (before the start, after the end) would make zero-length pieces.
     keep = np.concatenate([[True], np.any(tips[1:] != tips[:-1], axis=1)])
@@ -74,7 +77,7 @@ def contour_errors(reference_joints, measured_joints, a_pivot=(0, 0, 0), c_pivot
     tip_error = np.empty(len(ptips))
     orientation_error = np.empty(len(ptips))
     for k, (p, o) in enumerate(zip(ptips, paxes)):
-        newest = index[min(k, len(index) - 1)]
+        newest = index[min(k + ahead, len(index) - 1)]
         lo, hi = max(newest - WINDOW, 0) * UPSAMPLE, min(newest * UPSAMPLE, len(dense) - 1)
         if hi == lo:
             hi = min(lo + UPSAMPLE, len(dense) - 1)

@@ -5,9 +5,12 @@ use it without loading fmpy."""
 CLOSED_LOOP_CONNECTIONS = [
     ("interpolator", "ref.x", "controller", "ref.x"),
     ("interpolator", "ref.y", "controller", "ref.y"),
-    # The reference's velocity, for the controller's feed-forward (feedForward > 0).
+    # The reference's velocity and acceleration, for the controller's feed-forward
+    # (feedForward, accelerationFeedForward > 0).
     ("interpolator", "vref.x", "controller", "vref.x"),
     ("interpolator", "vref.y", "controller", "vref.y"),
+    ("interpolator", "aref.x", "controller", "aref.x"),
+    ("interpolator", "aref.y", "controller", "aref.y"),
     ("plant", "pos.x", "controller", "pos.x"),
     ("plant", "pos.y", "controller", "pos.y"),
     ("controller", "u.x", "plant", "u.x"),
@@ -25,6 +28,10 @@ FIVE_AXIS_JOINTS = ("X", "Y", "Z", "A", "C")
 # The five-axis loop: PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant.
 FIVE_AXIS_CONNECTIONS = (
     [("interpolator", f"ref.{j}", "controller", f"ref.{j}") for j in FIVE_AXIS_JOINTS]
+    # The reference's joint velocities and accelerations, for the feed-forward
+    # (feedForward, accelerationFeedForward > 0).
+    + [("interpolator", f"vref.{j}", "controller", f"vref.{j}") for j in FIVE_AXIS_JOINTS]
+    + [("interpolator", f"aref.{j}", "controller", f"aref.{j}") for j in FIVE_AXIS_JOINTS]
     + [("plant", f"pos.{j}", "controller", f"pos.{j}") for j in FIVE_AXIS_JOINTS]
     + [("controller", f"u.{j}", "plant", f"u.{j}") for j in FIVE_AXIS_JOINTS]
 )

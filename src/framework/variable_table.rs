@@ -179,6 +179,8 @@ impl AxisUnit {
     pub const POSITION: AxisUnit = AxisUnit::ByKind("mm", "rad");
     /// Velocity: mm/s or rad/s.
     pub const VELOCITY: AxisUnit = AxisUnit::ByKind("mm/s", "rad/s");
+    /// Acceleration: mm/s² or rad/s².
+    pub const ACCELERATION: AxisUnit = AxisUnit::ByKind("mm/s2", "rad/s2");
 }
 
 /// Which word of the axis goes into a description.

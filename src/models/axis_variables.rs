@@ -20,6 +20,28 @@ pub const REFERENCE_VELOCITY_OUT: AxisTemplate = AxisTemplate::output(
 )
 .unit(AxisUnit::VELOCITY);
 
+/// An interpolator's reference acceleration output: `aref.<axis>`.
+pub const REFERENCE_ACCELERATION_OUT: AxisTemplate = AxisTemplate::output(
+    ("aref.", ""),
+    (
+        "Reference acceleration at the sample, ",
+        AxisWord::Name,
+        " (for feed-forward)",
+    ),
+)
+.unit(AxisUnit::ACCELERATION);
+
+/// A controller's reference acceleration input: `aref.<axis>`.
+pub const REFERENCE_ACCELERATION_IN: AxisTemplate = AxisTemplate::input(
+    ("aref.", ""),
+    (
+        "Reference acceleration, ",
+        AxisWord::Name,
+        ", from the interpolator's aref (feed-forward; 0 when unconnected)",
+    ),
+)
+.unit(AxisUnit::ACCELERATION);
+
 /// A controller's reference velocity input: `vref.<axis>`.
 pub const REFERENCE_VELOCITY_IN: AxisTemplate = AxisTemplate::input(
     ("vref.", ""),

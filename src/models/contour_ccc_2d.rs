@@ -4,7 +4,8 @@
 //! `fmi2DoStep` on the inputs held over the step, whatever the communication step.
 
 use super::axis_variables::{
-    COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_IN, REFERENCE_VELOCITY_IN,
+    COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_ACCELERATION_IN, REFERENCE_IN,
+    REFERENCE_VELOCITY_IN,
 };
 use super::controller_parameters::{self, axis_gain, nonnegative};
 use super::line_arc_parameters;
@@ -133,6 +134,8 @@ variable_table! {
     TOLERANCE: Real = path_parameter::TOLERANCE;
     VREF: Reals<2> = axis_block(&XY, &[REFERENCE_VELOCITY_IN]);
     FEED_FORWARD: Real = controller_parameters::FEED_FORWARD;
+    AREF: Reals<2> = axis_block(&XY, &[REFERENCE_ACCELERATION_IN]);
+    ACCELERATION_FEED_FORWARD: Real = controller_parameters::ACCELERATION_FEED_FORWARD;
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -161,10 +164,10 @@ pub static INFO: ModelInfo = ModelInfo {
 /// `Option<State>` as below. Version 2: the controller became N-axis (per-axis contour
 /// PIDs, unused in the plane, joined its state). Version 3: the program estimator's track
 /// keeps its last two foot points (its next search's guess). Version 4: the velocity
-/// feed-forward gain.
+/// feed-forward gain. Version 5: the acceleration feed-forward time.
 const LAYOUT: StateLayout = StateLayout {
     model: "ContourCCC2D",
-    version: 4,
+    version: 5,
 };
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
@@ -173,6 +176,8 @@ struct State {
     clock: SampleClock,
     /// The velocity feed-forward gain (`feedForward`).
     feed_forward: f64,
+    /// The acceleration feed-forward time (`accelerationFeedForward`), s.
+    acceleration_feed_forward: f64,
 }
 
 impl SavedState for State {
@@ -180,12 +185,8 @@ impl SavedState for State {
     /// the offending value.
     fn validate(&self, time: f64) -> Result<(), String> {
         self.clock.validate_at(time)?;
-        if !(self.feed_forward.is_finite() && self.feed_forward >= 0.0) {
-            return Err(format!(
-                "feed-forward gain {} must be finite and >= 0",
-                self.feed_forward
-            ));
-        }
+        controller_parameters::check_feed_forward(self.feed_forward)?;
+        controller_parameters::check_feed_forward(self.acceleration_feed_forward)?;
         let controller = &self.controller;
         let config = controller.config();
         config
@@ -337,6 +338,7 @@ impl Model for ContourCCC2D {
             controller,
             clock: SampleClock::new(start_time, config.ts),
             feed_forward: FEED_FORWARD.get(values),
+            acceleration_feed_forward: ACCELERATION_FEED_FORWARD.get(values),
         });
         U.set(values, &Vector2::zeros());
         CONTOUR_ERROR.set(values, 0.0);
@@ -349,7 +351,8 @@ impl Model for ContourCCC2D {
         let state = self.state.as_mut().ok_or("not initialized")?;
         let reference = REF.vector(values);
         let actual = POS.vector(values);
-        let feed_forward = VREF.vector(values) * state.feed_forward;
+        let feed_forward = VREF.vector(values) * state.feed_forward
+            + AREF.vector(values) * state.acceleration_feed_forward;
         while state.clock.take_before(time + step) {
             let out = state
                 .controller

@@ -6,7 +6,10 @@
 //! Jacobian. The control law runs every `Ts` inside `fmi2DoStep` on the inputs held over
 //! the step, whatever the communication step.
 
-use super::axis_variables::{COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_IN};
+use super::axis_variables::{
+    COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_ACCELERATION_IN, REFERENCE_IN,
+    REFERENCE_VELOCITY_IN,
+};
 use super::controller_parameters::{self, axis_gain, nonnegative};
 use super::{joint_limits_parameters, kinematics_parameters};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
@@ -230,6 +233,10 @@ variable_table! {
          speed, a joint falling short of its commands, a mapping that lost the tool), \
          rising over `recovery` when none holds",
     );
+    VREF: Reals<5> = axis_block(&XYZAC, &[REFERENCE_VELOCITY_IN]);
+    FEED_FORWARD: Real = controller_parameters::FEED_FORWARD;
+    AREF: Reals<5> = axis_block(&XYZAC, &[REFERENCE_ACCELERATION_IN]);
+    ACCELERATION_FEED_FORWARD: Real = controller_parameters::ACCELERATION_FEED_FORWARD;
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -252,21 +259,28 @@ pub static INFO: ModelInfo = ModelInfo {
 
 /// Version 1: `Option<State>` as below. Version 2: the controller carries the machine's
 /// limits and the guard of its correction. Version 3: the guard also remembers the
-/// commands sent and the joints' shortfall of travel.
+/// commands sent and the joints' shortfall of travel. Version 4: the velocity
+/// feed-forward gain.
 const LAYOUT: StateLayout = StateLayout {
     model: "ContourCCC5X",
-    version: 3,
+    version: 4,
 };
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct State {
     controller: FiveAxisController,
     clock: SampleClock,
+    /// The velocity feed-forward gain (`feedForward`).
+    feed_forward: f64,
+    /// The acceleration feed-forward time (`accelerationFeedForward`), s.
+    acceleration_feed_forward: f64,
 }
 
 impl SavedState for State {
     fn validate(&self, time: f64) -> Result<(), String> {
         self.clock.validate_at(time)?;
+        controller_parameters::check_feed_forward(self.feed_forward)?;
+        controller_parameters::check_feed_forward(self.acceleration_feed_forward)?;
         let controller = &self.controller;
         let config = controller.config();
         config
@@ -428,6 +442,8 @@ impl Model for ContourCCC5X {
         self.state = Some(State {
             controller,
             clock: SampleClock::new(start_time, config.ts),
+            feed_forward: FEED_FORWARD.get(values),
+            acceleration_feed_forward: ACCELERATION_FEED_FORWARD.get(values),
         });
         Self::write_zero_outputs(values);
         Ok(())
@@ -437,13 +453,15 @@ impl Model for ContourCCC5X {
         let state = self.state.as_mut().ok_or("not initialized")?;
         let reference = REF.vector(values);
         let actual = POS.vector(values);
+        let feed_forward = VREF.vector(values) * state.feed_forward
+            + AREF.vector(values) * state.acceleration_feed_forward;
         let ts = state.controller.config().ts;
         while state.clock.take_before(time + step) {
             // Inputs are finite (fmi2SetReal refuses others), so a sample cannot fail.
             // The inputs were set at this communication point and are held over it.
             let out = state
                 .controller
-                .sample_held(&reference, time, &actual)
+                .sample_with(&reference, time, &actual, &feed_forward)
                 .map_err(|e| format!("sample at t = {time}: {e}"))?;
             U.set(values, &out.u);
             ERR.set(values, &out.following_error);

@@ -20,6 +20,26 @@ pub const FEED_FORWARD: Variable = nonnegative(
      reference's velocity)",
 );
 
+/// The acceleration feed-forward time: the command gains `accelerationFeedForward`·aref
+/// (a drive's velocity loop lags by about its time constant times the acceleration).
+pub const ACCELERATION_FEED_FORWARD: Variable = nonnegative(
+    "accelerationFeedForward",
+    0.0,
+    "Acceleration feed-forward time: the command adds accelerationFeedForward * aref; the \
+     drives' velocity-loop time constant cancels their lag behind the velocity feed-forward \
+     (0: none)",
+)
+.unit("s");
+
+/// Checks a restored feed-forward gain as `feedForward`'s own check would.
+pub fn check_feed_forward(gain: f64) -> Result<(), String> {
+    if gain.is_finite() && gain >= 0.0 {
+        Ok(())
+    } else {
+        Err(format!("feed-forward gain {gain} must be finite and >= 0"))
+    }
+}
+
 /// A position-loop gain of every axis (`axis.x.Kp`, `axis.C.Kd`, …), ≥ 0.
 pub const fn axis_gain(
     suffix: &'static str,

@@ -7,7 +7,7 @@
 
 use std::f64::consts::PI;
 
-use super::axis_variables::{REFERENCE_OUT, REFERENCE_VELOCITY_OUT};
+use super::axis_variables::{REFERENCE_ACCELERATION_OUT, REFERENCE_OUT, REFERENCE_VELOCITY_OUT};
 use super::line_arc_parameters;
 use super::path_parameter;
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
@@ -79,6 +79,7 @@ variable_table! {
     )
     .unit("s");
     VREF: Reals<2> = axis_block(&XY, &[REFERENCE_VELOCITY_OUT]);
+    AREF: Reals<2> = axis_block(&XY, &[REFERENCE_ACCELERATION_OUT]);
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -125,6 +126,8 @@ pub static INFO: ModelInfo = ModelInfo {
         // The feed along the start's tangent without a plan, at rest with one.
         (VREF.at(0).vr(), &DURATION_KNOWNS),
         (VREF.at(1).vr(), &DURATION_KNOWNS),
+        (AREF.at(0).vr(), &DURATION_KNOWNS),
+        (AREF.at(1).vr(), &DURATION_KNOWNS),
     ],
     create: |environment: &Environment| {
         Box::new(PathInterpolator2D {
@@ -168,6 +171,7 @@ const LAYOUT: StateLayout = StateLayout {
 
 /// The reference the parameters choose.
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
+#[allow(clippy::large_enum_variant)] // one per instance
 enum Reference {
     /// `accel` = 0: the paper's constant-feed interpolator.
     ConstantFeed(Interpolator),
@@ -261,7 +265,7 @@ fn path(values: &Values, environment: &Environment) -> Result<Path, String> {
 impl PathInterpolator2D {
     fn write_outputs(&self, values: &mut Values) {
         let Some(state) = &self.state else { return };
-        let (point, done, speed, duration, velocity) = match &state.reference {
+        let (point, done, speed, duration, velocity, acceleration) = match &state.reference {
             Reference::ConstantFeed(it) => {
                 let sample = it.current();
                 let speed = if sample.done { 0.0 } else { it.feed() };
@@ -271,6 +275,7 @@ impl PathInterpolator2D {
                     speed,
                     it.path().length() / it.feed(),
                     it.velocity(),
+                    it.acceleration(),
                 )
             }
             Reference::Planned(planned) => {
@@ -281,11 +286,13 @@ impl PathInterpolator2D {
                     sample.speed,
                     planned.duration(),
                     sample.direction * sample.speed,
+                    sample.acceleration,
                 )
             }
         };
         REF.set(values, &point);
         VREF.set(values, &velocity);
+        AREF.set(values, &acceleration);
         DONE.set(values, done);
         FEED_RATE.set(values, speed);
         DURATION.set(values, duration);

@@ -9,7 +9,7 @@
 
 use std::path::Path;
 
-use super::axis_variables::REFERENCE_OUT;
+use super::axis_variables::{REFERENCE_ACCELERATION_OUT, REFERENCE_OUT, REFERENCE_VELOCITY_OUT};
 use super::{joint_limits_parameters, kinematics_parameters};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
@@ -101,6 +101,8 @@ variable_table! {
         "Angle between the reference's tool axis and the programmed one",
     )
     .unit("rad");
+    VREF: Reals<5> = axis_block(&XYZAC, &[REFERENCE_VELOCITY_OUT]);
+    AREF: Reals<5> = axis_block(&XYZAC, &[REFERENCE_ACCELERATION_OUT]);
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -140,6 +142,17 @@ pub static INFO: ModelInfo = ModelInfo {
         (DURATION.vr(), &ALL_KNOWNS),
         (TIP_DEVIATION.vr(), &ALL_KNOWNS),
         (ORIENTATION_DEVIATION.vr(), &ALL_KNOWNS),
+        // The first sample's central differences: the second sample depends on everything.
+        (VREF.at(0).vr(), &ALL_KNOWNS),
+        (VREF.at(1).vr(), &ALL_KNOWNS),
+        (VREF.at(2).vr(), &ALL_KNOWNS),
+        (VREF.at(3).vr(), &ALL_KNOWNS),
+        (VREF.at(4).vr(), &ALL_KNOWNS),
+        (AREF.at(0).vr(), &ALL_KNOWNS),
+        (AREF.at(1).vr(), &ALL_KNOWNS),
+        (AREF.at(2).vr(), &ALL_KNOWNS),
+        (AREF.at(3).vr(), &ALL_KNOWNS),
+        (AREF.at(4).vr(), &ALL_KNOWNS),
     ],
     create: |environment: &Environment| {
         Box::new(PathInterpolator5X {
@@ -191,10 +204,11 @@ const ALL_KNOWNS: [usize; KNOWN_COUNT] = {
 /// Version 1: `Option<State>` as below, the path saved twice (with the interpolator's
 /// copy of its tip curve) and a built-in's poses in full. Version 2: the path once, a
 /// built-in by name (see `JointReference`'s saved form). Version 3: the reference is
-/// constant-feed or planned (a plan saved as its inputs and the place on it).
+/// constant-feed or planned (a plan saved as its inputs and the place on it). Version 4:
+/// the reference keeps the previous sample's joints (`vref.*`'s central difference).
 const LAYOUT: StateLayout = StateLayout {
     model: "PathInterpolator5X",
-    version: 3,
+    version: 4,
 };
 
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
@@ -360,6 +374,8 @@ impl PathInterpolator5X {
             REF.set(values, &out.joints);
             DONE.set(values, out.done);
             DURATION.set(values, state.reference.planned_duration().unwrap_or(0.0));
+            VREF.set(values, &state.reference.velocity());
+            AREF.set(values, &state.reference.acceleration());
             TIP_DEVIATION.set(values, out.tip_deviation);
             ORIENTATION_DEVIATION.set(values, out.orientation_deviation);
         }

@@ -289,6 +289,8 @@ pub enum SampleError {
     NonFiniteReference,
     /// A measured joint is NaN or infinite.
     NonFiniteActual,
+    /// A feed-forward velocity is NaN or infinite.
+    NonFiniteFeedForward,
 }
 
 impl std::fmt::Display for SampleError {
@@ -296,6 +298,7 @@ impl std::fmt::Display for SampleError {
         f.write_str(match self {
             SampleError::NonFiniteReference => "a reference joint is not finite",
             SampleError::NonFiniteActual => "a measured joint is not finite",
+            SampleError::NonFiniteFeedForward => "a feed-forward velocity is not finite",
         })
     }
 }
@@ -419,19 +422,37 @@ impl FiveAxisController {
         set_at: f64,
         actual: &Joints,
     ) -> Result<FiveAxisOutput, SampleError> {
+        self.sample_with(reference, set_at, actual, &Joints::zeros())
+    }
+
+    /// [`FiveAxisController::sample_held`] with a velocity feed-forward `feed_forward`
+    /// (mm/s, rad/s; the gain applied) added to the position loops' commands, the sum
+    /// within each joint's speed: the reference's velocity, which position loops alone
+    /// follow with a lag. The guard and the correction's room judge the sum.
+    pub fn sample_with(
+        &mut self,
+        reference: &Joints,
+        set_at: f64,
+        actual: &Joints,
+        feed_forward: &Joints,
+    ) -> Result<FiveAxisOutput, SampleError> {
         if !geometry::is_finite(reference) {
             return Err(SampleError::NonFiniteReference);
         }
         if !geometry::is_finite(actual) {
             return Err(SampleError::NonFiniteActual);
         }
+        if !geometry::is_finite(feed_forward) {
+            return Err(SampleError::NonFiniteFeedForward);
+        }
         let following_error = reference - actual;
         let axes = &mut self.axes;
+        let speed = &self.config.limits.velocity;
         let mut asked = Joints::zeros();
         let loops = Joints::from_fn(|i, _| {
             let (u, unclamped) = axes[i].update_unclamped(following_error[i], true);
-            asked[i] = unclamped;
-            u
+            asked[i] = unclamped + feed_forward[i];
+            (u + feed_forward[i]).clamp(-speed[i], speed[i])
         });
         let mut hold = Hold {
             beyond_limits: self.guard.beyond_limits(reference, set_at),

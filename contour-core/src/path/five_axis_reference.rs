@@ -12,8 +12,16 @@ use crate::limits::{JointLimits, PathLimits};
 
 /// A five-axis reference. The whole value is the state an FMU saves.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FiveAxisReference {
+    kind: Kind,
+    /// The joints one sample before the current one (the current ones at the start):
+    /// the velocity's central difference needs them.
+    previous: Joints,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[allow(clippy::large_enum_variant)] // one per instance
-pub enum FiveAxisReference {
+enum Kind {
     /// The tip at constant feed, the joints on the A ≥ 0 branch.
     ConstantFeed(JointReference),
     /// Planned within the limits.
@@ -59,20 +67,103 @@ impl FiveAxisReference {
                 limits,
                 ts,
             };
-            return Ok(FiveAxisReference::Planned(PlannedReference::new(
+            return Ok(Self::starting(Kind::Planned(PlannedReference::new(
                 inputs, name,
-            )?));
+            )?)));
         }
-        Ok(FiveAxisReference::ConstantFeed(match builtin {
+        Ok(Self::starting(Kind::ConstantFeed(match builtin {
             Some(name) => JointReference::builtin(&name, machine, limits.feed, ts)?,
             None => JointReference::new(path, machine, limits.feed, ts)?,
-        }))
+        })))
+    }
+
+    fn starting(kind: Kind) -> Self {
+        let previous = kind.joints();
+        FiveAxisReference { kind, previous }
     }
 
     /// The current sample.
     pub fn current(&mut self) -> ReferenceSample {
+        self.kind.current()
+    }
+
+    /// The reference's joint velocities at the current sample (mm/s, rad/s): the central
+    /// difference (q(k+1) − q(k−1))/(2·Ts), the derivative of the samples to O(Ts²) and
+    /// not a sample late as a backward difference would be; at the start q(−1) = q(0).
+    pub fn velocity(&self) -> Joints {
+        let (next, ts) = self.next();
+        (next - self.previous) / (2.0 * ts)
+    }
+
+    /// The reference's joint accelerations at the current sample (mm/s², rad/s²): the
+    /// central second difference (q(k+1) − 2·q(k) + q(k−1))/Ts².
+    pub fn acceleration(&self) -> Joints {
+        let (next, ts) = self.next();
+        (next - self.kind.joints() * 2.0 + self.previous) / (ts * ts)
+    }
+
+    /// The next sample's joints and the sample period.
+    fn next(&self) -> (Joints, f64) {
+        match &self.kind {
+            Kind::ConstantFeed(r) => (r.peek(), r.ts()),
+            Kind::Planned(r) => (r.peek(), r.inputs().ts),
+        }
+    }
+
+    /// Advances one period.
+    pub fn step(&mut self) -> Result<ReferenceSample, PathError> {
+        self.previous = self.kind.joints();
+        match &mut self.kind {
+            Kind::ConstantFeed(r) => {
+                r.step()?;
+            }
+            Kind::Planned(r) => {
+                r.step();
+            }
+        }
+        Ok(self.current())
+    }
+
+    /// The planned duration, s (`None` without a plan).
+    pub fn planned_duration(&self) -> Option<f64> {
+        match &self.kind {
+            Kind::ConstantFeed(_) => None,
+            Kind::Planned(r) => Some(r.plan().report().duration),
+        }
+    }
+
+    /// Checks a reference restored from bytes against the sample period `ts` (a plan
+    /// checked its place when it was restored).
+    pub fn check(&self, ts: f64) -> Result<(), String> {
+        if !crate::geometry::is_finite(&self.previous) {
+            return Err("the previous sample's joints are not finite".into());
+        }
+        match &self.kind {
+            Kind::ConstantFeed(r) => r.check(ts),
+            Kind::Planned(r) => {
+                let period = r.inputs().ts;
+                if period != ts {
+                    return Err(format!(
+                        "the plan's period {period} s differs from the sample clock's {ts} s"
+                    ));
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+impl Kind {
+    fn joints(&self) -> Joints {
         match self {
-            FiveAxisReference::ConstantFeed(r) => {
+            Kind::ConstantFeed(r) => r.joints(),
+            Kind::Planned(r) => r.joints(),
+        }
+    }
+
+    fn current(&mut self) -> ReferenceSample {
+        match self {
+            Kind::ConstantFeed(r) => {
                 let s = r.current();
                 ReferenceSample {
                     joints: s.joints,
@@ -82,7 +173,7 @@ impl FiveAxisReference {
                     orientation_deviation: 0.0,
                 }
             }
-            FiveAxisReference::Planned(r) => {
+            Kind::Planned(r) => {
                 let s = r.current();
                 ReferenceSample {
                     joints: s.joints,
@@ -91,44 +182,6 @@ impl FiveAxisReference {
                     tip_deviation: s.tip_deviation,
                     orientation_deviation: s.orientation_deviation,
                 }
-            }
-        }
-    }
-
-    /// Advances one period.
-    pub fn step(&mut self) -> Result<ReferenceSample, PathError> {
-        match self {
-            FiveAxisReference::ConstantFeed(r) => {
-                r.step()?;
-            }
-            FiveAxisReference::Planned(r) => {
-                r.step();
-            }
-        }
-        Ok(self.current())
-    }
-
-    /// The planned duration, s (`None` without a plan).
-    pub fn planned_duration(&self) -> Option<f64> {
-        match self {
-            FiveAxisReference::ConstantFeed(_) => None,
-            FiveAxisReference::Planned(r) => Some(r.plan().report().duration),
-        }
-    }
-
-    /// Checks a reference restored from bytes against the sample period `ts` (a plan
-    /// checked its place when it was restored).
-    pub fn check(&self, ts: f64) -> Result<(), String> {
-        match self {
-            FiveAxisReference::ConstantFeed(r) => r.check(ts),
-            FiveAxisReference::Planned(r) => {
-                let period = r.inputs().ts;
-                if period != ts {
-                    return Err(format!(
-                        "the plan's period {period} s differs from the sample clock's {ts} s"
-                    ));
-                }
-                Ok(())
             }
         }
     }

@@ -177,6 +177,14 @@ impl<const D: usize, C: Curve<D>> Interpolator<D, C> {
             _ => Vector::zeros(),
         }
     }
+    /// The reference's acceleration at the current sample, mm/s²: feed² times the
+    /// curve's curvature vector there (the feed is constant); zero at the end.
+    pub fn acceleration(&self) -> Vector<D> {
+        if self.done {
+            return Vector::zeros();
+        }
+        self.cur.frame().1 * (self.feed * self.feed)
+    }
     /// Number of steps taken since the start (the current point is at time samples·Ts).
     pub fn samples(&self) -> u64 {
         self.samples
@@ -197,9 +205,25 @@ impl<const D: usize, C: Curve<D>> Interpolator<D, C> {
             return self.current();
         }
         self.samples += 1;
+        (self.u, self.cur, self.done) = self.next_point();
+        self.current()
+    }
+
+    /// The parameter of the next sample and whether it is the end, the interpolator
+    /// unchanged.
+    pub fn peek(&self) -> (f64, bool) {
+        if self.done {
+            return (self.u, true);
+        }
+        let (u, _, done) = self.next_point();
+        (u, done)
+    }
+
+    /// Where the next sample lies: its parameter, curve point and whether it is the end.
+    fn next_point(&self) -> (f64, CurvePoint<D>, bool) {
         let l = self.feed * self.ts;
         if l == 0.0 {
-            return self.current();
+            return (self.u, self.cur, false);
         }
         let (_, u_end) = self.path.param_range();
         let (u0, p0) = (self.u, self.cur.p);
@@ -241,23 +265,16 @@ impl<const D: usize, C: Curve<D>> Interpolator<D, C> {
                 e = self.path.eval(u1);
             }
             if u1 < u_end {
-                self.u = u1;
-                self.cur = e;
-                return self.current();
+                return (u1, e, false);
             }
         } else if geometry::dist(&self.path.point(u_end), &p0) > (1.0 + CHORD_TOL) * l {
             // Predictor overshot the end although the end is still more than L away.
             u1 = u0 + self.bisect_step(l);
             if u1 < u_end {
-                self.u = u1;
-                self.cur = self.path.eval(u1);
-                return self.current();
+                return (u1, self.path.eval(u1), false);
             }
         }
-        self.u = u_end;
-        self.cur = self.path.eval(u_end);
-        self.done = true;
-        self.current()
+        (u_end, self.path.eval(u_end), true)
     }
 
     /// Parameter increment whose chord is `l`, by bracketing and bisection (bounded).

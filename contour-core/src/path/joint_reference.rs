@@ -184,6 +184,29 @@ impl JointReference {
         Ok(())
     }
 
+    /// The current sample's joints.
+    pub fn joints(&self) -> Joints {
+        self.joints
+    }
+
+    /// The joints of the next sample, the reference unchanged (the current ones where the
+    /// inverse kinematics refuse the next pose; `step` reports that).
+    pub fn peek(&self) -> Joints {
+        let (u, _) = match &self.tip {
+            TipInterpolator::Curve(i) => i.peek(),
+            TipInterpolator::Polyline(i) => i.peek(),
+        };
+        self.solve(u, self.joints[4]).unwrap_or(self.joints)
+    }
+
+    /// The sample period, s.
+    pub fn ts(&self) -> f64 {
+        match &self.tip {
+            TipInterpolator::Curve(i) => i.ts(),
+            TipInterpolator::Polyline(i) => i.ts(),
+        }
+    }
+
     /// Advances one period.
     pub fn step(&mut self) -> Result<JointSample, PathError> {
         let u = match &mut self.tip {

@@ -118,6 +118,20 @@ pub struct CurvePoint<const D: usize = 2> {
     pub d2: Vector<D>,
 }
 
+impl<const D: usize> CurvePoint<D> {
+    /// The unit tangent and the curvature vector d²C/ds² (toward the centre of curvature,
+    /// 1/radius long) by arc length s; zeros where the curve has no tangent.
+    pub fn frame(&self) -> (Vector<D>, Vector<D>) {
+        match crate::geometry::unit(&self.d1) {
+            Some(t) => {
+                let normal = self.d2 - t * self.d2.dot(&t);
+                (t, normal / self.d1.norm_squared())
+            }
+            None => (Vector::zeros(), Vector::zeros()),
+        }
+    }
+}
+
 impl<const D: usize> Default for CurvePoint<D> {
     fn default() -> Self {
         CurvePoint {

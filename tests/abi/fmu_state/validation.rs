@@ -328,13 +328,14 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
     let (_, interpolator_bytes) = interpolator.serialize(state);
     interpolator.free_state(&mut state);
 
-    // The models' current layout versions: ContourCCC2D 4 (the feed-forward gain; 3: the
+    // The models' current layout versions: ContourCCC2D 5 (the acceleration feed-forward;
+    // 4: the feed-forward gain; 3: the
     // program estimator keeps its last two feet; 2: the controller became N-axis),
     // XYServoPlant 3 (each axis gained its effects and the table behind the play; 2: the
     // lead became a transmission), PathInterpolator2D 2 (the
     // planned reference joined the constant-feed one).
     for (i, bytes, model, version) in [
-        (&controller, &controller_bytes, "ContourCCC2D", 4u16),
+        (&controller, &controller_bytes, "ContourCCC2D", 5u16),
         (&plant_instance, &plant_bytes, "XYServoPlant", 3),
         (&interpolator, &interpolator_bytes, "PathInterpolator2D", 2),
     ] {

@@ -73,20 +73,40 @@ impl<const D: usize> JerkFilter<D> {
         let (i, j) = self.at;
         for d in 0..D {
             let q = quantise(sample[d] - self.origin[d]);
-            self.first[d] += q - self.raw[i * D + d];
+            let (first, second) = self.sums_with(d, q);
             self.raw[i * D + d] = q;
-            self.second[d] += self.first[d] - self.sums[j * D + d];
-            self.sums[j * D + d] = self.first[d];
+            self.sums[j * D + d] = first;
+            (self.first[d], self.second[d]) = (first, second);
         }
         self.at = ((i + 1) % m1, (j + 1) % m2);
         self.output()
     }
 
+    /// The filtered sample [`Self::push`] would give for `sample`, the filter unchanged
+    /// (the reference's velocity looks one sample ahead).
+    pub fn peek(&self, sample: &Vector<D>) -> Vector<D> {
+        Vector::<D>::from_fn(|d, _| {
+            let (_, second) = self.sums_with(d, quantise(sample[d] - self.origin[d]));
+            self.value(d, second)
+        })
+    }
+
+    /// The two stages' sums of component `d` once its next raw sample is `q` quanta.
+    fn sums_with(&self, d: usize, q: i128) -> (i128, i128) {
+        let (i, j) = self.at;
+        let first = self.first[d] + q - self.raw[i * D + d];
+        (first, self.second[d] + first - self.sums[j * D + d])
+    }
+
+    /// Component `d` of the filtered sample whose second-stage sum is `second`.
+    fn value(&self, d: usize, second: i128) -> f64 {
+        let (m1, m2) = self.lengths();
+        self.origin[d] + second as f64 / ((m1 * m2) as f64 * SCALE)
+    }
+
     /// The current filtered sample.
     pub fn output(&self) -> Vector<D> {
-        let (m1, m2) = self.lengths();
-        let divisor = (m1 * m2) as f64 * SCALE;
-        Vector::<D>::from_fn(|d, _| self.origin[d] + self.second[d] as f64 / divisor)
+        Vector::<D>::from_fn(|d, _| self.value(d, self.second[d]))
     }
 
     /// Checks a filter restored from bytes: rings of whole samples, at least one each,
@@ -199,7 +219,18 @@ mod tests {
         raw.extend(std::iter::repeat_n(p, 100));
         let (m1, m2) = (20, 10);
         let mut filter = JerkFilter::new(m1, m2, &V1::new(3.0), &V1::new(p));
-        let out: Vec<f64> = raw.iter().map(|&r| filter.push(&V1::new(r))[0]).collect();
+        // Peeking gives what the push gives and changes nothing.
+        let out: Vec<f64> = raw
+            .iter()
+            .map(|&r| {
+                let before = filter.clone();
+                let ahead = filter.peek(&V1::new(r));
+                assert_eq!(filter, before);
+                let next = filter.push(&V1::new(r))[0];
+                assert_eq!(ahead[0], next);
+                next
+            })
+            .collect();
         let reference = convolved(&raw, 3.0, m1, m2);
         for (o, r) in out.iter().zip(&reference) {
             assert!((o - r).abs() < 1e-9, "{o} vs {r}");

@@ -228,11 +228,10 @@ impl NurbsPieces {
 }
 
 impl NurbsPieces {
-    /// The unit tangent at arc length `s` in cell `cell` (as [`NurbsPieces::point`] left
-    /// it); zero where the curve has none.
-    pub fn direction(&self, s: f64, cell: usize) -> Vector2 {
-        let d1 = self.nurbs.eval(self.cells[cell].parameter(s)).d1;
-        crate::geometry::unit(&d1).unwrap_or_else(Vector2::zeros)
+    /// The unit tangent and the curvature vector at arc length `s` in cell `cell` (as
+    /// [`NurbsPieces::point`] left it); zeros where the curve has no tangent.
+    pub fn frame(&self, s: f64, cell: usize) -> (Vector2, Vector2) {
+        self.nurbs.eval(self.cells[cell].parameter(s)).frame()
     }
 }
 

@@ -687,6 +687,16 @@ impl Plan {
         cursor.joints = self.joints_of(&filtered);
     }
 
+    /// The joints of the sample after `cursor`'s (its own at the end), `cursor` unchanged.
+    pub fn peek(&self, cursor: &Cursor) -> Joints {
+        if cursor.sample >= self.samples {
+            return cursor.joints;
+        }
+        let t = (cursor.sample + 1) as f64 * self.ts;
+        let (raw, _, _) = self.raw(t, cursor.interval);
+        self.joints_of(&cursor.filter.peek(&raw))
+    }
+
     /// The sample `cursor` stands at, its deviation from the programmed path measured
     /// from the programmed interval nearest the previous one (which `cursor` keeps).
     pub fn sample(&self, cursor: &mut Cursor) -> PlannedSample {
@@ -1025,6 +1035,16 @@ impl PlannedReference {
                 u0 + (u1 - u0) * (source / last).clamp(0.0, 1.0)
             }
         }
+    }
+
+    /// The current sample's joints.
+    pub fn joints(&self) -> Joints {
+        self.cursor.joints
+    }
+
+    /// The joints of the next sample, the reference unchanged.
+    pub fn peek(&self) -> Joints {
+        self.plan.peek(&self.cursor)
     }
 
     /// Advances one period.

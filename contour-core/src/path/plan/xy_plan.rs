@@ -67,6 +67,9 @@ pub struct XyPoint {
     pub speed: f64,
     /// The unit tangent of the planned geometry there (the direction of travel).
     pub direction: Vector2,
+    /// Acceleration, mm/s²: the path acceleration along the tangent plus speed² times
+    /// the curvature vector.
+    pub acceleration: Vector2,
 }
 
 /// The plan's position in its phases and along its geometry (a program's move, a
@@ -372,18 +375,18 @@ impl XyPlan {
     /// where it was: a run of increasing times costs O(1) a call, however long the path.
     pub fn at(&self, t: f64, cursor: &mut XyCursor) -> XyPoint {
         let length = self.length();
-        let (s, speed) = if t >= self.duration {
-            (length, 0.0)
+        let (s, speed, along) = if t >= self.duration {
+            (length, 0.0, 0.0)
         } else {
             let t = t.max(0.0);
             while cursor.phase + 1 < self.phases.len() && self.phases[cursor.phase + 1].time <= t {
                 cursor.phase += 1;
             }
             let phase = &self.phases[cursor.phase];
-            let (s, v, _) = phase.at(t - phase.time);
-            (s.clamp(0.0, length), v.max(0.0))
+            let (s, v, a) = phase.at(t - phase.time);
+            (s.clamp(0.0, length), v.max(0.0), a)
         };
-        let (point, direction) = match &self.geometry {
+        let (point, (direction, curvature)) = match &self.geometry {
             Geometry::Program(program) => {
                 let last = program.moves().len() - 1;
                 while cursor.piece < last && program.start_of(cursor.piece + 1) < s {
@@ -391,12 +394,12 @@ impl XyPlan {
                 }
                 (
                     program.point_in(cursor.piece, s),
-                    program.direction_in(cursor.piece, s),
+                    program.frame_in(cursor.piece, s),
                 )
             }
             Geometry::Nurbs(cut) => {
                 let point = cut.point(s, &mut cursor.piece);
-                (point, cut.direction(s, cursor.piece))
+                (point, cut.frame(s, cursor.piece))
             }
         };
         XyPoint {
@@ -404,6 +407,7 @@ impl XyPlan {
             s,
             speed,
             direction,
+            acceleration: direction * along + curvature * (speed * speed),
         }
     }
 }

@@ -182,10 +182,10 @@ impl Program {
     }
 
     /// The unit tangent of move `i` at path position `s` (clamped into the move), in the
-    /// direction of travel; zero where the move has none (a point).
-    pub fn direction_in(&self, i: usize, s: f64) -> Vector2 {
-        let d1 = self.moves[i].shape.curve().eval(self.local(i, s)).d1;
-        crate::geometry::unit(&d1).unwrap_or_else(Vector2::zeros)
+    /// direction of travel, and the curvature vector there; zeros where the move has no
+    /// tangent (a point).
+    pub fn frame_in(&self, i: usize, s: f64) -> (Vector2, Vector2) {
+        self.moves[i].shape.curve().eval(self.local(i, s)).frame()
     }
 
     /// The mirror image about the x axis, travelled in the mirrored sense.
