@@ -222,27 +222,19 @@ fn on_a_plant_that_saturates_below_its_limits_the_ccc_is_no_worse() {
 }
 
 #[test]
-fn with_coulomb_friction_the_guarantee_holds_but_on_the_dome() {
-    // Coulomb friction of a tenth of the drives' torque as well. The guarantee holds on
-    // every path but the dome with drives that just manage the limits, where the CCC's
-    // maxima exceed 1.1 times those without it (docs/design/five-axis.md §5.4b records
-    // it as open); this test says when that changes, so the docs can too.
-    for share in [1.0, 0.5] {
+fn with_coulomb_friction_the_ccc_is_no_worse() {
+    // Coulomb friction of a tenth of the drives' torque as well: the joints stick for a
+    // moment at each reversal. Before the laws stopped integrating while a joint lags
+    // (`CorrectionGuard::lagging`) the dome at share 1 had 1.5 times the orientation
+    // error of no CCC (2798 µrad against 1853): the integrals wound up against a stuck
+    // joint, too briefly for `disobeyed` to hold the correction.
+    for share in [1.0, 0.5, 0.25, 0.1] {
         for (name, path) in planned_paths() {
             let limited = Reference::CurrentLimited {
                 share,
                 friction: true,
             };
-            let runs = compare(name, &path, 50.0, limited);
-            if name == "dome" && share == 1.0 {
-                let [off, fixed, _] = &runs;
-                assert!(
-                    fixed.max_orientation > RATIO * off.max_orientation + ORIENTATION_FLOOR,
-                    "the dome with friction now keeps the guarantee: update §5.4b"
-                );
-            } else {
-                assert_no_worse(name, &runs);
-            }
+            assert_no_worse(name, &compare(name, &path, 50.0, limited));
         }
     }
 }

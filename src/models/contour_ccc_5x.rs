@@ -259,8 +259,8 @@ pub static INFO: ModelInfo = ModelInfo {
 
 /// Version 1: `Option<State>` as below. Version 2: the controller carries the machine's
 /// limits and the guard of its correction. Version 3: the guard also remembers the
-/// commands sent and the joints' shortfall of travel. Version 4: the velocity
-/// feed-forward gain.
+/// commands sent and the joints' shortfall of travel. Version 4: the feed-forward gains;
+/// the guard averages the joints' speeds and commands (`lagging`).
 const LAYOUT: StateLayout = StateLayout {
     model: "ContourCCC5X",
     version: 4,

@@ -77,6 +77,13 @@ pub struct CorrectionGuard {
     shortfall: Joints,
     /// Whether a joint fell short at the last measurement.
     short: bool,
+    /// Each joint's measured speed and its commands, averaged over [`OBEY_WINDOW`] as
+    /// the shortfall is forgotten.
+    mean_speed: Joints,
+    mean_sent: Joints,
+    /// Whether a joint fell short of its commands by more than its lag behind their
+    /// change explains, at the last measurement (see [`CorrectionGuard::lagging`]).
+    lagging: bool,
 }
 
 /// How long a shortfall of travel is remembered, s: long against a velocity loop's lag,
@@ -90,6 +97,10 @@ pub const OBEY_WINDOW: f64 = 0.02;
 /// over that time depends on the master (Gauss-Seidel: the last one sent; Jacobi: the one
 /// before), so it is known to within one such interval of command change.
 pub const OBEY_LAG: f64 = 0.01;
+
+/// The shortfall every joint is allowed before it counts as lagging, as a time at its
+/// speed limit, s: above the rounding of long runs, below a joint stuck for a few ms.
+pub const LAG_FLOOR: f64 = 1e-6;
 
 impl CorrectionGuard {
     /// A guard for a machine with `limits`, sampled every `ts` s, that returns to full
@@ -110,6 +121,9 @@ impl CorrectionGuard {
             sent_since: false,
             short: false,
             shortfall: Joints::zeros(),
+            mean_speed: Joints::zeros(),
+            mean_sent: Joints::zeros(),
+            lagging: false,
         }
     }
 
@@ -134,17 +148,34 @@ impl CorrectionGuard {
             let keep = (-dt / OBEY_WINDOW).exp();
             let l = &self.limits;
             self.short = false;
+            self.lagging = false;
             for i in 0..5 {
                 let short = self.sent[i] * dt - (actual[i] - self.from[i]);
                 self.shortfall[i] = keep * self.shortfall[i] + short;
+                let speed = (actual[i] - self.from[i]) / dt;
+                self.mean_speed[i] = keep * self.mean_speed[i] + (1.0 - keep) * speed;
+                self.mean_sent[i] = keep * self.mean_sent[i] + (1.0 - keep) * self.sent[i];
                 let allowed =
                     (OBEY_LAG + dt) * (l.acceleration[i] * OBEY_WINDOW).min(2.0 * l.velocity[i]);
                 self.short |= self.shortfall[i].abs() > allowed;
+                let change =
+                    (speed - self.mean_speed[i]).abs() + (self.sent[i] - self.mean_sent[i]).abs();
+                let explained = (OBEY_LAG + dt) * change + LAG_FLOOR * l.velocity[i];
+                self.lagging |= self.shortfall[i].abs() > explained;
             }
         }
         (self.from, self.measured_at, self.measured) = (*actual, at, true);
         self.sent_since = false;
         self.short
+    }
+
+    /// Whether a joint fell short of its commands, at the last measurement, by more than
+    /// a velocity loop of lag [`OBEY_LAG`] explains by the commands' own change (a loop
+    /// of lag τ falls short by τ·(v − v̄), v̄ the average over the window): a joint held
+    /// by friction for a moment, far below what `disobeyed` holds the correction for. The
+    /// laws do not integrate then (anti-windup against a joint that does not move).
+    pub fn lagging(&self) -> bool {
+        self.lagging
     }
 
     /// What the guard was built with: the limits, the sample period and the rise per
@@ -200,7 +231,13 @@ impl CorrectionGuard {
         if !(self.last.iter().all(|x| x.is_finite()) && self.since.is_finite()) {
             return Err("the guard's last reference or its time is not finite".into());
         }
-        let memories = [self.from, self.sent, self.shortfall];
+        let memories = [
+            self.from,
+            self.sent,
+            self.shortfall,
+            self.mean_speed,
+            self.mean_sent,
+        ];
         if !(memories.iter().all(|m| m.iter().all(|x| x.is_finite()))
             && self.measured_at.is_finite())
         {
@@ -292,12 +329,26 @@ mod tests {
     /// over each step the last command of the step before (a Jacobi master: the largest
     /// delay). Which samples were judged disobeyed.
     fn disobedience(peak: f64, lag: f64, cap: f64, every: usize) -> Vec<usize> {
+        judged(peak, 4000.0, lag, cap, every, 0.0).0
+    }
+
+    /// [`disobedience`] with commands changing at up to `accel` and an axis that sticks
+    /// while its command is below `stick` in size (friction it breaks away from): the
+    /// samples judged disobeyed, and lagging.
+    fn judged(
+        peak: f64,
+        accel: f64,
+        lag: f64,
+        cap: f64,
+        every: usize,
+        stick: f64,
+    ) -> (Vec<usize>, Vec<usize>) {
         let mut g = guard();
         let (ts, substeps) = (1e-3, 100);
         let (mut x, mut v) = (0.0, 0.0);
         let (mut measured, mut at) = (0.0, 0.0);
         let (mut held, mut last) = (0.0, 0.0);
-        let mut short = Vec::new();
+        let (mut short, mut lagging) = (Vec::new(), Vec::new());
         for k in 0..300 {
             if k % every == 0 {
                 (measured, at) = (x, k as f64 * ts);
@@ -306,17 +357,23 @@ mod tests {
             if g.disobeyed(&Joints::new(measured, 0.0, 0.0, 0.0, 0.0), at) {
                 short.push(k);
             }
+            if g.lagging() {
+                lagging.push(k);
+            }
             let t = k as f64 * ts;
-            last = peak * (4000.0 / peak * t).sin();
+            last = peak * (accel / peak * t).sin();
             g.commanded(&Joints::new(last, 0.0, 0.0, 0.0, 0.0));
             let u = if every == 1 { last } else { held };
             for _ in 0..substeps {
                 let h = ts / substeps as f64;
                 v = (v + h / lag * (u - v)).clamp(-cap, cap);
+                if u.abs() < stick {
+                    v = 0.0;
+                }
                 x += v * h;
             }
         }
-        short
+        (short, lagging)
     }
 
     #[test]
@@ -326,10 +383,8 @@ mod tests {
         // measurement).
         for lag in [0.0032, 0.01] {
             for every in [1, 3, 5, 10] {
-                assert!(
-                    disobedience(450.0, lag, f64::INFINITY, every).is_empty(),
-                    "{lag}"
-                );
+                let (short, lagging) = judged(450.0, 4000.0, lag, f64::INFINITY, every, 0.0);
+                assert!(short.is_empty() && lagging.is_empty(), "{lag}, {every}");
             }
         }
     }
@@ -346,6 +401,26 @@ mod tests {
             assert!((58..75).contains(&first), "{first}");
             // The command stays above the cap to the end (450·sin(2.67) = 203 mm/s).
             assert_eq!(short, (first..300).collect::<Vec<_>>());
+        }
+    }
+
+    #[test]
+    fn an_axis_stuck_for_a_moment_lags_but_is_not_held() {
+        // From rest, commands rising at 1000 mm/s² on an axis that sticks until they pass
+        // 30 mm/s (friction it breaks away from at t = asin(0.3)/10 = 30.5 ms). A loop
+        // of lag τ behind a ramp falls short by τ·(u − ū) (ū the commands' average over
+        // the window, small early on), so it explains τ·a·t, while the stuck axis falls
+        // short by a·t²/2: more than OBEY_LAG + Ts (11 ms) explains from t ≈ 22 ms or a
+        // little before (ū grows as t²/2W and takes from u − ū). Its
+        // 0.45 mm at breakaway is below `disobeyed`'s 1.1 mm, which would hold the
+        // correction only from t ≈ 47 ms.
+        for every in [1, 3] {
+            let (short, lagging) = judged(100.0, 1000.0, 0.0032, f64::INFINITY, every, 30.0);
+            assert!(short.is_empty(), "{short:?}");
+            let first = *lagging.first().expect("never lagging");
+            assert!((15..=23).contains(&first), "{first}");
+            // Not after the axis breaks away and follows.
+            assert!(lagging.iter().all(|&k| k < 40), "{lagging:?}");
         }
     }
 }

@@ -517,7 +517,7 @@ impl FiveAxisController {
         let mut clamped = false;
         if let (Some((e, tangent)), true) = (&foot, weight > 0.0) {
             // Integrals run at full weight only, and hold while a command saturates.
-            let integrate = weight == 1.0 && !self.clamped;
+            let integrate = weight == 1.0 && !self.clamped && !self.guard.lagging();
             let (v, tip_step) =
                 self.tip
                     .update_normal_to(geometry::norm(&e.tip), &e.tip, tangent, integrate);
