@@ -43,6 +43,41 @@ def co_simulation_description(path):
     return md
 
 
+def _unit(variable):
+    """A variable's declared unit, its own or its type's (None: none declared)."""
+    if variable.unit:
+        return variable.unit
+    declared = getattr(variable, "declaredType", None)
+    return getattr(declared, "unit", None) if declared is not None else None
+
+
+def check_connections(descriptions, connections):
+    """Refuses, with a ValueError naming both ends, a connection (source unit, output,
+    destination unit, input) to a unit or variable that does not exist, between
+    variables of different types, or between Real variables whose declared units differ
+    (an mm controller on an SI plant moves it a thousand times too far: take every FMU
+    from one build, target/fmu or target/fmu-si). `descriptions` maps unit names to
+    model descriptions."""
+    def variable(unit, name):
+        if unit not in descriptions:
+            raise ValueError(f"connection names unit {unit!r}, which the loop does not have "
+                             f"(units: {', '.join(descriptions)})")
+        found = next((v for v in descriptions[unit].modelVariables if v.name == name), None)
+        if found is None:
+            raise ValueError(f"{unit} has no variable {name!r}")
+        return found
+    for src, out, dst, inp in connections:
+        a, b = variable(src, out), variable(dst, inp)
+        if a.type != b.type:
+            raise ValueError(f"connection {src}.{out} -> {dst}.{inp}: a {a.type} onto a {b.type}")
+        ua, ub = _unit(a), _unit(b)
+        if ua and ub and ua != ub:
+            raise ValueError(
+                f"connection {src}.{out} -> {dst}.{inp}: units differ ({ua} onto {ub}); take "
+                f"every FMU from one build (target/fmu in mm, target/fmu-si in SI) or convert "
+                f"in the plant model")
+
+
 def set_value(slave, variable, value):
     """Sets one variable (an fmpy model variable) of an FMU2Slave, by its type."""
     vr = [variable.valueReference]
@@ -90,8 +125,10 @@ class Master:
         self.slaves, self.variables, self._dirs = {}, {}, []
 
     def __enter__(self):
+        descriptions = {u.name: co_simulation_description(u.path) for u in self.units}
+        check_connections(descriptions, list(self.connections) + list(self.initial))
         for u in self.units:
-            md = co_simulation_description(u.path)
+            md = descriptions[u.name]
             directory = extract(u.path)
             self._dirs.append(directory)
             slave = FMU2Slave(guid=md.guid, unzipDirectory=directory,

@@ -98,3 +98,30 @@ def test_the_si_five_axis_loop_is_the_mm_loop_in_metres(fmu_dir, si_dir):
     kept = [c for c in mm[0].dtype.names if ".evaluation." not in c]
     for a, b in zip(mm, si):
         compare_in_metres(a[kept], b[kept], described)
+
+
+def test_the_master_refuses_a_loop_that_mixes_the_builds_naming_the_connection(fmu_dir, si_dir):
+    """An mm controller on an SI plant would command metres as millimetres: the master
+    reads the declared units of both ends of every connection before it starts an FMU."""
+    from contour_fmu.master import Master, Unit
+    from contour_fmu.wiring import CLOSED_LOOP_CONNECTIONS, PATH_START
+
+    def loop(plant_dir, connections=CLOSED_LOOP_CONNECTIONS):
+        units = [Unit("controller", str(fmu_dir / "ContourCCC2D.fmu")),
+                 Unit("plant", str(plant_dir / "XYServoPlant.fmu")),
+                 Unit("interpolator", str(fmu_dir / "PathInterpolator2D.fmu"))]
+        return Master(units, connections, 1e-3, 0.01, initial=PATH_START)
+
+    with pytest.raises(ValueError, match=r"plant\.pos\.x -> controller\.pos\.x: units differ "
+                                         r"\(m onto mm\)"):
+        loop(si_dir).__enter__()
+    with pytest.raises(ValueError, match=r"interpolator has no variable 'ref\.z'"):
+        loop(fmu_dir, CLOSED_LOOP_CONNECTIONS + [("interpolator", "ref.z", "controller", "ref.x")]
+             ).__enter__()
+    with pytest.raises(ValueError, match=r"interpolator\.done -> controller\.ref\.x: a Boolean "
+                                         r"onto a Real"):
+        loop(fmu_dir, CLOSED_LOOP_CONNECTIONS + [("interpolator", "done", "controller", "ref.x")]
+             ).__enter__()
+    # One build throughout runs.
+    with loop(fmu_dir) as master:
+        assert master.get("plant", "pos.x") == master.get("interpolator", "ref.x")
