@@ -23,6 +23,8 @@ pub struct CircularOptions {
     pub to: f64,
     pub out: Option<PathBuf>,
     pub plot: Option<PathBuf>,
+    /// The figures as JSON (mm), for scripts.
+    pub figures: Option<PathBuf>,
     /// Deviation magnification of the plot (0: chosen from the data).
     pub magnification: f64,
 }
@@ -39,6 +41,7 @@ pub fn parse(args: &[String]) -> Result<CircularOptions, String> {
         to: f64::INFINITY,
         out: None,
         plot: None,
+        figures: None,
         magnification: 0.0,
     };
     let mut circle = None;
@@ -77,6 +80,7 @@ pub fn parse(args: &[String]) -> Result<CircularOptions, String> {
             "--to" => o.to = number("--to")?,
             "--out" => o.out = Some(PathBuf::from(value)),
             "--plot" => o.plot = Some(PathBuf::from(value)),
+            "--figures" => o.figures = Some(PathBuf::from(value)),
             "--magnification" => {
                 o.magnification = number("--magnification")?;
                 if o.magnification <= 0.0 {
@@ -169,6 +173,7 @@ pub fn run(o: CircularOptions) -> Result<(), Failure> {
         .map_err(Failure::Input)?;
     let points = |run: &Vec<(f64, Vector2)>| run.iter().map(|(_, p)| *p).collect::<Vec<_>>();
     let mut all = Vec::new();
+    let mut json = serde_json::json!({ "unit": "mm", "runs": [] });
     for (index, run) in runs.iter().enumerate() {
         let f = figures(&points(run), &o.nominal)
             .map_err(|e| Failure::Input(format!("{}: {e}", o.runs[index].display())))?;
@@ -181,6 +186,17 @@ pub fn run(o: CircularOptions) -> Result<(), Failure> {
             ),
             &f,
         );
+        json["runs"]
+            .as_array_mut()
+            .expect("an array")
+            .push(serde_json::json!({
+                "file": o.runs[index].display().to_string(),
+                "samples": run.len(),
+                "centre": [f.lsc.centre.x, f.lsc.centre.y],
+                "radius": f.lsc.radius,
+                "G": f.circular_deviation,
+                "F": [f.radial_deviation.0, f.radial_deviation.1],
+            }));
         all.extend(points(run));
     }
     if runs.len() == 2 {
@@ -191,6 +207,8 @@ pub fn run(o: CircularOptions) -> Result<(), Failure> {
             both.lsc.centre.x,
             both.lsc.centre.y
         );
+        json["Gb"] = serde_json::json!(both.circular_deviation);
+        json["Gb_centre"] = serde_json::json!([both.lsc.centre.x, both.lsc.centre.y]);
     }
     let mut staged = Vec::new();
     let mut written = Ok(());
@@ -209,6 +227,14 @@ pub fn run(o: CircularOptions) -> Result<(), Failure> {
             o.magnification,
         )
         .map_err(|e| format!("cannot plot {}: {e}", target.display()));
+    }
+    if let (Ok(()), Some(target)) = (&written, &o.figures) {
+        staged.push(Staged::new(target));
+        written = std::fs::write(
+            &staged[staged.len() - 1].temporary,
+            serde_json::to_string_pretty(&json).expect("plain numbers and strings"),
+        )
+        .map_err(|e| format!("cannot write {}: {e}", target.display()));
     }
     commit(&staged, written).map_err(Failure::Run)
 }

@@ -48,7 +48,7 @@ usage: contour-eval --path PART.cl|PART.apt|PART.json|tilted_helix|figure_eight
                     --measured RUN.csv --out ERR.csv [--tolerance P] [--plot ERR.png]
        contour-eval --circle CX,CY,R --measured RUN.csv [--reverse RUN.csv]
                     [--from T0] [--to T1] [--out DEV.csv] [--plot BALLBAR.png]
-                    [--magnification M]
+                    [--magnification M] [--figures FIG.json]
 
 The run's columns say what it is: time,X,Y,Z,A,C a five-axis run, time,X,Y and none of
 Z, A, C a run of the XY table. A --path of the other kind is refused.
@@ -93,7 +93,9 @@ deviation G(b).
   DEV.csv        run,time,angle,deviation per sample (rad from the nominal centre, mm
                  from the nominal circle, > 0 outside)
   BALLBAR.png    the polar plot of the deviation, magnified M times (default: the
-                 largest deviation drawn as a quarter of the radius)";
+                 largest deviation drawn as a quarter of the radius)
+  FIG.json       the figures for scripts, in mm: per run its file, samples, LSC centre
+                 and radius, G and F [min, max]; with --reverse, Gb and its LSC centre";
 
 /// The options that apply to five-axis runs only.
 const FIVE_AXIS_ONLY: [&str; 8] = [

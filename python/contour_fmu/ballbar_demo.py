@@ -12,7 +12,7 @@ usage: python -m contour_fmu.ballbar_demo [--fmu-dir DIR] [--out DIR]
 """
 
 import argparse
-import re
+import json
 import subprocess
 from pathlib import Path
 
@@ -57,15 +57,12 @@ def run(fmu_dir, file, controller):
     return before, before["time"][on[0]], before["time"][on[-1]]
 
 
-def figures(text):
-    """The figures contour-eval printed, in um (and the LSC radius in mm)."""
-    def numbers(label):
-        return [[float(x) for x in re.findall(r"-?\d+\.\d+", line)]
-                for line in text.splitlines() if label in line]
-    return dict(G=[n[0] for n in numbers("circular deviation G:")],
-                F=numbers("radial deviation F"),
-                radius=[n[2] for n in numbers("least-squares circle")],
-                Gb=numbers("G(b)")[0][0])
+def figures(file):
+    """The figures contour-eval wrote (--figures), in um (the LSC radius in mm)."""
+    written = json.loads(Path(file).read_text())
+    runs = written["runs"]
+    return dict(G=[r["G"] * 1e3 for r in runs], F=[[f * 1e3 for f in r["F"]] for r in runs],
+                radius=[r["radius"] for r in runs], Gb=written["Gb"] * 1e3)
 
 
 def ballbar_demo(fmu_dir, out, tool=None):
@@ -94,10 +91,12 @@ def ballbar_demo(fmu_dir, out, tool=None):
         done = subprocess.run(
             [str(tool), "--circle", f"0,0,{RADIUS}", "--measured", str(runs[0]), "--reverse",
              str(runs[1]), "--from", repr(float(start)), "--to", repr(float(end)), "--plot",
-             str(out / f"ballbar_{name}.png")], capture_output=True, text=True)
+             str(out / f"ballbar_{name}.png"), "--figures", str(out / f"ballbar_{name}.json")],
+            capture_output=True, text=True)
         if done.returncode != 0:
             raise RuntimeError(f"contour-eval failed on {runs}: {done.stderr}")
-        results[label] = {**figures(done.stdout), "window": (float(start), float(end))}
+        results[label] = {**figures(out / f"ballbar_{name}.json"),
+                          "window": (float(start), float(end))}
     return results
 
 

@@ -11,6 +11,7 @@ G = max |p - c| - min |p - c| about it, F about the nominal circle, and G(b) abo
 LSC of both traces together.
 """
 
+import json
 import math
 import os
 import re
@@ -75,11 +76,11 @@ def test_circular_test_matches_the_definitions(contour_eval, tmp_path):
         file = tmp_path / f"{name}.csv"
         np.savetxt(file, trace(direction, glitch), delimiter=",", header="time,X,Y", comments="")
         files.append(file)
-    out, plot = tmp_path / "dev.csv", tmp_path / "ballbar.png"
+    out, plot, written = tmp_path / "dev.csv", tmp_path / "ballbar.png", tmp_path / "fig.json"
     done = subprocess.run(
         [contour_eval, "--circle", ",".join(map(str, NOMINAL)), "--measured", str(files[0]),
          "--reverse", str(files[1]), "--from", "0.1", "--to", "2.1", "--out", str(out),
-         "--plot", str(plot)], capture_output=True, text=True)
+         "--plot", str(plot), "--figures", str(written)], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
     print(done.stdout)
@@ -108,6 +109,16 @@ def test_circular_test_matches_the_definitions(contour_eval, tmp_path):
     nominal = np.hypot(circles[0][:, 0] - NOMINAL[0], circles[0][:, 1] - NOMINAL[1]) - NOMINAL[2]
     assert np.allclose(rows[rows[:, 0] == 0][:, 3], nominal, atol=1e-12)
     assert plot.stat().st_size > 10_000
+    # The figures file for scripts: the same, unrounded (mm).
+    data = json.loads(written.read_text())
+    assert data["unit"] == "mm" and [r["samples"] for r in data["runs"]] == [2001, 2001]
+    for run, points in zip(data["runs"], circles):
+        want = figures(points)
+        assert np.allclose(run["centre"], want["centre"], atol=1e-9)
+        assert abs(run["radius"] - want["radius"]) < 1e-9
+        assert abs(run["G"] - want["G"]) < 1e-9
+        assert np.allclose(run["F"], want["F"], atol=1e-9)
+    assert abs(data["Gb"] - both["G"]) < 1e-9
 
 
 def test_a_run_that_is_no_circle_is_refused(contour_eval, tmp_path):
