@@ -177,12 +177,12 @@ impl Instance {
     /// Lets the model (re)compute its state and outputs from the current parameters.
     fn initialize_if_needed(&mut self) -> Outcome {
         if self.needs_initialize {
-            self.model
-                .initialize(&mut self.values, self.time)
-                .map_err(Failure::error)?;
+            if let Err(message) = self.model.initialize(&mut self.values, self.time) {
+                return Err(Failure::error(self.in_model_units(message)));
+            }
             self.needs_initialize = false;
             for warning in self.model.take_warnings() {
-                self.log_warning(&warning);
+                self.log_warning(&self.in_model_units(warning));
             }
         }
         Ok(())
@@ -444,6 +444,18 @@ impl Instance {
         Ok(())
     }
 
+    /// A model's message as the importer should read it: the model speaks mm, so in an
+    /// interface that scales lengths a message with numbers says which unit they are in
+    /// (the interface cannot tell a length from a count inside the text).
+    fn in_model_units(&self, message: String) -> String {
+        let scaled = self.scale.iter().any(|s| *s != 1.0);
+        if scaled && message.contains(|c: char| c.is_ascii_digit()) {
+            message + " (lengths in this message in mm, the model's own unit: 1 mm = 0.001 m)"
+        } else {
+            message
+        }
+    }
+
     /// `fmi2DoStep`. The checks of the arguments run first, as one condition; a step they
     /// refuse is explained by [`Instance::refuse_step`], out of line.
     #[inline]
@@ -469,11 +481,12 @@ impl Instance {
         if let Err(message) = self.model.do_step(&mut self.values, current, step) {
             self.mode = Mode::Error;
             return Err(Failure::error(format!(
-                "step at t = {current} failed: {message}"
+                "step at t = {current} failed: {}",
+                self.in_model_units(message)
             )));
         }
         for warning in self.model.take_warnings() {
-            self.log_warning(&warning);
+            self.log_warning(&self.in_model_units(warning));
         }
         // Never report success with a non-finite output: parameters at the edge of f64
         // (an inertia of 1e-300) can overflow a model, the importer would carry the NaN

@@ -125,3 +125,25 @@ def test_the_master_refuses_a_loop_that_mixes_the_builds_naming_the_connection(f
     # One build throughout runs.
     with loop(fmu_dir) as master:
         assert master.get("plant", "pos.x") == master.get("interpolator", "ref.x")
+
+
+def test_an_si_model_says_its_messages_numbers_are_in_mm(fmu_dir, si_dir):
+    """The model computes in mm and its messages quote its own values; the SI build says
+    so wherever a message has numbers, the mm build says nothing."""
+    from fmpy.fmi1 import FMICallException
+
+    from helpers.fmu_slave import Slave
+
+    note = "lengths in this message in mm, the model's own unit: 1 mm = 0.001 m"
+    # A radius of -2 mm: -0.002 in the SI build.
+    for directory, radius, noted in ((fmu_dir, -2.0, False), (si_dir, -0.002, True)):
+        s = Slave(str(directory / "PathInterpolator2D.fmu"))
+        try:
+            s.set(path="arc", **{"arc.r": radius})
+            with pytest.raises(FMICallException):
+                s.fmu.exitInitializationMode()
+            (error,) = s.log.errors()
+            assert "arc radius must be > 0, got -2" in error
+            assert (note in error) == noted, error
+        finally:
+            s.close()
