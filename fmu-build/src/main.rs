@@ -5,7 +5,8 @@
 //! `modelDescription/si/<Model>.xml`) files from the code; each `--resource` puts FILE
 //! into MODEL's `resources/` folder in both builds.
 //! PathInterpolator5X always carries the example CL part `examples/cl/blade.cl` as
-//! `resources/blade.cl`.
+//! `resources/blade.cl`. The loops' SSP files (`python/contour_fmu/loops/*.ssd`) go beside
+//! the mm FMUs, where their components' sources are.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -27,6 +28,8 @@ const USAGE: &str = "usage: fmu-build [--bless] [--out DIR] [--resource MODEL=FI
 
 /// The APT CL part every PathInterpolator5X carries in its resources.
 const EXAMPLE_CL_PART: &str = "examples/cl/blade.cl";
+/// The loops as SSP system structures, for engines that read SSP (libcosim).
+const LOOPS: &str = "python/contour_fmu/loops";
 
 fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -131,12 +134,34 @@ fn run(args: &[String]) -> Result<(), String> {
             println!("  resources/{} <- {}", r.name, r.source.display());
         }
     }
+    copy_loops(&root.join(LOOPS), &out)?;
     if !stale.is_empty() {
         eprintln!(
             "warning: the committed model descriptions differ from the code (the FMUs use the code's): {}\n\
              run `cargo run --release -p fmu-build -- --bless` and commit the result",
             stale.join(", ")
         );
+    }
+    Ok(())
+}
+
+/// Copies every `.ssd` of `from` into `to` (the mm FMUs' folder: their start values are
+/// in mm).
+fn copy_loops(from: &Path, to: &Path) -> Result<(), String> {
+    let entries = std::fs::read_dir(from).map_err(|e| format!("{}: {e}", from.display()))?;
+    for entry in entries {
+        let path = entry.map_err(|e| e.to_string())?.path();
+        if path.extension().is_some_and(|e| e == "ssd") {
+            let target = to.join(path.file_name().expect("a file"));
+            std::fs::copy(&path, &target).map_err(|e| {
+                format!(
+                    "cannot copy {} to {}: {e}",
+                    path.display(),
+                    target.display()
+                )
+            })?;
+            println!("wrote {}", target.display());
+        }
     }
     Ok(())
 }

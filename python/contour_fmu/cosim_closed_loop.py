@@ -3,11 +3,16 @@
 contour_fmu.loops) in libcosim (libcosimpy) and prints the trajectories as one line of JSON.
 
 Kept in its own process: libcosim can take the interpreter down on a broken FMU.
-usage: python -m contour_fmu.cosim_closed_loop [--loop two_axis|five_axis] FMU_DIR STEP_NS STEPS
-                                               [UNIT.VARIABLE=VALUE ...]
+usage: python -m contour_fmu.cosim_closed_loop [--loop two_axis|five_axis] [--ssp]
+                                               FMU_DIR STEP_NS STEPS [UNIT.VARIABLE=VALUE ...]
+
+By default the script adds the loop's FMUs and connections itself; with --ssp libcosim
+reads them from the loop's SSP file beside the FMUs (FMU_DIR/<loop>.ssd, which make fmus
+puts there), applying its first parameter set (the default path).
 
 libcosim connections are transferred at every step, so they cannot carry an output onto a
-fixed parameter once: the plant's pos0.* (the path's start) come as UNIT.VARIABLE=VALUE.
+fixed parameter once: the plant's pos0.* (the path's start) come as UNIT.VARIABLE=VALUE,
+or from the SSP file's parameter set of a built-in path.
 
 The printed object holds
 - "time_ns": the execution's final time (integer ns);
@@ -56,24 +61,38 @@ def set_initial(execution, index, variable, text):
 
 
 def main(argv, prog=None):
-    args = engine_arguments(argv, "A closed loop in libcosim", (int, "communication step (ns)"), prog)
+    ssp = "--ssp" in argv
+    args = engine_arguments([a for a in argv if a != "--ssp"], "A closed loop in libcosim",
+                            (int, "communication step (ns)"), prog)
     loop, steps = args.loop, args.steps
     log_output_level(CosimLogLevel.WARNING)
 
-    execution = CosimExecution.from_step_size(step_size=args.step)
     slaves, index, variables = {}, {}, {}
-    for name, file in loop.units.items():
-        slaves[name] = CosimLocalSlave(fmu_path=str(args.fmu_dir / file), instance_name=name)
-        index[name] = execution.add_local_slave(local_slave=slaves[name])
-        check(index[name] >= 0, f"adding {file}")
+    if ssp:
+        file = args.fmu_dir / f"{loop.structure.name}.ssd"
+        if not file.is_file():
+            raise SystemExit(f"libcosim: {file} is missing (make fmus puts it beside the FMUs)")
+        execution = CosimExecution.from_ssp_file(str(file), step_size=args.step)
+        for name in loop.units:
+            index[name] = execution.slave_index_from_instance_name(name)
+            check(index[name] is not None and index[name] >= 0, f"finding {name} in {file}")
+    else:
+        execution = CosimExecution.from_step_size(step_size=args.step)
+        for name, file in loop.units.items():
+            slaves[name] = CosimLocalSlave(fmu_path=str(args.fmu_dir / file), instance_name=name)
+            index[name] = execution.add_local_slave(local_slave=slaves[name])
+            check(index[name] >= 0, f"adding {file}")
+    for name in loop.units:
         variables[name] = {v.name.decode(): v for v in execution.slave_variables(index[name])}
 
     def ref(unit, name):
         return variables[unit][name].reference
 
-    for src, out, dst, inp in loop.connections:
-        check(execution.connect_real_variables(index[src], ref(src, out), index[dst], ref(dst, inp)),
-              f"connecting {src}.{out} -> {dst}.{inp}")
+    if not ssp:
+        for src, out, dst, inp in loop.connections:
+            check(execution.connect_real_variables(index[src], ref(src, out), index[dst],
+                                                   ref(dst, inp)),
+                  f"connecting {src}.{out} -> {dst}.{inp}")
     for unit, name, text in args.assignments:
         set_initial(execution, index[unit], variables[unit][name], text)
 

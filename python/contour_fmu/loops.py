@@ -1,26 +1,39 @@
 """The closed loops an outside engine (libcosim, ecos, fmpy's container) can run, by name:
-which FMUs, how they are wired, what is recorded. One table, so that each engine runs
-either loop from the same code. It imports nothing that loads fmpy or an engine, so an
-engine's own process can use it.
+which FMUs and how they are wired (the shipped SSP files, contour_fmu.wiring), what is
+recorded. One table, so that each engine runs either loop from the same code. It imports
+nothing that loads fmpy or an engine, so an engine's own process can use it.
 """
 
 import argparse
 from dataclasses import dataclass
 from pathlib import Path
 
-from .wiring import (CLOSED_LOOP_CONNECTIONS, FIVE_AXIS_CONNECTIONS, FIVE_AXIS_JOINTS,
-                     FIVE_AXIS_PATH_START, PATH_START)
+from .ssp import SystemStructure
+from .wiring import FIVE_AXIS, FIVE_AXIS_JOINTS, TWO_AXIS
 
 
 @dataclass(frozen=True)
 class Loop:
-    units: dict  # instance name -> FMU file: interpolator, controller, plant
-    connections: list  # (source unit, output, destination unit, input), at every step
-    path_start: list  # output at t_0 -> parameter: the plant starts where the path does
+    structure: SystemStructure  # the FMUs and their wiring, from the loop's SSP file
     recorded: list  # Real outputs every engine records; contour_fmu.master records them too
     more_outputs: list  # further outputs a container FMU exposes
     parameters: list  # start values a container FMU exposes (besides the path_start targets)
     container_name: str
+
+    @property
+    def units(self):
+        """Instance name -> FMU file: interpolator, controller, plant."""
+        return self.structure.units
+
+    @property
+    def connections(self):
+        """(source unit, output, destination unit, input), at every step."""
+        return self.structure.connections
+
+    @property
+    def path_start(self):
+        """Output at t_0 -> parameter: the plant starts where the path does."""
+        return self.structure.initial_copies
 
     @property
     def title(self):
@@ -35,10 +48,7 @@ def _per_joint(unit, prefix):
 
 LOOPS = {
     "two_axis": Loop(
-        units={"interpolator": "PathInterpolator2D.fmu", "controller": "ContourCCC2D.fmu",
-               "plant": "XYServoPlant.fmu"},
-        connections=CLOSED_LOOP_CONNECTIONS,
-        path_start=PATH_START,
+        structure=TWO_AXIS,
         recorded=[
             ("interpolator", "ref.x"), ("interpolator", "ref.y"),
             ("plant", "pos.x"), ("plant", "pos.y"),
@@ -55,10 +65,7 @@ LOOPS = {
         container_name="ContourLoop",
     ),
     "five_axis": Loop(
-        units={"interpolator": "PathInterpolator5X.fmu", "controller": "ContourCCC5X.fmu",
-               "plant": "FiveAxisPlant.fmu"},
-        connections=FIVE_AXIS_CONNECTIONS,
-        path_start=FIVE_AXIS_PATH_START,
+        structure=FIVE_AXIS,
         recorded=(_per_joint("interpolator", "ref") + _per_joint("plant", "pos")
                   + _per_joint("controller", "u")
                   + [("controller", name) for name in (

@@ -14,6 +14,7 @@ coupling schemes:
 
 import shutil
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 from fmpy import extract, read_model_description
@@ -21,8 +22,7 @@ from fmpy.fmi2 import FMU2Slave
 
 from .loops import LOOPS
 from .stepping import SCHEMES, Stepping
-from .wiring import (CLOSED_LOOP_CONNECTIONS, FIVE_AXIS_CONNECTIONS, FIVE_AXIS_PATH_START,
-                     PATH_START)
+from .wiring import FIVE_AXIS, TWO_AXIS
 
 
 def co_simulation_description(path):
@@ -197,15 +197,19 @@ def closed_loop(fmu_dir, path="circle", feed=None, stop=2.0, step=1e-3, controll
     interpolator = {"path": path, **(interpolator or {})}
     if feed is not None:
         interpolator["feed"] = feed
-    # Stepping order controller -> plant -> interpolator: with Gauss-Seidel the controller
-    # acts on ref(t_k) and pos(t_k), and the plant integrates the command u_k it produced.
-    units = [
-        Unit("controller", str(fmu_dir / "ContourCCC2D.fmu"), dict(controller or {})),
-        Unit("plant", str(fmu_dir / "XYServoPlant.fmu"), dict(plant or {})),
-        Unit("interpolator", str(fmu_dir / "PathInterpolator2D.fmu"), interpolator),
-    ]
-    with Master(units, CLOSED_LOOP_CONNECTIONS, step, stop, scheme, initial=PATH_START) as master:
+    units = loop_units(TWO_AXIS, fmu_dir, {"controller": controller, "plant": plant,
+                                           "interpolator": interpolator})
+    with Master(units, TWO_AXIS.connections, step, stop, scheme,
+                initial=TWO_AXIS.initial_copies) as master:
         return master.run(CLOSED_LOOP_RECORD)
+
+
+def loop_units(structure, fmu_dir, start_values):
+    """The Units of a shipped loop, its FMUs in `fmu_dir`, in its stepping order
+    (controller -> plant -> interpolator: with Gauss-Seidel the controller acts on ref(t_k)
+    and pos(t_k), and the plant integrates the command u_k it produced)."""
+    return [Unit(name, str(Path(fmu_dir) / structure.units[name]),
+                 dict(start_values.get(name) or {})) for name in structure.order]
 
 
 # Every output the engines record for the five-axis loop (contour_fmu.loops).
@@ -219,11 +223,8 @@ def five_axis_closed_loop(fmu_dir, path="tilted_helix", feed=None, stop=1.0, ste
     interpolator = {"path": path, **(interpolator or {})}
     if feed is not None:
         interpolator["feed"] = feed
-    units = [
-        Unit("controller", str(fmu_dir / "ContourCCC5X.fmu"), dict(controller or {})),
-        Unit("plant", str(fmu_dir / "FiveAxisPlant.fmu"), dict(plant or {})),
-        Unit("interpolator", str(fmu_dir / "PathInterpolator5X.fmu"), interpolator),
-    ]
-    with Master(units, FIVE_AXIS_CONNECTIONS, step, stop, scheme,
-                initial=FIVE_AXIS_PATH_START) as master:
+    units = loop_units(FIVE_AXIS, fmu_dir, {"controller": controller, "plant": plant,
+                                            "interpolator": interpolator})
+    with Master(units, FIVE_AXIS.connections, step, stop, scheme,
+                initial=FIVE_AXIS.initial_copies) as master:
         return master.run(FIVE_AXIS_RECORD)

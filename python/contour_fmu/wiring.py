@@ -1,43 +1,26 @@
-"""How the paper's closed loop is wired, shared by every master (fmpy, libcosim,
-container): interpolator -> controller <- plant. Kept free of imports so a process can
-use it without loading fmpy."""
+"""How the loops are wired, shared by every master (fmpy, libcosim, container, the
+campaigns): interpolator -> controller <- plant, as the shipped SSP files describe them
+(contour_fmu/loops/*.ssd, read by contour_fmu.ssp). Standard library only, so a process
+can use it without loading fmpy."""
 
-CLOSED_LOOP_CONNECTIONS = [
-    ("interpolator", "ref.x", "controller", "ref.x"),
-    ("interpolator", "ref.y", "controller", "ref.y"),
-    # The reference's velocity and acceleration, for the controller's feed-forward
-    # (feedForward, accelerationFeedForward > 0).
-    ("interpolator", "vref.x", "controller", "vref.x"),
-    ("interpolator", "vref.y", "controller", "vref.y"),
-    ("interpolator", "aref.x", "controller", "aref.x"),
-    ("interpolator", "aref.y", "controller", "aref.y"),
-    ("plant", "pos.x", "controller", "pos.x"),
-    ("plant", "pos.y", "controller", "pos.y"),
-    ("controller", "u.x", "plant", "u.x"),
-    ("controller", "u.y", "plant", "u.y"),
-]
+from .ssp import shipped
 
-# The plant starts where the path does.
-PATH_START = [
-    ("interpolator", "ref.x", "plant", "pos0.x"),
-    ("interpolator", "ref.y", "plant", "pos0.y"),
-]
+TWO_AXIS = shipped("two_axis")
+FIVE_AXIS = shipped("five_axis")
+
+# Every step: the reference (with its velocity and acceleration, for the controller's
+# feed-forward), the measured position, the command.
+CLOSED_LOOP_CONNECTIONS = TWO_AXIS.connections
+# Once in initialization mode: the plant starts where the path does.
+PATH_START = TWO_AXIS.initial_copies
 
 FIVE_AXIS_JOINTS = ("X", "Y", "Z", "A", "C")
 
 # The five-axis loop: PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant.
-FIVE_AXIS_CONNECTIONS = (
-    [("interpolator", f"ref.{j}", "controller", f"ref.{j}") for j in FIVE_AXIS_JOINTS]
-    # The reference's joint velocities and accelerations, for the feed-forward
-    # (feedForward, accelerationFeedForward > 0).
-    + [("interpolator", f"vref.{j}", "controller", f"vref.{j}") for j in FIVE_AXIS_JOINTS]
-    + [("interpolator", f"aref.{j}", "controller", f"aref.{j}") for j in FIVE_AXIS_JOINTS]
-    + [("plant", f"pos.{j}", "controller", f"pos.{j}") for j in FIVE_AXIS_JOINTS]
-    + [("controller", f"u.{j}", "plant", f"u.{j}") for j in FIVE_AXIS_JOINTS]
-)
-
+FIVE_AXIS_CONNECTIONS = FIVE_AXIS.connections
 # The plant starts at the path's start joints.
-FIVE_AXIS_PATH_START = [("interpolator", f"ref.{j}", "plant", f"pos0.{j}") for j in FIVE_AXIS_JOINTS]
+FIVE_AXIS_PATH_START = FIVE_AXIS.initial_copies
+
 
 # NC -> drive -> the user's mechanics, for each of X and Y: the interpolator and the
 # controller, one ServoDrive per axis ("drive_x", "drive_y") and one mechanical axis FMU

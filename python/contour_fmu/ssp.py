@@ -1,0 +1,103 @@
+"""The loops as SSP 1.0 system structure descriptions (.ssd): which FMUs, how they are
+wired, the start values of each built-in path, and what SSP itself has no word for (the
+order a Gauss-Seidel master steps the units in, and outputs copied onto parameters once in
+initialization mode), in an annotation of ours. Standard library only: any process can
+read a loop without loading fmpy or an engine.
+"""
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
+SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
+SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+LOOP = "urn:contour-fmu:ssp:loop"
+LOOP_ANNOTATION = "com.contour-fmu.loop"
+# The folder of the loops shipped with the package.
+SHIPPED = Path(__file__).resolve().parent / "loops"
+TYPES = {"Real": float, "Integer": int, "Boolean": lambda text: text == "true", "String": str}
+
+
+@dataclass(frozen=True)
+class SystemStructure:
+    name: str
+    file: Path
+    units: dict  # component name -> FMU file (relative to the .ssd), in the file's order
+    order: list  # the component names in the order a Gauss-Seidel master steps them
+    connections: list  # (source unit, output, destination unit, input), at every step
+    initial_copies: list  # the same, copied once in initialization mode
+    parameter_sets: dict  # set name -> {unit: {variable: value}}, in the file's order
+
+    def start_values(self, parameter_set):
+        """{unit: {variable: value}} of `parameter_set` (an unknown name is refused)."""
+        if parameter_set not in self.parameter_sets:
+            raise ValueError(f"{self.file}: no parameter set {parameter_set!r} (it has "
+                             f"{', '.join(self.parameter_sets) or 'none'})")
+        return self.parameter_sets[parameter_set]
+
+
+def _ends(element):
+    return (element.get("startElement"), element.get("startConnector"),
+            element.get("endElement"), element.get("endConnector"))
+
+
+def read(file):
+    """The system structure in `file`; a ValueError naming the file says what is wrong."""
+    file = Path(file)
+    try:
+        root = ET.parse(file).getroot()
+    except (OSError, ET.ParseError) as e:
+        raise ValueError(f"{file}: not a readable system structure description: {e}") from None
+    if root.tag != f"{{{SSD}}}SystemStructureDescription" or root.get("version") != "1.0":
+        raise ValueError(f"{file}: not an SSP 1.0 SystemStructureDescription")
+    system = root.find(f"{{{SSD}}}System")
+    if system is None:
+        raise ValueError(f"{file}: no <ssd:System>")
+    units, connectors, sets = {}, {}, {}
+    for component in system.iterfind(f"{{{SSD}}}Elements/{{{SSD}}}Component"):
+        name, source = component.get("name"), component.get("source")
+        if not name or not source:
+            raise ValueError(f"{file}: a component without a name or a source")
+        units[name] = source
+        connectors[name] = {c.get("name"): c for c in
+                            component.iterfind(f"{{{SSD}}}Connectors/{{{SSD}}}Connector")}
+        for values in component.iterfind(f"{{{SSD}}}ParameterBindings/{{{SSD}}}ParameterBinding/"
+                                         f"{{{SSD}}}ParameterValues/{{{SSV}}}ParameterSet"):
+            assigned = sets.setdefault(values.get("name"), {}).setdefault(name, {})
+            for parameter in values.iterfind(f"{{{SSV}}}Parameters/{{{SSV}}}Parameter"):
+                (typed,) = list(parameter)
+                kind = typed.tag.rsplit("}", 1)[1]
+                if kind not in TYPES:
+                    raise ValueError(f"{file}: {name}.{parameter.get('name')}: type {kind} is "
+                                     f"not one of {', '.join(TYPES)}")
+                assigned[parameter.get("name")] = TYPES[kind](typed.get("value"))
+
+    def checked(ends, what):
+        for unit, connector in (ends[:2], ends[2:]):
+            if unit not in units:
+                raise ValueError(f"{file}: {what} names component {unit!r}, which is not one "
+                                 f"of {', '.join(units)}")
+            if connector not in connectors[unit]:
+                raise ValueError(f"{file}: {what} names {unit}.{connector}, which is not "
+                                 f"among {unit}'s connectors")
+        return ends
+
+    connections = [checked(_ends(c), "a connection")
+                   for c in system.iterfind(f"{{{SSD}}}Connections/{{{SSD}}}Connection")]
+    loop = None
+    for annotation in system.iterfind(f"{{{SSD}}}Annotations/{{{SSC}}}Annotation"):
+        if annotation.get("type") == LOOP_ANNOTATION:
+            loop = annotation.find(f"{{{LOOP}}}Loop")
+    order = loop.get("order", "").split() if loop is not None else list(units)
+    if sorted(order) != sorted(units):
+        raise ValueError(f"{file}: the step order {order} does not list each component once")
+    copies = ([checked(_ends(c), "an initial copy") for c in loop.iterfind(f"{{{LOOP}}}InitialCopy")]
+              if loop is not None else [])
+    return SystemStructure(name=root.get("name"), file=file, units=units, order=order,
+                           connections=connections, initial_copies=copies, parameter_sets=sets)
+
+
+def shipped(name):
+    """The loop `name` (two_axis, five_axis) shipped with the package."""
+    return read(SHIPPED / f"{name}.ssd")
