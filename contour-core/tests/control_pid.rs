@@ -84,6 +84,25 @@ fn anti_windup_freezes_integral_in_saturation() {
 }
 
 #[test]
+fn anti_windup_judges_the_output_with_its_feed_forward() {
+    // Kp = 1, Ki = 10, Ts = 0.1, |u| ≤ 2, unit error and a feed-forward of 1.5 the limit
+    // also bounds: k=1: candidate I = 0.1 gives 1 + 1 + 1.5 = 3.5 > 2 with a positive
+    // push → frozen at 0, u = 2 (the sum clamped), 3.5 asked.
+    let mut pid = Pid::new(PidGains::new(1.0, 10.0, 0.0), 0.1, Some(2.0));
+    for _ in 0..100 {
+        assert_eq!(pid.update_unclamped(1.0, true, 1.5), (2.0, 2.5));
+    }
+    assert_eq!(pid.integral(), 0.0);
+    // Without the offset in the test the integral wound up under the clamped sum.
+    let mut wound = Pid::new(PidGains::new(1.0, 10.0, 0.0), 0.1, Some(2.0));
+    for _ in 0..100 {
+        let u = wound.update(1.0);
+        assert!((u + 1.5).min(2.0) == 2.0);
+    }
+    assert!(close(wound.integral(), 0.1));
+}
+
+#[test]
 fn anti_windup_negative_side_and_clamped_output() {
     // Kp = 4, Ki = 1, Ts = 0.5, |u| ≤ 3, error −1:
     // k=1: candidate I = −0.5 → −4.5 < −3 with a negative push → frozen at 0, u = −3.

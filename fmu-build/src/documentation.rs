@@ -116,7 +116,7 @@ print(result.dtype.names)</pre>
         id = model.identifier,
         description = escape(&interface.description()),
         units = match interface.units {
-            UnitSystem::Si if !interface.converts() => "SI build: this model has no lengths, so its units (N·m, rad, rad/s, s) are those of the mm build; it exists so that an SI loop takes every FMU from one folder.",
+            UnitSystem::Si if !interface.converts() => "SI build: this model has no lengths, so its units are those of the mm build, SI already; it exists so that an SI loop takes every FMU from one folder.",
             UnitSystem::Millimetre => "Lengths in mm (mm/s, mm/s², mm/s³); the SI build of this model takes and gives metres.",
             UnitSystem::Si => "SI build: lengths in m (m/s, m/s², m/s³), angles in rad, time in s. It computes as the mm build does (lengths in mm inside) and converts at the interface, so gains, fuzzy factors and tuned files carry over unchanged; path files (NURBS JSON, G-code) keep their own units (mm, or G20 inches). Error and warning messages quote the model's values in mm and say so.",
         },

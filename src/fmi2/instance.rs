@@ -66,6 +66,8 @@ pub struct Instance {
     variables: &'static [Variable],
     /// Interface value = model value × scale, by value reference.
     scale: &'static [f64],
+    /// Whether the interface scales any value (an SI build with lengths).
+    converts: bool,
     guid: String,
     environment: Environment,
     model: Box<dyn Model>,
@@ -124,6 +126,7 @@ impl Instance {
                 .collect(),
             variables: &interface.variables,
             scale: &interface.scale,
+            converts: interface.converts(),
             guid: interface.guid.clone(),
             model: (info.create)(&environment),
             environment,
@@ -448,8 +451,7 @@ impl Instance {
     /// interface that scales lengths a message with numbers says which unit they are in
     /// (the interface cannot tell a length from a count inside the text).
     fn in_model_units(&self, message: String) -> String {
-        let scaled = self.scale.iter().any(|s| *s != 1.0);
-        if scaled && message.contains(|c: char| c.is_ascii_digit()) {
+        if self.converts && message.contains(|c: char| c.is_ascii_digit()) {
             message + " (lengths in this message in mm, the model's own unit: 1 mm = 0.001 m)"
         } else {
             message

@@ -237,6 +237,12 @@ variable_table! {
     FEED_FORWARD: Real = controller_parameters::FEED_FORWARD;
     AREF: Reals<5> = axis_block(&XYZAC, &[REFERENCE_ACCELERATION_IN]);
     ACCELERATION_FEED_FORWARD: Real = controller_parameters::ACCELERATION_FEED_FORWARD;
+    LAGGING: Bool = Variable::discrete_output(
+        "ccc.lagging",
+        Start::Boolean(false),
+        "A joint falls short of its commands by more than its velocity loop explains (held \
+         by friction, stuck): the contour laws do not integrate this sample",
+    );
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -279,8 +285,14 @@ struct State {
 impl SavedState for State {
     fn validate(&self, time: f64) -> Result<(), String> {
         self.clock.validate_at(time)?;
-        controller_parameters::check_feed_forward(self.feed_forward)?;
-        controller_parameters::check_feed_forward(self.acceleration_feed_forward)?;
+        controller_parameters::check_feed_forward(
+            &controller_parameters::FEED_FORWARD,
+            self.feed_forward,
+        )?;
+        controller_parameters::check_feed_forward(
+            &controller_parameters::ACCELERATION_FEED_FORWARD,
+            self.acceleration_feed_forward,
+        )?;
         let controller = &self.controller;
         let config = controller.config();
         config
@@ -431,6 +443,7 @@ impl ContourCCC5X {
         ] {
             output.set(values, 0.0);
         }
+        LAGGING.set(values, false);
     }
 }
 
@@ -461,7 +474,7 @@ impl Model for ContourCCC5X {
             // The inputs were set at this communication point and are held over it.
             let out = state
                 .controller
-                .sample_with(&reference, time, &actual, &feed_forward)
+                .sample_with_feed_forward(&reference, time, &actual, &feed_forward)
                 .map_err(|e| format!("sample at t = {time}: {e}"))?;
             U.set(values, &out.u);
             ERR.set(values, &out.following_error);
@@ -470,6 +483,7 @@ impl Model for ContourCCC5X {
             });
             TIP_ERROR.set(values, tip);
             WEIGHT.set(values, out.weight);
+            LAGGING.set(values, out.lagging);
             ORIENTATION_ERROR.set(values, orientation);
             if let Some(e) = out.evaluation {
                 EVAL_TIP.set(values, e.tip);

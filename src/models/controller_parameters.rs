@@ -31,12 +31,16 @@ pub const ACCELERATION_FEED_FORWARD: Variable = nonnegative(
 )
 .unit("s");
 
-/// Checks a restored feed-forward gain as `feedForward`'s own check would.
-pub fn check_feed_forward(gain: f64) -> Result<(), String> {
-    if gain.is_finite() && gain >= 0.0 {
+/// Checks a restored feed-forward parameter (`feedForward`, `accelerationFeedForward`)
+/// as the parameter's own check would.
+pub fn check_feed_forward(parameter: &Variable, value: f64) -> Result<(), String> {
+    if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {
-        Err(format!("feed-forward gain {gain} must be finite and >= 0"))
+        Err(format!(
+            "{} = {value} must be finite and >= 0",
+            parameter.name
+        ))
     }
 }
 

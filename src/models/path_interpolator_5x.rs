@@ -374,8 +374,9 @@ impl PathInterpolator5X {
             REF.set(values, &out.joints);
             DONE.set(values, out.done);
             DURATION.set(values, state.reference.planned_duration().unwrap_or(0.0));
-            VREF.set(values, &state.reference.velocity());
-            AREF.set(values, &state.reference.acceleration());
+            let (velocity, acceleration) = state.reference.derivatives();
+            VREF.set(values, &velocity);
+            AREF.set(values, &acceleration);
             TIP_DEVIATION.set(values, out.tip_deviation);
             ORIENTATION_DEVIATION.set(values, out.orientation_deviation);
         }

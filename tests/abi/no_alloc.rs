@@ -354,6 +354,41 @@ fn a_planned_xy_reference_samples_without_allocating() {
 }
 
 #[test]
+fn a_five_axis_reference_and_its_derivatives_sample_without_allocating() {
+    use contour_core::kinematics::TableTiltingAc;
+    use contour_core::limits::{JointLimits, PathLimits};
+    use contour_core::path::{FiveAxisReference, ToolPath};
+    // At constant feed (the interpolator's look-ahead and the inverse kinematics) and
+    // planned (the jerk filter's look-ahead), to the end of the path.
+    for accel in [0.0, 2000.0] {
+        let limits = PathLimits {
+            accel,
+            ..PathLimits::at_feed(50.0)
+        };
+        let mut reference = FiveAxisReference::new(
+            ToolPath::builtin("tilted_helix").unwrap(),
+            Some("tilted_helix".into()),
+            TableTiltingAc::ORIGIN,
+            JointLimits::DEFAULT,
+            limits,
+            1e-3,
+            &|i| format!("pose {i}"),
+        )
+        .unwrap();
+        let mut acc = 0.0;
+        let count = allocations_during(|| {
+            while !reference.current().done {
+                let sample = reference.step().unwrap();
+                let (v, a) = reference.derivatives();
+                acc += black_box(sample.joints[0] + v[0] + a[0]);
+            }
+        });
+        assert_eq!(count, 0, "accel {accel}: a five-axis sample allocated");
+        assert!(acc.is_finite());
+    }
+}
+
+#[test]
 fn closed_loop_samples_do_not_allocate() {
     for name in ["circle", "trident"] {
         let sim = Simulator::new(SimConfig::builtin(name).unwrap()).unwrap();

@@ -50,15 +50,29 @@ def interpolate(fmu_dir, steps, **parameters):
         s.close()
 
 
-def test_at_constant_feed_vref_moves_the_tip_at_the_feed(fmu_dir):
-    q, v, _ = interpolate(fmu_dir, 900, path="tilted_helix", accel=0.0, feed=50.0)
-    h = 1e-6
-    tip_velocity = (forward(q + h * v)[0] - forward(q - h * v)[0]) / (2 * h)
-    speed = np.linalg.norm(tip_velocity, axis=1)[1:]
-    print(f"tip speed from vref: {speed.min():.6f} .. {speed.max():.6f} mm/s")
-    # The central difference of samples 2.5 um apart on a helix: off by Ts^2/6 of the
-    # third derivative, well inside 1e-4 of the feed.
+def test_at_constant_feed_vref_and_aref_move_the_tip_along_the_helix_at_the_feed(fmu_dir):
+    """Through numpy's forward kinematics: the tip moved along vref travels at the feed,
+    and along the joints' second-order path it accelerates by feed^2 times the helix's
+    curvature (radius 20 mm, 5 mm a turn: 20/(20^2 + (5/2pi)^2) per mm), across the
+    path, from the first sample on (no start-up at half the feed, no spike)."""
+    q, v, a = interpolate(fmu_dir, 900, path="tilted_helix", accel=0.0, feed=50.0)
+    h = 1e-4
+    tips = [forward(q + s * h * v + (s * h) ** 2 / 2 * a)[0] for s in (-1, 0, 1)]
+    tip_velocity = (tips[2] - tips[0]) / (2 * h)
+    tip_acceleration = (tips[2] - 2 * tips[1] + tips[0]) / h**2
+    speed = np.linalg.norm(tip_velocity, axis=1)
+    along = np.einsum("ij,ij->i", tip_acceleration, tip_velocity) / speed
+    across = np.linalg.norm(tip_acceleration, axis=1)
+    curvature = 20.0 / (20.0**2 + (5.0 / (2 * np.pi)) ** 2)
+    print(f"tip speed {speed.min():.6f} .. {speed.max():.6f} mm/s, acceleration "
+          f"{across.min():.3f} .. {across.max():.3f} mm/s2 (helix {50**2 * curvature:.3f}), "
+          f"along the path at most {np.abs(along).max():.3g}")
+    # The central differences of samples 50 um apart on a helix: off by Ts^2/6 of the
+    # next derivative, well inside 1e-4 of the feed and 1e-2 of the acceleration; the
+    # first sample's second-order forward differences by Ts^2/3.
     assert np.all(np.abs(speed - 50.0) < 5e-3)
+    assert np.all(np.abs(across - 50.0**2 * curvature) < 1e-2 * 50.0**2 * curvature)
+    assert np.all(np.abs(along) < 1e-2 * 50.0**2 * curvature)
 
 
 def test_on_a_planned_cam_path_vref_and_aref_are_the_central_differences_of_the_samples(

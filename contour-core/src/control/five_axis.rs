@@ -272,6 +272,9 @@ pub struct FiveAxisOutput {
     pub weight: f64,
     /// Why the correction stands aside, if it does.
     pub hold: Hold,
+    /// Whether a joint lags its commands beyond what its velocity loop explains, so the
+    /// laws did not integrate ([`CorrectionGuard::lagging`]).
+    pub lagging: bool,
     /// The tip law's step.
     pub tip_step: CccStep,
     /// The orientation law's step.
@@ -289,7 +292,7 @@ pub enum SampleError {
     NonFiniteReference,
     /// A measured joint is NaN or infinite.
     NonFiniteActual,
-    /// A feed-forward velocity is NaN or infinite.
+    /// A feed-forward command is NaN or infinite.
     NonFiniteFeedForward,
 }
 
@@ -298,7 +301,7 @@ impl std::fmt::Display for SampleError {
         f.write_str(match self {
             SampleError::NonFiniteReference => "a reference joint is not finite",
             SampleError::NonFiniteActual => "a measured joint is not finite",
-            SampleError::NonFiniteFeedForward => "a feed-forward velocity is not finite",
+            SampleError::NonFiniteFeedForward => "a feed-forward command is not finite",
         })
     }
 }
@@ -422,14 +425,15 @@ impl FiveAxisController {
         set_at: f64,
         actual: &Joints,
     ) -> Result<FiveAxisOutput, SampleError> {
-        self.sample_with(reference, set_at, actual, &Joints::zeros())
+        self.sample_with_feed_forward(reference, set_at, actual, &Joints::zeros())
     }
 
-    /// [`FiveAxisController::sample_held`] with a velocity feed-forward `feed_forward`
-    /// (mm/s, rad/s; the gain applied) added to the position loops' commands, the sum
-    /// within each joint's speed: the reference's velocity, which position loops alone
-    /// follow with a lag. The guard and the correction's room judge the sum.
-    pub fn sample_with(
+    /// [`FiveAxisController::sample_held`] with a feed-forward command `feed_forward`
+    /// (mm/s, rad/s: the reference's velocity and acceleration terms, gains applied)
+    /// added to the position loops' commands, the sum within each joint's speed (the
+    /// loops' anti-windup judges the sum): what position loops alone follow with a lag.
+    /// The guard and the correction's room judge the sum too.
+    pub fn sample_with_feed_forward(
         &mut self,
         reference: &Joints,
         set_at: f64,
@@ -447,12 +451,14 @@ impl FiveAxisController {
         }
         let following_error = reference - actual;
         let axes = &mut self.axes;
-        let speed = &self.config.limits.velocity;
         let mut asked = Joints::zeros();
+        // The loops' limits are the joints' speeds: the sum is within them, and the
+        // anti-windup judges the sum.
         let loops = Joints::from_fn(|i, _| {
-            let (u, unclamped) = axes[i].update_unclamped(following_error[i], true);
-            asked[i] = unclamped + feed_forward[i];
-            (u + feed_forward[i]).clamp(-speed[i], speed[i])
+            let (u, unclamped) =
+                axes[i].update_unclamped(following_error[i], true, feed_forward[i]);
+            asked[i] = unclamped;
+            u
         });
         let mut hold = Hold {
             beyond_limits: self.guard.beyond_limits(reference, set_at),
@@ -510,6 +516,7 @@ impl FiveAxisController {
             correction: Joints::zeros(),
             weight,
             hold,
+            lagging: self.guard.lagging(),
             tip_step: CccStep::default(),
             orientation_step: CccStep::default(),
             evaluation,

@@ -135,14 +135,16 @@ impl Pid {
     /// a caller that knows the output cannot act (its own consumer saturates) holds the
     /// integral.
     pub fn update_with(&mut self, error: f64, integrate: bool) -> f64 {
-        self.update_unclamped(error, integrate).0
+        self.update_unclamped(error, integrate, 0.0).0
     }
 
-    /// [`Pid::update_with`], returning the output and what it was before the clamp (how
-    /// far beyond its limit the loop asks to go).
-    pub fn update_unclamped(&mut self, error: f64, integrate: bool) -> (f64, f64) {
+    /// [`Pid::update_with`] with `offset` added to the output before the clamp (a
+    /// feed-forward the limit also bounds, so the anti-windup judges the sum), returning
+    /// the output and what it was before the clamp (how far beyond its limit the loop
+    /// asks to go).
+    pub fn update_unclamped(&mut self, error: f64, integrate: bool, offset: f64) -> (f64, f64) {
         let g = self.gains;
-        let p = g.kp * error;
+        let p = g.kp * error + offset;
         let d = g.kd * self.difference(error) / self.ts;
         let candidate = self.integral + error * self.ts;
         let integrate = integrate

@@ -78,7 +78,22 @@ impl FiveAxisReference {
     }
 
     fn starting(kind: Kind) -> Self {
-        let previous = kind.joints();
+        let first = kind.joints();
+        // A plan starts at rest: the sample before is the first one. At constant feed the
+        // tip starts at the feed: the sample before is the quadratic through the first
+        // three extended back, so the central differences at the first sample are the
+        // second-order forward ones (q(−1) = q(0) would give half the feed and a spike
+        // of v/Ts in the acceleration).
+        let previous = match &kind {
+            Kind::Planned(_) => first,
+            Kind::ConstantFeed(r) => {
+                // A copy of the reference, once at initialization.
+                let mut ahead = r.clone();
+                let second = ahead.step().map_or(first, |s| s.joints);
+                let third = ahead.step().map_or(second, |s| s.joints);
+                first * 3.0 - second * 3.0 + third
+            }
+        };
         FiveAxisReference { kind, previous }
     }
 
@@ -87,27 +102,24 @@ impl FiveAxisReference {
         self.kind.current()
     }
 
-    /// The reference's joint velocities at the current sample (mm/s, rad/s): the central
-    /// difference (q(k+1) − q(k−1))/(2·Ts), the derivative of the samples to O(Ts²) and
-    /// not a sample late as a backward difference would be; at the start q(−1) = q(0).
-    pub fn velocity(&self) -> Joints {
-        let (next, ts) = self.next();
-        (next - self.previous) / (2.0 * ts)
-    }
-
-    /// The reference's joint accelerations at the current sample (mm/s², rad/s²): the
-    /// central second difference (q(k+1) − 2·q(k) + q(k−1))/Ts².
-    pub fn acceleration(&self) -> Joints {
-        let (next, ts) = self.next();
-        (next - self.kind.joints() * 2.0 + self.previous) / (ts * ts)
-    }
-
-    /// The next sample's joints and the sample period.
-    fn next(&self) -> (Joints, f64) {
-        match &self.kind {
+    /// The reference's joint velocities (mm/s, rad/s) and accelerations (mm/s², rad/s²)
+    /// at the current sample: the central differences (q(k+1) − q(k−1))/(2·Ts) and
+    /// (q(k+1) − 2·q(k) + q(k−1))/Ts², the derivatives of the samples to O(Ts²) and not a
+    /// sample late as a backward difference would be (see [`Self::starting`] for the
+    /// first sample); both 0 once the reference rests at its end.
+    pub fn derivatives(&self) -> (Joints, Joints) {
+        if self.kind.done() {
+            return (Joints::zeros(), Joints::zeros());
+        }
+        let (next, ts) = match &self.kind {
             Kind::ConstantFeed(r) => (r.peek(), r.ts()),
             Kind::Planned(r) => (r.peek(), r.inputs().ts),
-        }
+        };
+        let now = self.kind.joints();
+        (
+            (next - self.previous) / (2.0 * ts),
+            (next - now * 2.0 + self.previous) / (ts * ts),
+        )
     }
 
     /// Advances one period.
@@ -161,6 +173,13 @@ impl Kind {
         }
     }
 
+    fn done(&self) -> bool {
+        match self {
+            Kind::ConstantFeed(r) => r.is_done(),
+            Kind::Planned(r) => r.is_done(),
+        }
+    }
+
     fn current(&mut self) -> ReferenceSample {
         match self {
             Kind::ConstantFeed(r) => {
@@ -182,6 +201,87 @@ impl Kind {
                     tip_deviation: s.tip_deviation,
                     orientation_deviation: s.orientation_deviation,
                 }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{self, Vector};
+
+    fn reference(accel: f64) -> FiveAxisReference {
+        let limits = PathLimits {
+            accel,
+            ..PathLimits::at_feed(50.0)
+        };
+        FiveAxisReference::new(
+            ToolPath::builtin("tilted_helix").unwrap(),
+            Some("tilted_helix".into()),
+            TableTiltingAc::ORIGIN,
+            JointLimits::DEFAULT,
+            limits,
+            1e-3,
+            &|i| format!("pose {i}"),
+        )
+        .unwrap()
+    }
+
+    /// The tip's speed in the workpiece frame when the joints move at `qdot`.
+    fn tip_speed(q: &Joints, qdot: &Joints) -> f64 {
+        let moved = TableTiltingAc::ORIGIN.jacobian(q) * qdot;
+        geometry::norm(&Vector::<3>::new(moved[0], moved[1], moved[2]))
+    }
+
+    #[test]
+    fn the_derivatives_are_the_samples_central_differences_from_start_to_end() {
+        for accel in [0.0, 2000.0] {
+            let mut r = reference(accel);
+            let ts = 1e-3;
+            let mut samples = vec![r.current().joints];
+            let mut derivatives = vec![r.derivatives()];
+            while !r.current().done {
+                let next = match &r.kind {
+                    Kind::ConstantFeed(j) => j.peek(),
+                    Kind::Planned(p) => p.peek(),
+                };
+                let sample = r.step().unwrap();
+                // Peeking says what the step gives.
+                assert_eq!(next, sample.joints);
+                samples.push(sample.joints);
+                derivatives.push(r.derivatives());
+            }
+            let n = samples.len();
+            for k in 1..n - 1 {
+                let (v, a) = derivatives[k];
+                let central = (samples[k + 1] - samples[k - 1]) / (2.0 * ts);
+                let second = (samples[k + 1] - samples[k] * 2.0 + samples[k - 1]) / (ts * ts);
+                assert!(
+                    (v - central).amax() < 1e-9 * (1.0 + central.amax()),
+                    "{accel} {k}"
+                );
+                assert!(
+                    (a - second).amax() < 1e-6 * (1.0 + second.amax()),
+                    "{accel} {k}"
+                );
+            }
+            // At rest at the end.
+            assert_eq!(derivatives[n - 1], (Joints::zeros(), Joints::zeros()));
+            let (v0, a0) = derivatives[0];
+            let (_, a1) = derivatives[1];
+            if accel == 0.0 {
+                // At constant feed the tip moves at the feed from the first sample on, and
+                // the first acceleration is the second's (the helix's), not a start-up
+                // spike: second-order forward differences.
+                assert!((tip_speed(&samples[0], &v0) - 50.0).abs() < 1e-3);
+                assert!((a0 - a1).amax() < 1e-2 * a1.amax(), "{a0} {a1}");
+            } else {
+                // A plan starts at rest: the raw samples' first move, a·Ts²/2, averaged
+                // over the filter's m1 = a/(j·Ts) samples, is j·Ts³/2 at most, so the
+                // central difference over 2·Ts is below j·Ts²/4 (0.025 mm/s).
+                let jerk = PathLimits::at_feed(50.0).jerk;
+                assert!(tip_speed(&samples[0], &v0) < jerk * 1e-6 / 4.0);
             }
         }
     }

@@ -196,7 +196,19 @@ impl JointReference {
             TipInterpolator::Curve(i) => i.peek(),
             TipInterpolator::Polyline(i) => i.peek(),
         };
-        self.solve(u, self.joints[4]).unwrap_or(self.joints)
+        // Not `solve`: its error message would allocate on every refused peek.
+        let pose = self.path.pose_at(u);
+        self.machine
+            .inverse(&pose, self.joints[4])
+            .unwrap_or(self.joints)
+    }
+
+    /// Whether the reference rests at the path's end.
+    pub fn is_done(&self) -> bool {
+        match &self.tip {
+            TipInterpolator::Curve(i) => i.is_done(),
+            TipInterpolator::Polyline(i) => i.is_done(),
+        }
     }
 
     /// The sample period, s.

@@ -13,8 +13,8 @@ use contour_core::control::{ControllerConfig, CrossCoupledController};
 use contour_core::geometry::Vector2;
 use contour_fmu::framework::variables::Value;
 use contour_fmu::models::{
-    contour_ccc_2d as ccc, line_arc_parameters as geometry, path_interpolator_2d as interp,
-    xy_servo_plant as plant,
+    contour_ccc_2d as ccc, contour_ccc_5x, line_arc_parameters as geometry,
+    path_interpolator_2d as interp, path_interpolator_5x, xy_servo_plant as plant,
 };
 
 /// A Ts that appears nowhere else in the state.
@@ -327,17 +327,35 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
     let (_, mut state) = interpolator.get_state();
     let (_, interpolator_bytes) = interpolator.serialize(state);
     interpolator.free_state(&mut state);
+    let five_axis = |info| {
+        let instance = Instance::new(info);
+        let (_, mut state) = instance.get_state();
+        let (_, bytes) = instance.serialize(state);
+        instance.free_state(&mut state);
+        (instance, bytes)
+    };
+    let (controller_5x, controller_5x_bytes) = five_axis(&contour_ccc_5x::INFO);
+    let (interpolator_5x, interpolator_5x_bytes) = five_axis(&path_interpolator_5x::INFO);
 
     // The models' current layout versions: ContourCCC2D 5 (the acceleration feed-forward;
     // 4: the feed-forward gain; 3: the
     // program estimator keeps its last two feet; 2: the controller became N-axis),
     // XYServoPlant 3 (each axis gained its effects and the table behind the play; 2: the
     // lead became a transmission), PathInterpolator2D 2 (the
-    // planned reference joined the constant-feed one).
+    // planned reference joined the constant-feed one), ContourCCC5X 4 (the feed-forward
+    // gains, the guard's averaged speeds and commands), PathInterpolator5X 4 (the sample
+    // before the current one, for vref and aref).
     for (i, bytes, model, version) in [
         (&controller, &controller_bytes, "ContourCCC2D", 5u16),
         (&plant_instance, &plant_bytes, "XYServoPlant", 3),
         (&interpolator, &interpolator_bytes, "PathInterpolator2D", 2),
+        (&controller_5x, &controller_5x_bytes, "ContourCCC5X", 4),
+        (
+            &interpolator_5x,
+            &interpolator_5x_bytes,
+            "PathInterpolator5X",
+            4,
+        ),
     ] {
         let (_, envelope) = open_state(bytes);
         assert_eq!(

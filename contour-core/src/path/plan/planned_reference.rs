@@ -1042,6 +1042,11 @@ impl PlannedReference {
         self.cursor.joints
     }
 
+    /// Whether the reference rests at the path's end.
+    pub fn is_done(&self) -> bool {
+        self.cursor.sample >= self.plan.samples
+    }
+
     /// The joints of the next sample, the reference unchanged.
     pub fn peek(&self) -> Joints {
         self.plan.peek(&self.cursor)
