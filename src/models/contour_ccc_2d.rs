@@ -186,11 +186,7 @@ impl SavedState for State {
     fn validate(&self, time: f64) -> Result<(), String> {
         self.clock.validate_at(time)?;
         controller_parameters::check_feed_forward(
-            &controller_parameters::FEED_FORWARD,
             self.feed_forward,
-        )?;
-        controller_parameters::check_feed_forward(
-            &controller_parameters::ACCELERATION_FEED_FORWARD,
             self.acceleration_feed_forward,
         )?;
         let controller = &self.controller;

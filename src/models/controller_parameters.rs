@@ -31,17 +31,21 @@ pub const ACCELERATION_FEED_FORWARD: Variable = nonnegative(
 )
 .unit("s");
 
-/// Checks a restored feed-forward parameter (`feedForward`, `accelerationFeedForward`)
-/// as the parameter's own check would.
-pub fn check_feed_forward(parameter: &Variable, value: f64) -> Result<(), String> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(())
-    } else {
-        Err(format!(
-            "{} = {value} must be finite and >= 0",
-            parameter.name
-        ))
+/// Checks a restored state's feed-forward parameters (`feedForward`,
+/// `accelerationFeedForward`) as the parameters' own checks would.
+pub fn check_feed_forward(velocity: f64, acceleration: f64) -> Result<(), String> {
+    for (parameter, value) in [
+        (&FEED_FORWARD, velocity),
+        (&ACCELERATION_FEED_FORWARD, acceleration),
+    ] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(format!(
+                "{} = {value} must be finite and >= 0",
+                parameter.name
+            ));
+        }
     }
+    Ok(())
 }
 
 /// A position-loop gain of every axis (`axis.x.Kp`, `axis.C.Kd`, …), ≥ 0.
