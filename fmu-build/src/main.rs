@@ -5,8 +5,8 @@
 //! `modelDescription/si/<Model>.xml`) files from the code; each `--resource` puts FILE
 //! into MODEL's `resources/` folder in both builds.
 //! PathInterpolator5X always carries the example CL part `examples/cl/blade.cl` as
-//! `resources/blade.cl`. The loops' SSP files (`python/contour_fmu/loops/*.ssd`) go beside
-//! the mm FMUs, where their components' sources are.
+//! `resources/blade.cl`. The loops' SSP files (`python/contour_fmu/loops/*.ssd`, and
+//! `loops/si/` for the SI build) go beside the FMUs, where their components' sources are.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -119,11 +119,7 @@ fn run(args: &[String]) -> Result<(), String> {
     for interface in packaged() {
         let out = match interface.units {
             UnitSystem::Millimetre => out.clone(),
-            UnitSystem::Si => {
-                let mut name = out.clone().into_os_string();
-                name.push("-si");
-                PathBuf::from(name)
-            }
+            UnitSystem::Si => si_folder(&out),
         };
         let fmu = package::write_fmu_with_resources(interface, &library, &out, &resources)?;
         println!("wrote {}", fmu.display());
@@ -135,6 +131,7 @@ fn run(args: &[String]) -> Result<(), String> {
         }
     }
     copy_loops(&root.join(LOOPS), &out)?;
+    copy_loops(&root.join(LOOPS).join("si"), &si_folder(&out))?;
     if !stale.is_empty() {
         eprintln!(
             "warning: the committed model descriptions differ from the code (the FMUs use the code's): {}\n\
@@ -145,8 +142,15 @@ fn run(args: &[String]) -> Result<(), String> {
     Ok(())
 }
 
-/// Copies every `.ssd` of `from` into `to` (the mm FMUs' folder: their start values are
-/// in mm).
+/// The SI build's folder beside the mm build's `out`: `out`-si.
+fn si_folder(out: &Path) -> PathBuf {
+    let mut name = out.as_os_str().to_owned();
+    name.push("-si");
+    PathBuf::from(name)
+}
+
+/// Copies every `.ssd` of `from` into `to` (an SSD's start values are in the units of the
+/// build beside which it goes: loops/ in mm, loops/si/ in m).
 fn copy_loops(from: &Path, to: &Path) -> Result<(), String> {
     let entries = std::fs::read_dir(from).map_err(|e| format!("{}: {e}", from.display()))?;
     for entry in entries {

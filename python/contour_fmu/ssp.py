@@ -5,6 +5,7 @@ initialization mode), in an annotation of ours. Standard library only: any proce
 read a loop without loading fmpy or an engine.
 """
 
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -101,3 +102,49 @@ def read(file):
 def shipped(name):
     """The loop `name` (two_axis, five_axis) shipped with the package."""
     return read(SHIPPED / f"{name}.ssd")
+
+
+def si_variant(file, model_descriptions):
+    """The text of the SSP file `file` for the SI build: every Real start value of a
+    length (a variable the mm model description in `model_descriptions`, a folder of
+    <Model>.xml, declares in mm, mm/s, ...) in metres; the rest unchanged, line for line.
+    make fmus puts the result beside the SI FMUs (python -m contour_fmu.ssp writes them)."""
+    file = Path(file)
+    scale_of = {}
+    for component, source in read(file).units.items():
+        description = ET.parse(Path(model_descriptions) / f"{Path(source).stem}.xml").getroot()
+        for variable in description.iter("ScalarVariable"):
+            real = variable.find("Real")
+            if real is not None and (real.get("unit") or "").startswith("mm"):
+                scale_of[component, variable.get("name")] = 1e-3
+    lines, component = [], None
+    for line in file.read_text().splitlines(keepends=True):
+        found = re.search(r'<ssd:Component name="([^"]+)"', line)
+        if found:
+            component = found.group(1)
+        parameter = re.search(r'<ssv:Parameter name="([^"]+)"><ssv:Real value="([^"]+)"/>', line)
+        if parameter and (component, parameter.group(1)) in scale_of:
+            value = float(parameter.group(2)) * scale_of[component, parameter.group(1)]
+            line = line.replace(f'value="{parameter.group(2)}"', f'value="{value!r}"')
+        line = line.replace("copies it into target/fmu.", "copies it into target/fmu-si.")
+        line = line.replace("The loop every contour_fmu master runs (contour_fmu.wiring reads this file).",
+                            "The SI build's copy, lengths in m (python -m contour_fmu.ssp writes it).")
+        lines.append(line)
+    return "".join(lines)
+
+
+def main(argv=None):
+    """Writes the SI variants of the shipped loops (loops/si/) from the mm ones and the
+    committed model descriptions of the repository at `argv[0]` (default: the checkout)."""
+    import sys
+    argv = sys.argv[1:] if argv is None else argv
+    root = Path(argv[0]) if argv else SHIPPED.parents[2]
+    (SHIPPED / "si").mkdir(exist_ok=True)
+    for file in sorted(SHIPPED.glob("*.ssd")):
+        target = SHIPPED / "si" / file.name
+        target.write_text(si_variant(file, root / "modelDescription"))
+        print(f"wrote {target}")
+
+
+if __name__ == "__main__":
+    main()
