@@ -408,9 +408,10 @@ impl Instance {
             v.check(&value).map_err(Failure::error)?;
             // And in the model's units, as a saved state is checked: a finite value in m
             // can overflow in mm, a bound can round across.
-            self.info.variables[vr as usize]
-                .check(&self.to_model(vr as Vr, value))
-                .map_err(|e| Failure::error(format!("{e} (in the model's units)")))?;
+            if let Err(e) = self.info.variables[vr as usize].check(&self.to_model(vr as Vr, value))
+            {
+                return Err(Failure::error(self.in_model_units(e)));
+            }
             match (v.causality, self.mode) {
                 (Causality::Output, _) => {
                     return Err(Failure::error(format!(
@@ -441,7 +442,7 @@ impl Instance {
         if let Some(backup) = backup {
             if let Err(message) = self.model.parameters_changed(&mut self.values) {
                 self.values = backup;
-                return Err(Failure::error(message));
+                return Err(Failure::error(self.in_model_units(message)));
             }
         }
         Ok(())
