@@ -17,7 +17,10 @@ LOOP = "urn:contour-fmu:ssp:loop"
 LOOP_ANNOTATION = "com.contour-fmu.loop"
 # The folder of the loops shipped with the package.
 SHIPPED = Path(__file__).resolve().parent / "loops"
-TYPES = {"Real": float, "Integer": int, "Boolean": lambda text: text == "true", "String": str}
+# xs:boolean is true, false, 1 or 0.
+TYPES = {"Real": float, "Integer": int, "Boolean": lambda text: {"true": True, "1": True,
+                                                                 "false": False, "0": False}[text],
+         "String": str}
 
 
 @dataclass(frozen=True)
@@ -67,12 +70,16 @@ def read(file):
                                          f"{{{SSD}}}ParameterValues/{{{SSV}}}ParameterSet"):
             assigned = sets.setdefault(values.get("name"), {}).setdefault(name, {})
             for parameter in values.iterfind(f"{{{SSV}}}Parameters/{{{SSV}}}Parameter"):
-                (typed,) = list(parameter)
-                kind = typed.tag.rsplit("}", 1)[1]
+                what = f"{file}: {name}.{parameter.get('name')}"
+                typed = list(parameter)
+                kind = typed[0].tag.rsplit("}", 1)[1] if len(typed) == 1 else None
                 if kind not in TYPES:
-                    raise ValueError(f"{file}: {name}.{parameter.get('name')}: type {kind} is "
-                                     f"not one of {', '.join(TYPES)}")
-                assigned[parameter.get("name")] = TYPES[kind](typed.get("value"))
+                    raise ValueError(f"{what}: a parameter needs one value of type "
+                                     f"{', '.join(TYPES)}")
+                try:
+                    assigned[parameter.get("name")] = TYPES[kind](typed[0].get("value"))
+                except (TypeError, ValueError, KeyError):
+                    raise ValueError(f"{what}: {typed[0].get('value')!r} is no {kind}") from None
 
     def checked(ends, what):
         for unit, connector in (ends[:2], ends[2:]):

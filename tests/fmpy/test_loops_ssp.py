@@ -116,6 +116,10 @@ def test_a_malformed_or_inconsistent_ssd_is_refused_naming_the_file(tmp_path):
          "component 'table', which is not one"),
         (shipped.replace('order="controller plant interpolator"', 'order="controller plant"'),
          "does not list each component once"),
+        (shipped.replace('<ssv:Real value="40.2"/>', '<ssv:Real value="forty"/>'),
+         "plant.pos0.x: 'forty' is no Real"),
+        (shipped.replace('<ssv:Real value="40.2"/>', '<ssv:Enumeration value="1"/>'),
+         "plant.pos0.x: a parameter needs one value of type"),
     ]
     for text, words in cases:
         file = write(tmp_path, text)
