@@ -209,14 +209,12 @@ impl<const D: usize, C: Curve<D>> Interpolator<D, C> {
         self.current()
     }
 
-    /// The parameter of the next sample and whether it is the end, the interpolator
-    /// unchanged.
-    pub fn peek(&self) -> (f64, bool) {
+    /// The parameter of the next sample, the interpolator unchanged.
+    pub fn peek(&self) -> f64 {
         if self.done {
-            return (self.u, true);
+            return self.u;
         }
-        let (u, _, done) = self.next_point();
-        (u, done)
+        self.next_point().0
     }
 
     /// Where the next sample lies: its parameter, curve point and whether it is the end.

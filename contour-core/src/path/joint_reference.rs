@@ -192,7 +192,7 @@ impl JointReference {
     /// The joints of the next sample, the reference unchanged (the current ones where the
     /// inverse kinematics refuse the next pose; `step` reports that).
     pub fn peek(&self) -> Joints {
-        let (u, _) = match &self.tip {
+        let u = match &self.tip {
             TipInterpolator::Curve(i) => i.peek(),
             TipInterpolator::Polyline(i) => i.peek(),
         };
