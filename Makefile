@@ -22,6 +22,7 @@ demo: fmus ccc-tune contour-eval $(VENV)/.run-installed
 
 fmus:
 	$(CARGO) run --release -p fmu-build
+	$(CARGO) build --release -p contour-cosim
 
 ccc-tune:
 	$(CARGO) build --release -p contour-tune --bin ccc-tune

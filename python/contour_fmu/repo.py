@@ -1,6 +1,6 @@
 """Where things are in a contour-fmu checkout: its root, the FMUs that `fmu-build` writes
-(target/fmu), the demo's output folder (out/), the `ccc-tune` program
-(target/release/ccc-tune), and which Cargo package of the workspace builds a target.
+(target/fmu), the demo's output folder (out/), the `ccc-tune` and `contour-cosim` programs
+(target/release/), and which Cargo package of the workspace builds a target.
 
 The root is, first found:
 1. the folder named by the environment variable CONTOUR_FMU_REPO (an error if it is not a
@@ -84,12 +84,19 @@ def ccc_tune():
     return target_dir() / "release" / "ccc-tune"
 
 
+def contour_cosim():
+    """The release build of the native co-simulation master (contour_fmu.native runs it)."""
+    return target_dir() / "release" / "contour-cosim"
+
+
 def contour_eval():
     """The release build of the offline evaluation (the ballbar demo's circular test)."""
     return target_dir() / "release" / "contour-eval"
 
 
 # The workspace crates that hold the cargo targets the Python side runs: the library
-# (the FMUs, the dump examples) and the tuner (ccc-tune, the PSO examples).
+# (the FMUs, the dump examples), the tuner (ccc-tune, the PSO examples) and the native
+# master (contour-cosim).
 LIBRARY_PACKAGE = "contour-fmu"
 TUNER_PACKAGE = "contour-tune"
+COSIM_PACKAGE = "contour-cosim"

@@ -1,0 +1,242 @@
+//! `contour-cosim`: runs a loop described by an SSP file through its FMUs and writes the
+//! recorded trajectory as CSV. `contour-cosim --help` says how.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use contour_cosim::watchdog::Watchdog;
+use contour_cosim::{End, Error, Experiment, Recording, Scheme, Simulation, System};
+
+const USAGE: &str = "\
+usage: contour-cosim run LOOP.ssd|LOOP.ssp [options]
+       contour-cosim check LOOP.ssd|LOOP.ssp
+
+run: steps the loop's FMUs from t = 0 with a fixed communication step and writes, as CSV,
+the recorded variables at every t_k (row k: before the step from t_k; the last row after
+the last step). check: loads the FMUs and checks the wiring, then lists the units.
+
+options:
+  --parameter-set NAME     the start values of the SSP file's parameter set NAME
+  --start UNIT.VAR=VALUE   a further start value (repeatable; after the parameter set)
+  --step SECONDS           the communication step (default: the file's default experiment)
+  --stop SECONDS           the end time (default: the file's default experiment)
+  --until UNIT.VAR         instead of --stop: end --settle seconds after this Boolean
+                           output turns true (e.g. interpolator.done)
+  --settle SECONDS         with --until (default 0)
+  --max-stop SECONDS       with --until: the run fails if the signal has not come (default 600)
+  --scheme gauss-seidel|jacobi   the coupling (default gauss-seidel, in the file's order)
+  --record UNIT.VAR,...    the variables to record (default: every output of every unit)
+  --output FILE            the CSV file (default: standard output)
+  --timeout SECONDS        a single FMU call that takes longer ends the run as a timeout
+                           (default 60)
+  --log                    print the FMUs' log messages on standard error
+
+exit status: 0 done; 1 the run failed (an FMU call returned an error); 2 refused before any
+run (a file, the wiring or an option); 3 timeout.";
+
+/// Exit status of a timeout (the run's other statuses: 0 done, 1 failed, 2 refused).
+const TIMEOUT_STATUS: i32 = 3;
+
+struct Options {
+    command: String,
+    file: PathBuf,
+    parameter_set: Option<String>,
+    starts: Vec<String>,
+    step: Option<f64>,
+    stop: Option<f64>,
+    until: Option<String>,
+    settle: f64,
+    max_stop: f64,
+    scheme: Scheme,
+    record: Option<Vec<String>>,
+    output: Option<PathBuf>,
+    timeout: f64,
+    log: bool,
+}
+
+fn seconds(option: &str, text: &str) -> Result<f64, Error> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v >= 0.0)
+        .ok_or_else(|| Error::Refused(format!("{option} wants a number of seconds, not {text:?}")))
+}
+
+fn parse(args: &[String]) -> Result<Options, Error> {
+    let usage = |why: &str| Error::Refused(format!("{why}\n{USAGE}"));
+    let (Some(command), Some(file)) = (args.first(), args.get(1)) else {
+        return Err(usage("a command and a loop file are needed"));
+    };
+    if command != "run" && command != "check" {
+        return Err(usage(&format!("unknown command {command:?}")));
+    }
+    let mut options = Options {
+        command: command.clone(),
+        file: PathBuf::from(file),
+        parameter_set: None,
+        starts: Vec::new(),
+        step: None,
+        stop: None,
+        until: None,
+        settle: 0.0,
+        max_stop: 600.0,
+        scheme: Scheme::GaussSeidel,
+        record: None,
+        output: None,
+        timeout: 60.0,
+        log: false,
+    };
+    let mut rest = args[2..].iter();
+    while let Some(option) = rest.next() {
+        if option == "--log" {
+            options.log = true;
+            continue;
+        }
+        let value = rest
+            .next()
+            .ok_or_else(|| usage(&format!("{option} wants a value")))?;
+        match option.as_str() {
+            "--parameter-set" => options.parameter_set = Some(value.clone()),
+            "--start" => options.starts.push(value.clone()),
+            "--step" => options.step = Some(seconds(option, value)?),
+            "--stop" => options.stop = Some(seconds(option, value)?),
+            "--until" => options.until = Some(value.clone()),
+            "--settle" => options.settle = seconds(option, value)?,
+            "--max-stop" => options.max_stop = seconds(option, value)?,
+            "--scheme" => options.scheme = value.parse()?,
+            "--record" => options.record = Some(value.split(',').map(str::to_string).collect()),
+            "--output" => options.output = Some(PathBuf::from(value)),
+            "--timeout" => options.timeout = seconds(option, value)?,
+            other => return Err(usage(&format!("unknown option {other:?}"))),
+        }
+    }
+    if options.until.is_some() && options.stop.is_some() {
+        return Err(usage("--stop and --until exclude each other"));
+    }
+    Ok(options)
+}
+
+/// "unit.variable" split at its first dot.
+fn port(text: &str) -> Result<(String, String), Error> {
+    text.split_once('.')
+        .map(|(u, v)| (u.to_string(), v.to_string()))
+        .ok_or_else(|| Error::Refused(format!("{text:?} is not UNIT.VARIABLE")))
+}
+
+fn run(options: &Options) -> Result<(), Error> {
+    let system = System::load(&options.file)?;
+    if options.command == "check" {
+        for unit in &system.units {
+            println!(
+                "{}: {} ({})",
+                unit.name,
+                unit.fmu.description.model_name,
+                unit.fmu.file.display()
+            );
+        }
+        println!(
+            "{} connections, {} initial copies",
+            system.connections.len(),
+            system.initial_copies.len()
+        );
+        return Ok(());
+    }
+    let mut starts = match &options.parameter_set {
+        Some(name) => system.structure.parameter_set(name)?.clone(),
+        None => Vec::new(),
+    };
+    for assignment in &options.starts {
+        let (target, text) = assignment.split_once('=').ok_or_else(|| {
+            Error::Refused(format!("--start {assignment:?} is not UNIT.VARIABLE=VALUE"))
+        })?;
+        let (unit, name) = port(target)?;
+        starts.push(system.parse_start_value(&unit, &name, text)?);
+    }
+    let start_values = system.start_values(&starts)?;
+    let file = system.structure.file.display().to_string();
+    let step = options.step.or(system.structure.step).ok_or_else(|| {
+        Error::Refused(format!(
+            "{file} gives no communication step (an OSP FixedStepAlgorithm); pass --step"
+        ))
+    })?;
+    let end = match &options.until {
+        Some(signal) => {
+            let (unit, name) = port(signal)?;
+            End::Signal {
+                signal: system.resolve(&unit, &name)?,
+                settle: options.settle,
+                max_stop: options.max_stop,
+            }
+        }
+        None => End::Time(options.stop.or(system.structure.stop).ok_or_else(|| {
+            Error::Refused(format!("{file} gives no stop time; pass --stop or --until"))
+        })?),
+    };
+    let experiment = Experiment { step, end }.checked()?;
+    let columns = match &options.record {
+        Some(names) => names
+            .iter()
+            .map(|n| port(n))
+            .collect::<Result<Vec<_>, _>>()?,
+        None => system.outputs(),
+    };
+    let recording = Recording::new(&system, &columns)?;
+    let mut output: Box<dyn Write> = match &options.output {
+        Some(path) => Box::new(
+            std::fs::File::create(path)
+                .map_err(|e| Error::Refused(format!("{}: {e}", path.display())))?,
+        ),
+        None => Box::new(std::io::stdout().lock()),
+    };
+
+    let mut simulation = Simulation::new(&system, options.scheme, options.log)?;
+    let timeout = Duration::from_secs_f64(options.timeout.max(1e-3));
+    let _watchdog = Watchdog::start(simulation.activity(), timeout, move || {
+        eprintln!(
+            "contour-cosim: timeout: an FMU call did not return within {} s",
+            timeout.as_secs_f64()
+        );
+        // The hung call keeps its thread; only ending the process frees it.
+        std::process::exit(TIMEOUT_STATUS);
+    });
+    let trace = simulation.run(&experiment, &start_values, &recording)?;
+
+    let mut text = String::with_capacity(trace.values.len() * 20);
+    text.push_str("time");
+    for column in &trace.columns {
+        text.push(',');
+        text.push_str(column);
+    }
+    text.push('\n');
+    for k in 0..=trace.steps {
+        text.push_str(&(k as f64 * trace.step).to_string());
+        for value in trace.row(k) {
+            text.push(',');
+            text.push_str(&value.to_string());
+        }
+        text.push('\n');
+    }
+    output
+        .write_all(text.as_bytes())
+        .and_then(|()| output.flush())
+        .map_err(|e| Error::Failed(format!("cannot write the trajectory: {e}")))
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "--help" || a == "-h") {
+        println!("{USAGE}");
+        return ExitCode::SUCCESS;
+    }
+    match parse(&args).and_then(|options| run(&options)) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("contour-cosim: {e}");
+            ExitCode::from(match e {
+                Error::Refused(_) => 2,
+                Error::Failed(_) => 1,
+            })
+        }
+    }
+}
