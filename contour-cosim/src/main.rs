@@ -1,21 +1,28 @@
 //! `contour-cosim`: runs a loop described by an SSP file through its FMUs and writes the
 //! recorded trajectory as CSV. `contour-cosim --help` says how.
 
-use std::io::Write;
+use std::io::{BufRead, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
+use contour_cosim::ssp::StartValues;
 use contour_cosim::watchdog::Watchdog;
-use contour_cosim::{End, Error, Experiment, Recording, Scheme, Simulation, System};
+use contour_cosim::{End, Error, Experiment, Recording, Scheme, Simulation, System, Trace, Value};
 
-const USAGE: &str = "\
-usage: contour-cosim run LOOP.ssd|LOOP.ssp [options]
+const USAGE: &str = r#"usage: contour-cosim run LOOP.ssd|LOOP.ssp [options]
+       contour-cosim batch LOOP.ssd|LOOP.ssp [options] [--runs FILE]
        contour-cosim check LOOP.ssd|LOOP.ssp
 
 run: steps the loop's FMUs from t = 0 with a fixed communication step and writes, as CSV,
 the recorded variables at every t_k (row k: before the step from t_k; the last row after
 the last step). check: loads the FMUs and checks the wiring, then lists the units.
+batch: many runs through one set of instances (reset between runs), one per line of
+--runs (default: standard input), each a JSON object {"run": ID, "start": [[UNIT,
+VARIABLE, TEXT], ...]} (TEXT as --start takes it; the options' start values come first).
+For each run it writes a JSON line {"run", "status" ("ok" or "error"), "message",
+"steps"} and, when ok, the trajectory: (steps + 1) rows of the recorded columns as
+little-endian f64. Its first line lists the columns: {"columns": [...]}.
 
 options:
   --parameter-set NAME     the start values of the SSP file's parameter set NAME
@@ -28,13 +35,15 @@ options:
   --max-stop SECONDS       with --until: the run fails if the signal has not come (default 600)
   --scheme gauss-seidel|jacobi   the coupling (default gauss-seidel, in the file's order)
   --record UNIT.VAR,...    the variables to record (default: every output of every unit)
-  --output FILE            the CSV file (default: standard output)
+  --output FILE            where the results go (default: standard output)
+  --runs FILE              batch: the run lines (default: standard input)
   --timeout SECONDS        a single FMU call that takes longer ends the run as a timeout
                            (default 60)
   --log                    print the FMUs' log messages on standard error
 
-exit status: 0 done; 1 the run failed (an FMU call returned an error); 2 refused before any
-run (a file, the wiring or an option); 3 timeout.";
+exit status: 0 done; 1 the run failed (an FMU call returned an error; batch: never, each
+run says); 2 refused before any run (a file, the wiring or an option; batch: also a run
+line it cannot read); 3 timeout (batch: of the first run without its result line)."#;
 
 /// Exit status of a timeout (the run's other statuses: 0 done, 1 failed, 2 refused).
 const TIMEOUT_STATUS: i32 = 3;
@@ -52,6 +61,7 @@ struct Options {
     scheme: Scheme,
     record: Option<Vec<String>>,
     output: Option<PathBuf>,
+    runs: Option<PathBuf>,
     timeout: f64,
     log: bool,
 }
@@ -68,7 +78,7 @@ fn parse(args: &[String]) -> Result<Options, Error> {
     let (Some(command), Some(file)) = (args.first(), args.get(1)) else {
         return Err(usage("a command and a loop file are needed"));
     };
-    if command != "run" && command != "check" {
+    if !["run", "batch", "check"].contains(&command.as_str()) {
         return Err(usage(&format!("unknown command {command:?}")));
     }
     let mut options = Options {
@@ -84,6 +94,7 @@ fn parse(args: &[String]) -> Result<Options, Error> {
         scheme: Scheme::GaussSeidel,
         record: None,
         output: None,
+        runs: None,
         timeout: 60.0,
         log: false,
     };
@@ -107,6 +118,7 @@ fn parse(args: &[String]) -> Result<Options, Error> {
             "--scheme" => options.scheme = value.parse()?,
             "--record" => options.record = Some(value.split(',').map(str::to_string).collect()),
             "--output" => options.output = Some(PathBuf::from(value)),
+            "--runs" => options.runs = Some(PathBuf::from(value)),
             "--timeout" => options.timeout = seconds(option, value)?,
             other => return Err(usage(&format!("unknown option {other:?}"))),
         }
@@ -124,24 +136,15 @@ fn port(text: &str) -> Result<(String, String), Error> {
         .ok_or_else(|| Error::Refused(format!("{text:?} is not UNIT.VARIABLE")))
 }
 
-fn run(options: &Options) -> Result<(), Error> {
-    let system = System::load(&options.file)?;
-    if options.command == "check" {
-        for unit in &system.units {
-            println!(
-                "{}: {} ({})",
-                unit.name,
-                unit.fmu.description.model_name,
-                unit.fmu.file.display()
-            );
-        }
-        println!(
-            "{} connections, {} initial copies",
-            system.connections.len(),
-            system.initial_copies.len()
-        );
-        return Ok(());
-    }
+/// What every run of a command shares: the start values of the options, the experiment,
+/// the recorded columns.
+struct Setup {
+    starts: StartValues,
+    experiment: Experiment,
+    recording: Recording,
+}
+
+fn setup(options: &Options, system: &System) -> Result<Setup, Error> {
     let mut starts = match &options.parameter_set {
         Some(name) => system.structure.parameter_set(name)?.clone(),
         None => Vec::new(),
@@ -153,7 +156,7 @@ fn run(options: &Options) -> Result<(), Error> {
         let (unit, name) = port(target)?;
         starts.push(system.parse_start_value(&unit, &name, text)?);
     }
-    let start_values = system.start_values(&starts)?;
+    system.start_values(&starts)?;
     let file = system.structure.file.display().to_string();
     let step = options.step.or(system.structure.step).ok_or_else(|| {
         Error::Refused(format!(
@@ -181,7 +184,33 @@ fn run(options: &Options) -> Result<(), Error> {
             .collect::<Result<Vec<_>, _>>()?,
         None => system.outputs(),
     };
-    let recording = Recording::new(&system, &columns)?;
+    let recording = Recording::new(system, &columns)?;
+    Ok(Setup {
+        starts,
+        experiment,
+        recording,
+    })
+}
+
+fn run(options: &Options) -> Result<(), Error> {
+    let system = System::load(&options.file)?;
+    if options.command == "check" {
+        for unit in &system.units {
+            println!(
+                "{}: {} ({})",
+                unit.name,
+                unit.fmu.description.model_name,
+                unit.fmu.file.display()
+            );
+        }
+        println!(
+            "{} connections, {} initial copies",
+            system.connections.len(),
+            system.initial_copies.len()
+        );
+        return Ok(());
+    }
+    let setup = setup(options, &system)?;
     let mut output: Box<dyn Write> = match &options.output {
         Some(path) => Box::new(
             std::fs::File::create(path)
@@ -189,7 +218,6 @@ fn run(options: &Options) -> Result<(), Error> {
         ),
         None => Box::new(std::io::stdout().lock()),
     };
-
     let mut simulation = Simulation::new(&system, options.scheme, options.log)?;
     let timeout = Duration::from_secs_f64(options.timeout.max(1e-3));
     let _watchdog = Watchdog::start(simulation.activity(), timeout, move || {
@@ -200,8 +228,20 @@ fn run(options: &Options) -> Result<(), Error> {
         // The hung call keeps its thread; only ending the process frees it.
         std::process::exit(TIMEOUT_STATUS);
     });
-    let trace = simulation.run(&experiment, &start_values, &recording)?;
+    let written = if options.command == "batch" {
+        batch(options, &system, &setup, &mut simulation, &mut output)
+    } else {
+        let start_values = system.start_values(&setup.starts)?;
+        let trace = simulation.run(&setup.experiment, &start_values, &setup.recording)?;
+        output.write_all(csv(&trace).as_bytes())
+    };
+    written
+        .and_then(|()| output.flush())
+        .map_err(|e| Error::Failed(format!("cannot write the results: {e}")))
+}
 
+/// The trajectory as CSV: a "time" column, then the recorded ones.
+fn csv(trace: &Trace) -> String {
     let mut text = String::with_capacity(trace.values.len() * 20);
     text.push_str("time");
     for column in &trace.columns {
@@ -217,10 +257,95 @@ fn run(options: &Options) -> Result<(), Error> {
         }
         text.push('\n');
     }
-    output
-        .write_all(text.as_bytes())
-        .and_then(|()| output.flush())
-        .map_err(|e| Error::Failed(format!("cannot write the trajectory: {e}")))
+    text
+}
+
+/// One run line of a batch: its id and its start values.
+fn run_line(
+    line: &str,
+    system: &System,
+) -> Result<(serde_json::Value, StartValues), Error> {
+    let bad = |why: &str| Error::Refused(format!("run line {line:?}: {why}"));
+    let parsed: serde_json::Value = serde_json::from_str(line).map_err(|e| bad(&e.to_string()))?;
+    let id = parsed
+        .get("run")
+        .cloned()
+        .ok_or_else(|| bad("no \"run\""))?;
+    let mut starts = Vec::new();
+    for triple in parsed
+        .get("start")
+        .and_then(|s| s.as_array())
+        .map_or(&[][..], |a| a.as_slice())
+    {
+        let Some([unit, name, text]) = triple
+            .as_array()
+            .and_then(|t| <&[_; 3]>::try_from(t.as_slice()).ok())
+            .map(|t| t.each_ref().map(|v| v.as_str()))
+        else {
+            return Err(bad("a start value is not [UNIT, VARIABLE, TEXT]"));
+        };
+        let (Some(unit), Some(name), Some(text)) = (unit, name, text) else {
+            return Err(bad(
+                "a start value is not [UNIT, VARIABLE, TEXT] of strings",
+            ));
+        };
+        starts.push(system.parse_start_value(unit, name, text)?);
+    }
+    Ok((id, starts))
+}
+
+fn batch(
+    options: &Options,
+    system: &System,
+    setup: &Setup,
+    simulation: &mut Simulation,
+    output: &mut dyn Write,
+) -> std::io::Result<()> {
+    let input: Box<dyn BufRead> = match &options.runs {
+        Some(path) => Box::new(std::io::BufReader::new(std::fs::File::open(path)?)),
+        None => Box::new(std::io::stdin().lock()),
+    };
+    writeln!(
+        output,
+        "{}",
+        serde_json::json!({ "columns": setup.recording.columns() })
+    )?;
+    output.flush()?;
+    let mut bytes = Vec::new();
+    for line in input.lines() {
+        let line = line?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let (id, mut starts) = match run_line(&line, system) {
+            Ok(parsed) => parsed,
+            Err(e) => {
+                eprintln!("contour-cosim: {e}");
+                std::process::exit(2);
+            }
+        };
+        starts.splice(0..0, setup.starts.iter().cloned());
+        let result = system
+            .start_values(&starts)
+            .and_then(|values| simulation.run(&setup.experiment, &values, &setup.recording));
+        let (status, message, steps) = match &result {
+            Ok(trace) => ("ok", String::new(), trace.steps),
+            Err(e) => ("error", e.to_string(), 0),
+        };
+        writeln!(
+            output,
+            "{}",
+            serde_json::json!({ "run": id, "status": status, "message": message, "steps": steps })
+        )?;
+        if let Ok(trace) = result {
+            bytes.clear();
+            bytes.extend(trace.values.iter().flat_map(|v| v.to_le_bytes()));
+            output.write_all(&bytes)?;
+        }
+        // The caller reads as runs finish, and knows which run a crash took.
+        output.flush()?;
+    }
+    Ok(())
 }
 
 fn main() -> ExitCode {

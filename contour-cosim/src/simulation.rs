@@ -109,8 +109,10 @@ impl Experiment {
         Ok(self)
     }
 
+    /// Whole steps in `seconds`, halves to even as Python's round() (the Python masters
+    /// count steps with it).
     fn steps(&self, seconds: f64) -> usize {
-        (seconds / self.step).round() as usize
+        (seconds / self.step).round_ties_even() as usize
     }
 }
 
@@ -232,6 +234,11 @@ impl Recording {
             columns: columns.iter().map(|(u, n)| format!("{u}.{n}")).collect(),
             groups: grouped(resolved),
         })
+    }
+
+    /// The columns' names, "unit.variable".
+    pub fn columns(&self) -> &[String] {
+        &self.columns
     }
 }
 

@@ -17,6 +17,10 @@ from . import repo
 from .ssp import SHIPPED
 
 
+# contour-cosim's exit status when an FMU call did not return within its timeout.
+TIMEOUT_STATUS = 3
+
+
 class RunFailed(RuntimeError):
     """contour-cosim refused the loop or a run failed; the message is its own."""
 
@@ -74,7 +78,7 @@ def run(ssd, **options):
         number = -done.returncode
         raise Crashed(number, f"contour-cosim was killed by {signal.Signals(number).name} "
                               f"(an FMU crashed the process)")
-    if done.returncode == 3:
+    if done.returncode == TIMEOUT_STATUS:
         raise Timeout(done.stderr.strip())
     if done.returncode != 0:
         raise RunFailed(done.stderr.strip())

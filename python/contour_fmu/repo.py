@@ -85,8 +85,10 @@ def ccc_tune():
 
 
 def contour_cosim():
-    """The release build of the native co-simulation master (contour_fmu.native runs it)."""
-    return target_dir() / "release" / "contour-cosim"
+    """The native co-simulation master that contour_fmu.native runs: $CONTOUR_COSIM when
+    set, else the checkout's release build."""
+    named = os.environ.get("CONTOUR_COSIM")
+    return Path(named) if named else target_dir() / "release" / "contour-cosim"
 
 
 def contour_eval():

@@ -111,6 +111,21 @@ def shipped(name):
     return read(SHIPPED / f"{name}.ssd")
 
 
+def with_sources(file, sources):
+    """The text of the SSP file `file` with the FMU files of some components renamed
+    (`sources`: component name -> file name); the rest unchanged."""
+    ET.register_namespace("ssd", SSD)
+    ET.register_namespace("ssc", SSC)
+    ET.register_namespace("ssv", SSV)
+    ET.register_namespace("cf", LOOP)
+    ET.register_namespace("osp", "https://opensimulationplatform.com/SSP/OSPAnnotations")
+    tree = ET.parse(file)
+    for component in tree.getroot().iterfind(f"{{{SSD}}}System/{{{SSD}}}Elements/{{{SSD}}}Component"):
+        if component.get("name") in sources:
+            component.set("source", sources[component.get("name")])
+    return ET.tostring(tree.getroot(), encoding="unicode", xml_declaration=True)
+
+
 def si_variant(file, model_descriptions):
     """The text of the SSP file `file` for the SI build: every Real start value of a
     length (a variable the mm model description in `model_descriptions`, a folder of

@@ -5,22 +5,28 @@ import subprocess
 
 import pytest
 
+from contour_fmu import native
 from contour_fmu.loops import LOOPS
+from contour_fmu.repo import COSIM_PACKAGE
 from helpers.checkout import REPO, target_dir
 
 
 @pytest.fixture(scope="session")
 def fmu_dir():
-    """Runs `cargo run --release -p fmu-build` (a no-op rebuild when nothing changed)."""
-    done = subprocess.run(
-        ["cargo", "run", "--quiet", "--release", "-p", "fmu-build"],
-        cwd=REPO,
-        capture_output=True,
-        text=True,
-    )
-    if done.returncode != 0:
-        raise RuntimeError(f"fmu-build failed:\n{done.stdout}\n{done.stderr}")
+    """Runs `cargo run --release -p fmu-build` (a no-op rebuild when nothing changed), and
+    builds contour-cosim, which the campaigns' default engine runs."""
+    for command in (["cargo", "run", "--quiet", "--release", "-p", "fmu-build"],
+                    ["cargo", "build", "--quiet", "--release", "-p", COSIM_PACKAGE]):
+        done = subprocess.run(command, cwd=REPO, capture_output=True, text=True)
+        if done.returncode != 0:
+            raise RuntimeError(f"{' '.join(command)} failed:\n{done.stdout}\n{done.stderr}")
     return target_dir() / "fmu"
+
+
+@pytest.fixture(scope="session")
+def cosim(fmu_dir):
+    """The contour-cosim program (built with the FMUs)."""
+    return native.program()
 
 
 @pytest.fixture(scope="session")

@@ -16,18 +16,9 @@ import pytest
 
 from contour_fmu import native
 from contour_fmu.master import CLOSED_LOOP_RECORD, FIVE_AXIS_RECORD, closed_loop, five_axis_closed_loop
-from contour_fmu.repo import COSIM_PACKAGE
 from helpers import faulty_fmu
-from helpers.checkout import REPO
 
 STEP = 1e-3
-
-
-@pytest.fixture(scope="session")
-def cosim():
-    subprocess.run(["cargo", "build", "--quiet", "--release", "-p", COSIM_PACKAGE], cwd=REPO,
-                   check=True)
-    return native.program()
 
 
 @pytest.fixture(scope="module")
@@ -216,9 +207,18 @@ def test_a_foreign_fmu_runs_and_one_that_hangs_or_crashes_ends_the_run_clearly(c
     call's timeout ends the run as a timeout (exit status 3) within about the timeout; when
     it segfaults, the process dies of SIGSEGV, which the caller sees as a crash."""
     ssd = faulty_fmu.build(tmp_path)
-    fine = native.run(ssd, step=0.01, stop=0.5, scheme=scheme, start={"a": {"u": 1.0}},
-                      record=[("a", "y"), ("b", "y")])
-    assert len(fine) == 51 and not fine["b.y"].any()  # u = 1 was overwritten by b.y = 0 at t_0
+    fine = native.run(ssd, step=0.01, stop=0.5, scheme=scheme,
+                      start={"a": {"pos0.x": 1.0, "u.x": 2.0}, "b": {"u.x": -4.0}},
+                      record=[("a", "pos.x"), ("b", "pos.x")])
+    assert len(fine) == 51
+    assert np.allclose(fine["a.pos.x"], 1.0 + 2.0 * fine["time"], rtol=0, atol=1e-12)
+    assert np.allclose(fine["b.pos.x"], -4.0 * fine["time"], rtol=0, atol=1e-12)
+    ring = ssd.read_text().replace("</ssd:Elements>", """</ssd:Elements><ssd:Connections>
+        <ssd:Connection startElement="a" startConnector="pos.x" endElement="b" endConnector="u.x"/>
+        </ssd:Connections>""")
+    (tmp_path / "ring.ssd").write_text(ring)
+    with pytest.raises(native.RunFailed, match=r"a.pos.x -> b.u.x: units differ \(mm onto mm/s\)"):
+        native.run(tmp_path / "ring.ssd", stop=0.1)
     began = time.monotonic()
     with pytest.raises(native.Timeout, match="did not return within 0.5 s"):
         native.run(ssd, step=0.01, stop=1.0, scheme=scheme, timeout=0.5,

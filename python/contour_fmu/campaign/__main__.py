@@ -106,13 +106,13 @@ def main(argv=None, prog=PROG):
     except MissingExtra as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    from .execute import SchedulerUnreachable
+    from .execute import RunnerUnavailable, SchedulerUnreachable
     from .spec import CampaignError
     from .store import OutputInUse
 
     try:
         return command_run(args) if args.command == "run" else command_replay(args)
-    except (CampaignError, OutputInUse, SchedulerUnreachable) as e:
+    except (CampaignError, OutputInUse, SchedulerUnreachable, RunnerUnavailable) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
 

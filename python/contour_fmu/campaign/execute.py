@@ -11,12 +11,15 @@ once; a remote scheduler applies its own allowed-failures before reporting a los
 """
 
 import asyncio
+import collections
 import contextlib
 import hashlib
+import math
 import time
 
 from ..extras import needs
-from .runner import Job, extracted, run_batch
+from . import native_batch
+from .runner import Job, RunFailed, extracted, run_batch
 from .store import ResultStore
 
 try:
@@ -32,35 +35,103 @@ class SchedulerUnreachable(RuntimeError):
     pass
 
 
+class RunnerUnavailable(RuntimeError):
+    """A worker cannot run contour-cosim (the native engine); the campaign does not start."""
+
+
 def job_of(campaign):
     return Job(loop=campaign.loop, step=campaign.step, stop=campaign.stop, settle=campaign.settle,
                max_stop=campaign.max_stop, metrics=campaign.metrics,
                fmus={name: unit.sha256 for name, unit in campaign.units.items()},
-               interpolator_variables=campaign.units["interpolator"].variables)
+               interpolator_variables=campaign.units["interpolator"].variables,
+               engine=campaign.engine, timeout=campaign.timeout)
 
 
 def archives_of(campaign):
     return {name: unit.path.read_bytes() for name, unit in campaign.units.items()}
 
 
-def batches(runs, size):
-    """Consecutive runs in lists of `size`, as (run id, start values) pairs."""
-    pairs = [(r.id, r.start_values) for r in runs]
-    return [pairs[i:i + size] for i in range(0, len(pairs), size)]
+def program_of(campaign):
+    """contour-cosim as bytes for the native engine (None for fmpy)."""
+    if campaign.engine != "native":
+        return None
+    try:
+        return native_batch.local_program()
+    except RunFailed as e:
+        raise RunnerUnavailable(f"engine = \"native\" needs contour-cosim: {e}") from None
 
 
-class FmuArchives(WorkerPlugin):
-    """Extracts a campaign's FMU archives on each worker as it starts, into the worker's
-    own folder (removed with the worker)."""
+def engine_batch(job):
+    """The function that runs a batch of `job` on a worker, by its engine."""
+    return native_batch.run_batch if job.engine == "native" else run_batch
 
-    def __init__(self, job, archives):
-        together = hashlib.sha256("".join(sorted(job.fmus.values())).encode()).hexdigest()
-        self.name = f"contour-fmu-archives-{together[:16]}"
-        self.archives = {job.fmus[unit]: data for unit, data in archives.items()}
+
+def batch_function(campaign, batch_fn=None):
+    """The engine's batch function, unless a test gives one."""
+    return batch_fn if batch_fn is not None else engine_batch(job_of(campaign))
+
+
+# With batch_size = "auto", a batch is about this much work (seconds of runs): Dask's
+# cost per task (a few ms) and the row file per batch stay small against it.
+TASK_SECONDS = 1.0
+# Runs of each first batch, before any run's cost is known.
+FIRST_BATCH = 2
+
+
+class BatchSizer:
+    """Runs per batch: the campaign's batch_size, or (auto) as many as make about
+    TASK_SECONDS of work at the mean wall time of the runs so far, and never more than a
+    share of what is left, so that every worker has work until the end."""
+
+    def __init__(self, fixed, workers):
+        self.fixed, self.workers = fixed, max(1, workers)
+        self.seconds, self.runs = 0.0, 0
+
+    def observe(self, rows):
+        times = [r["wall_time_s"] for r in rows if math.isfinite(r["wall_time_s"])]
+        self.seconds += sum(times)
+        self.runs += len(times)
+
+    def size(self, remaining):
+        if self.fixed is not None:
+            return self.fixed
+        if self.runs == 0:
+            return FIRST_BATCH
+        per_run = max(self.seconds / self.runs, 1e-6)
+        return max(1, min(round(TASK_SECONDS / per_run), math.ceil(remaining / (2 * self.workers))))
+
+
+class Pending:
+    """The runs still to submit, as (run id, start values), taken in order."""
+
+    def __init__(self, runs):
+        self.runs = collections.deque((r.id, r.start_values) for r in runs)
+
+    def __len__(self):
+        return len(self.runs)
+
+    def take(self, size):
+        return [self.runs.popleft() for _ in range(min(size, len(self.runs)))]
+
+
+class CampaignFiles(WorkerPlugin):
+    """Gives each worker, as it starts, what its engine needs, in the worker's own folder
+    (removed with the worker): the FMU archives extracted (fmpy), or the FMUs, the loop's
+    SSP file and contour-cosim (native), which it then checks it can run: a worker that
+    cannot fails the plugin, and the campaign does not start."""
+
+    def __init__(self, job, archives, program):
+        together = hashlib.sha256("".join([job.engine, *sorted(job.fmus.values())]).encode()).hexdigest()
+        self.name = f"contour-fmu-files-{together[:16]}"
+        self.job, self.archives, self.program = job, archives, program
 
     def setup(self, worker):
-        for sha256, data in self.archives.items():
-            extracted(sha256, data, within=worker.local_directory)
+        if self.job.engine == "native":
+            native_batch.check_program(native_batch.prepare(self.job, self.archives, self.program,
+                                                            within=worker.local_directory))
+        else:
+            for unit, data in self.archives.items():
+                extracted(self.job.fmus[unit], data, within=worker.local_directory)
 
 
 @contextlib.contextmanager
@@ -139,20 +210,24 @@ def _write(store, progress, rows):
             progress.update(len(rows))
 
 
-def run_serial(campaign, store, progress=None, batch_fn=run_batch):
+def run_serial(campaign, store, progress=None, batch_fn=None):
     """Every pending batch in this process, in order, with the Dask loop's rules: a batch
     raising outside any run is tried once more, then recorded as failed."""
     job, archives = job_of(campaign), archives_of(campaign)
-    for batch in batches(pending_runs(campaign, store), campaign.batch_size):
+    batch_fn = batch_function(campaign, batch_fn)
+    pending, sizer = Pending(pending_runs(campaign, store)), BatchSizer(campaign.batch_size, 1)
+    while pending:
+        batch = pending.take(sizer.size(len(pending)))
         for attempt in (1, 2):
             rows, again = _settle(batch, attempt, lambda: batch_fn(job, batch, archives),
                                   campaign.metrics)
+            sizer.observe(rows)
             _write(store, progress, rows)
             if not again:
                 break
 
 
-def run_on_dask(campaign, store, client, progress=None, batch_fn=run_batch):
+def run_on_dask(campaign, store, client, progress=None, batch_fn=None):
     """Every pending batch as a task on `client`'s workers; rows written as tasks finish.
     No more batches are in flight than the workers have threads, so a worker's death
     loses only what it was running, on any scheduler; the next batch is submitted before
@@ -161,17 +236,23 @@ def run_on_dask(campaign, store, client, progress=None, batch_fn=run_batch):
         from distributed import as_completed
 
     job = job_of(campaign)
-    plugin = FmuArchives(job, archives_of(campaign))
-    client.register_plugin(plugin)
+    batch_fn = batch_function(campaign, batch_fn)
+    plugin = CampaignFiles(job, archives_of(campaign), program_of(campaign))
+    try:
+        client.register_plugin(plugin)
+    except RunFailed as e:  # raised by a worker's setup: it cannot run contour-cosim
+        raise RunnerUnavailable(f"{e}; give the workers a contour-cosim built for their "
+                                f"platform, or choose engine = \"fmpy\"") from None
     tag = f"{campaign.digest[:8]}-{time.time_ns()}"
-    waiting = [(b, 1) for b in reversed(batches(pending_runs(campaign, store), campaign.batch_size))]
-    submitted = {}
+    pending = Pending(pending_runs(campaign, store))
+    sizer = BatchSizer(campaign.batch_size, sum(client.nthreads().values()))
+    retries, submitted = [], {}
     running = as_completed(loop=client.loop)
 
     def top_up():
         capacity = max(1, sum(client.nthreads().values()))
-        while waiting and running.count() < capacity:
-            batch, attempt = waiting.pop()
+        while (retries or pending) and running.count() < capacity:
+            batch, attempt = retries.pop() if retries else (pending.take(sizer.size(len(pending))), 1)
             future = client.submit(batch_fn, job, batch, pure=False,
                                    key=f"campaign-{tag}-run{batch[0][0]}-attempt{attempt}")
             submitted[future.key] = (batch, attempt)
@@ -179,13 +260,14 @@ def run_on_dask(campaign, store, client, progress=None, batch_fn=run_batch):
 
     try:
         top_up()
-        while running.count() or waiting:
+        while running.count() or retries or pending:
             future = next(running)
             batch, attempt = submitted.pop(future.key)
             rows, again = _settle(batch, attempt, future.result, campaign.metrics)
             future.release()
+            sizer.observe(rows)
             if again:
-                waiting.append((batch, 2))
+                retries.append((batch, 2))
             top_up()
             _write(store, progress, rows)
     finally:
@@ -196,7 +278,7 @@ def run_on_dask(campaign, store, client, progress=None, batch_fn=run_batch):
 
 
 def execute(campaign, out, *, scheduler=None, workers=None, resume=False, serial=False,
-            show_progress=True, batch_fn=run_batch):
+            show_progress=True, batch_fn=None):
     """Runs the campaign's pending runs into OUT; returns the store. Connects to the
     scheduler (or starts the LocalCluster) before any run."""
     with needs("campaign"):

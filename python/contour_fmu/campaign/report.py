@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..extras import needs
+from .store import STATUSES
 from .metrics import unit_of
 
 SCALE = {"mm": (1e3, "µm"), "rad": (1e6, "µrad")}
@@ -64,7 +65,7 @@ def summary(campaign, table, out):
     """The Markdown text of OUT/summary.md."""
     c = table.to_pydict()
     metrics, first = campaign.metrics, campaign.metrics[0]
-    statuses = {s: c["status"].count(s) for s in ("ok", "error", "lost", "failed")}
+    statuses = {s: c["status"].count(s) for s in STATUSES}
     wall = np.nansum(np.asarray(c["wall_time_s"], float))
     lines = [f"# Campaign: {campaign.name}", "",
              f"- file: `{campaign.source}`; loop {campaign.loop}; digest `{campaign.digest[:12]}`",

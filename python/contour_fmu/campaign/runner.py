@@ -46,6 +46,8 @@ class Job:
     metrics: tuple
     fmus: dict  # unit -> SHA-256 of its archive (the key of the extraction cache)
     interpolator_variables: dict  # name -> spec.Variable, for the metrics' defaults
+    engine: str = "native"  # native (native_batch) or fmpy (here)
+    timeout: float = 60.0  # seconds an FMU call may take (native engine)
 
 
 class RunFailed(RuntimeError):

@@ -10,7 +10,10 @@ The file (every key but `loop` optional; docs/campaigns.md has the whole referen
     stop = "end_of_path"               # or a stop time in seconds
     settle = 0.05                      # seconds run after the end of the path
     metrics = ["contour_error.max", "contour_error.mean"]
-    batch_size = 4                     # runs per Dask task (one set of instances)
+    engine = "native"                  # contour-cosim (default), or "fmpy"
+    timeout = 60.0                     # native: an FMU call longer than this ends its run
+    batch_size = "auto"                # runs per Dask task (one set of instances); auto:
+                                       #   about a second of work each
 
     [fmus]                             # default: the loop's FMUs in <repo>/target/fmu
     directory = "../target/fmu"        # relative to this file; or one file per unit:
@@ -63,7 +66,10 @@ DEFAULT_MAX_STOP = 600.0
 # More runs than this is a typo in a grid, not a campaign (and would fill memory first).
 MAX_RUNS = 1_000_000
 TOP_KEYS = {"name", "loop", "step", "stop", "settle", "max_stop", "metrics", "batch_size",
-            "fmus", "fixed", "paths", "variants", "sweep"}
+            "engine", "timeout", "fmus", "fixed", "paths", "variants", "sweep"}
+# Who steps the FMUs: contour-cosim (contour_fmu.native), or fmpy in the worker's Python.
+ENGINES = ("native", "fmpy")
+AUTO = "auto"
 
 
 class CampaignError(ValueError):
@@ -110,10 +116,12 @@ class Campaign:
     settle: float
     max_stop: float
     metrics: tuple
-    batch_size: int
+    batch_size: int | None  # None: sized by work (execute.BatchSizer)
     swept: tuple  # "unit.variable" names, in file order
     runs: tuple = field(repr=False)
     fmu_dir: Path | None = None  # --fmu-dir, when given (replay commands repeat it)
+    engine: str = "native"  # not in the digest: both engines give the same rows
+    timeout: float = 60.0  # seconds an FMU call may take (native engine)
 
     @functools.cached_property
     def digest(self):
@@ -183,9 +191,15 @@ class _Reader:
             self.fail("settle applies to stop = \"end_of_path\"; with a stop time, lengthen the stop")
         if max_stop / step > 1e8:
             self.fail(f"max_stop / step = {max_stop / step:.3g} steps: more than 1e8 per run")
-        batch_size = self.doc.get("batch_size", 4)
-        if not isinstance(batch_size, int) or isinstance(batch_size, bool) or batch_size < 1:
-            self.fail(f"batch_size = {batch_size!r}: expected a whole number >= 1")
+        batch_size = self.doc.get("batch_size", AUTO)
+        if batch_size == AUTO:
+            batch_size = None
+        elif not isinstance(batch_size, int) or isinstance(batch_size, bool) or batch_size < 1:
+            self.fail(f"batch_size = {batch_size!r}: expected a whole number >= 1 or \"auto\"")
+        engine = self.doc.get("engine", "native")
+        if engine not in ENGINES:
+            self.fail(f"engine = {engine!r}: expected one of {', '.join(map(repr, ENGINES))}")
+        timeout = self.positive("timeout", 60.0)
         metrics = self.doc.get("metrics", list(METRICS[loop].names[:2]))
         try:
             check_metrics(loop, metrics)
@@ -224,7 +238,7 @@ class _Reader:
             fmu_dir=None if self.fmu_dir is None else Path(self.fmu_dir).resolve(),
             loop=loop, units=self.units, step=step, stop=None if stop == STOP_AT_END else stop,
             settle=settle, max_stop=max_stop, metrics=tuple(metrics), batch_size=batch_size,
-            swept=tuple(swept), runs=tuple(runs))
+            swept=tuple(swept), runs=tuple(runs), engine=engine, timeout=timeout)
 
     # --- scalars -----------------------------------------------------------------------
 

@@ -2,7 +2,8 @@
 
 OUT/rows/ holds one Parquet file per finished batch, each written under a temporary name
 and renamed, so a campaign killed at any moment leaves only whole files: nothing written
-is lost, and --resume reads them back. A run may appear in several files (a lost batch
+is lost, and --resume reads them back. The newest small files are merged as the campaign
+goes (`compact`), so a million runs leave a handful of files, not one per batch. A run may appear in several files (a lost batch
 rerun by --resume); its newest row counts. OUT/campaign.json records the campaign's
 digest: --resume refuses an output folder of another campaign, or of other FMUs.
 At the end OUT/results.parquet holds every run's row, sorted by run id.
@@ -18,11 +19,17 @@ with needs("campaign"):
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-# A row's outcome. ok and error are final (an FMU error repeats when rerun); lost (the
-# batch died with its worker twice) and failed (the batch raised outside any run, twice)
-# are run again by --resume.
-FINAL = ("ok", "error")
-STATUSES = ("ok", "error", "lost", "failed")
+# A row's outcome. ok, error (an FMU returned an error), crashed (an FMU killed the
+# native engine's process; the message names the signal) and timeout (an FMU call did not
+# return within the campaign's timeout) are final: they repeat when rerun. lost (the batch
+# died with its worker twice) and failed (the batch raised outside any run, twice) are run
+# again by --resume.
+FINAL = ("ok", "error", "crashed", "timeout")
+STATUSES = ("ok", "error", "crashed", "timeout", "lost", "failed")
+# Row files are merged as the campaign goes: once this many of the newest files each hold
+# fewer than SMALL_FILE_ROWS rows, they become one.
+COMPACT_AFTER = 16
+SMALL_FILE_ROWS = 100_000
 
 _ARROW_TYPES = {"Real": pa.float64(), "Integer": pa.int64(), "Enumeration": pa.int64(),
                 "Boolean": pa.bool_(), "String": pa.string()}
@@ -108,12 +115,27 @@ class ResultStore:
             complete.append({**row, "variant": run.variant, "path": run.path, **run.swept})
         table = pa.Table.from_pylist(complete, schema=self.schema)
         number = 1 + max((int(p.stem.split("-")[1]) for p in self.parts()), default=-1)
-        target = self.rows_dir / f"part-{number:06d}.parquet"
-        temporary = target.with_suffix(".tmp")
-        pq.write_table(table, temporary)
-        with open(temporary, "rb") as f:
-            os.fsync(f.fileno())
-        os.replace(temporary, target)
+        _write_durably(self.rows_dir / f"part-{number:06d}.parquet", table)
+        self.compact()
+
+    def compact(self, after=COMPACT_AFTER):
+        """Merges the newest row files into the oldest of them once `after` of them are
+        small: a finished campaign is a handful of files, not one per batch. Safe at any
+        moment: the merged file replaces the first of them, then the rest go; a kill in
+        between leaves their rows twice, the same rows, and the newest counts."""
+        parts = self.parts()
+        small = []
+        for part in reversed(parts):
+            if pq.ParquetFile(part).metadata.num_rows >= SMALL_FILE_ROWS:
+                break
+            small.append(part)
+        if len(small) < after:
+            return
+        small.reverse()
+        merged = pa.concat_tables([pq.read_table(p, schema=self.schema) for p in small])
+        _write_durably(small[0], merged)
+        for part in small[1:]:
+            part.unlink()
 
     def table(self):
         """Every run's newest row, sorted by run id (a pyarrow Table)."""
@@ -134,7 +156,9 @@ class ResultStore:
                                   table.column("status").to_pylist()) if s in FINAL}
 
     def consolidate(self):
-        """Writes OUT/results.parquet; returns the table."""
+        """Merges the small row files, writes OUT/results.parquet; returns the table."""
+        if self.lock is not None:
+            self.compact(after=2)
         table = self.table()
         self.out.mkdir(parents=True, exist_ok=True)
         temporary = self.out / "results.parquet.tmp"
@@ -154,6 +178,16 @@ def _lockable(path):
             return False
         fcntl.flock(f, fcntl.LOCK_UN)
         return True
+
+
+def _write_durably(target, table):
+    """Writes a Parquet file under a temporary name, syncs it and renames it: readers see
+    the old file or the whole new one."""
+    temporary = target.with_suffix(".tmp")
+    pq.write_table(table, temporary)
+    with open(temporary, "rb") as f:
+        os.fsync(f.fileno())
+    os.replace(temporary, target)
 
 
 def _write_atomically(path, data):

@@ -1,5 +1,5 @@
 """Batch functions that misbehave on purpose, for the campaign tests: they run the real
-batch (contour_fmu.campaign.runner.run_batch) but kill their Dask worker, or interrupt
+batch (the campaign engine's) but kill their Dask worker, or interrupt
 the campaign, on the batches they are told. Pickled by value (the workers do not have the
 tests on their path)."""
 
@@ -7,7 +7,7 @@ import os
 import signal
 from pathlib import Path
 
-from contour_fmu.campaign.runner import run_batch
+from contour_fmu.campaign.execute import engine_batch
 
 
 class KillWorker:
@@ -23,7 +23,7 @@ class KillWorker:
             if self.every_attempt or not self.marker.exists():
                 self.marker.touch()
                 os.kill(os.getpid(), signal.SIGKILL)
-        return run_batch(job, runs, archives)
+        return engine_batch(job)(job, runs, archives)
 
 
 class InterruptAfter:
@@ -36,4 +36,4 @@ class InterruptAfter:
         if self.left == 0:
             raise KeyboardInterrupt
         self.left -= 1
-        return run_batch(job, runs, archives)
+        return engine_batch(job)(job, runs, archives)

@@ -1,8 +1,10 @@
-"""A foreign FMU that misbehaves on purpose, built from C in the test (gcc): `Faulty`, FMI 2.0
-Co-Simulation, one Real input `u` and one Real output `y` (y follows u: y = u at each step's
-end), and at `fault_time` its fmi2DoStep does what the Integer parameter `fault` says: 0
-nothing, 1 dereferences NULL (SIGSEGV), 2 spins forever. Every other fmi2 function a master
-may look up exists and returns fmi2Error where it does nothing."""
+"""A foreign FMU that misbehaves on purpose, built from C in the test (gcc): model identifier
+`Faulty`, FMI 2.0 Co-Simulation, a stand-in for the XY plant (model name XYServoPlant, so a
+campaign takes it as the plant): velocity commands `u.x`, `u.y` in, positions `pos.x`,
+`pos.y` out (ideal axes: pos += u·h), starting at `pos0.*`. At `fault_time` its fmi2DoStep
+does what the Integer parameter `fault` says: 0 nothing, 1 dereferences NULL (SIGSEGV), 2
+spins forever. Every other fmi2 function a master may look up exists and returns fmi2Error
+where it does nothing."""
 
 import subprocess
 import zipfile
@@ -16,7 +18,8 @@ SOURCE = r"""
 #include <string.h>
 typedef void *C;
 typedef unsigned int VR;
-typedef struct { double u, y, fault_time; int fault; } M;
+/* Reals by value reference: 0 u.x, 1 u.y, 2 pos.x, 3 pos.y, 4 pos0.x, 5 pos0.y, 6 fault_time. */
+typedef struct { double r[7]; int fault; } M;
 #define OK 0
 #define ERR 3
 #define EXPORT __attribute__((visibility("default")))
@@ -25,40 +28,40 @@ EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
 EXPORT int fmi2SetDebugLogging(C c, int on, size_t n, const char *const *cats) { return OK; }
 EXPORT C fmi2Instantiate(const char *name, int type, const char *guid, const char *res,
                          const void *callbacks, int visible, int logging) {
-    M *m = calloc(1, sizeof(M));
-    m->fault_time = 0.0;
-    return m;
+    return calloc(1, sizeof(M));
 }
 EXPORT void fmi2FreeInstance(C c) { free(c); }
 EXPORT int fmi2SetupExperiment(C c, int td, double tol, double start, int sd, double stop) { return OK; }
 EXPORT int fmi2EnterInitializationMode(C c) { return OK; }
-EXPORT int fmi2ExitInitializationMode(C c) { return OK; }
+EXPORT int fmi2ExitInitializationMode(C c) {
+    M *m = c;
+    m->r[2] = m->r[4];
+    m->r[3] = m->r[5];
+    return OK;
+}
 EXPORT int fmi2Terminate(C c) { return OK; }
-EXPORT int fmi2Reset(C c) { M *m = c; memset(m, 0, sizeof(M)); return OK; }
+EXPORT int fmi2Reset(C c) { memset(c, 0, sizeof(M)); return OK; }
 EXPORT int fmi2GetReal(C c, const VR *vr, size_t n, double *v) {
     M *m = c;
-    for (size_t i = 0; i < n; i++) {
-        switch (vr[i]) { case 0: v[i] = m->u; break; case 1: v[i] = m->y; break;
-                         case 2: v[i] = m->fault_time; break; default: return ERR; }
-    }
+    for (size_t i = 0; i < n; i++) { if (vr[i] > 6) return ERR; v[i] = m->r[vr[i]]; }
     return OK;
 }
 EXPORT int fmi2SetReal(C c, const VR *vr, size_t n, const double *v) {
     M *m = c;
     for (size_t i = 0; i < n; i++) {
-        switch (vr[i]) { case 0: m->u = v[i]; break; case 2: m->fault_time = v[i]; break;
-                         default: return ERR; }
+        if (vr[i] > 6 || vr[i] == 2 || vr[i] == 3) return ERR;
+        m->r[vr[i]] = v[i];
     }
     return OK;
 }
 EXPORT int fmi2GetInteger(C c, const VR *vr, size_t n, int *v) {
     M *m = c;
-    for (size_t i = 0; i < n; i++) { if (vr[i] != 3) return ERR; v[i] = m->fault; }
+    for (size_t i = 0; i < n; i++) { if (vr[i] != 7) return ERR; v[i] = m->fault; }
     return OK;
 }
 EXPORT int fmi2SetInteger(C c, const VR *vr, size_t n, const int *v) {
     M *m = c;
-    for (size_t i = 0; i < n; i++) { if (vr[i] != 3) return ERR; m->fault = v[i]; }
+    for (size_t i = 0; i < n; i++) { if (vr[i] != 7) return ERR; m->fault = v[i]; }
     return OK;
 }
 EXPORT int fmi2GetBoolean(C c, const VR *vr, size_t n, int *v) { return n ? ERR : OK; }
@@ -67,11 +70,12 @@ EXPORT int fmi2GetString(C c, const VR *vr, size_t n, const char **v) { return n
 EXPORT int fmi2SetString(C c, const VR *vr, size_t n, const char *const *v) { return n ? ERR : OK; }
 EXPORT int fmi2DoStep(C c, double t, double h, int no_prior) {
     M *m = c;
-    if (m->fault != 0 && t >= m->fault_time) {
+    if (m->fault != 0 && t >= m->r[6]) {
         if (m->fault == 1) { volatile int *nothing = NULL; *nothing = 1; }
         if (m->fault == 2) { volatile int spin = 1; while (spin) {} }
     }
-    m->y = m->u;
+    m->r[2] += m->r[0] * h;
+    m->r[3] += m->r[1] * h;
     return OK;
 }
 EXPORT int fmi2CancelStep(C c) { return ERR; }
@@ -92,21 +96,36 @@ EXPORT int fmi2SetRealInputDerivatives(C c, const VR *vr, size_t n, const int *o
 EXPORT int fmi2GetRealOutputDerivatives(C c, const VR *vr, size_t n, const int *o, double *v) { return ERR; }
 """
 
+def _real(name, vr, causality, unit="mm"):
+    variability = "fixed" if causality == "parameter" else "continuous"
+    initial = ' initial="exact"' if causality == "output" else ""
+    start = ' start="0"'
+    return (f'<ScalarVariable name="{name}" valueReference="{vr}" causality="{causality}" '
+            f'variability="{variability}"{initial}><Real unit="{unit}"{start}/></ScalarVariable>')
+
+
 DESCRIPTION = f"""<?xml version="1.0" encoding="UTF-8"?>
-<fmiModelDescription fmiVersion="2.0" modelName="Faulty" guid="{GUID}" generationTool="gcc">
+<fmiModelDescription fmiVersion="2.0" modelName="XYServoPlant" guid="{GUID}" generationTool="gcc"
+    description="A misbehaving stand-in for the XY plant (tests/fmpy/helpers/faulty_fmu.py)">
   <CoSimulation modelIdentifier="Faulty" canHandleVariableCommunicationStepSize="true"/>
+  <UnitDefinitions><Unit name="mm"/><Unit name="mm/s"/><Unit name="s"/></UnitDefinitions>
   <ModelVariables>
-    <ScalarVariable name="u" valueReference="0" causality="input" variability="continuous"><Real start="0"/></ScalarVariable>
-    <ScalarVariable name="y" valueReference="1" causality="output" variability="continuous" initial="exact"><Real start="0"/></ScalarVariable>
-    <ScalarVariable name="fault_time" valueReference="2" causality="parameter" variability="fixed"><Real start="0"/></ScalarVariable>
-    <ScalarVariable name="fault" valueReference="3" causality="parameter" variability="fixed"><Integer start="0"/></ScalarVariable>
+    {_real("u.x", 0, "input", "mm/s")}
+    {_real("u.y", 1, "input", "mm/s")}
+    {_real("pos.x", 2, "output")}
+    {_real("pos.y", 3, "output")}
+    {_real("pos0.x", 4, "parameter")}
+    {_real("pos0.y", 5, "parameter")}
+    {_real("fault_time", 6, "parameter", "s")}
+    <ScalarVariable name="fault" valueReference="7" causality="parameter" variability="fixed"><Integer start="0"/></ScalarVariable>
   </ModelVariables>
-  <ModelStructure><Outputs><Unknown index="2"/></Outputs><InitialUnknowns><Unknown index="2"/></InitialUnknowns></ModelStructure>
+  <ModelStructure><Outputs><Unknown index="3"/><Unknown index="4"/></Outputs>
+    <InitialUnknowns><Unknown index="3"/><Unknown index="4"/></InitialUnknowns></ModelStructure>
 </fmiModelDescription>
 """
 
-# Two Faulty units in a ring: a's y feeds b's u and back (values stay 0; the fault is what
-# matters).
+# Two Faulty units side by side, unconnected (a position onto a velocity command is a
+# unit mismatch the master refuses).
 LOOP = """<?xml version="1.0" encoding="UTF-8"?>
 <ssd:SystemStructureDescription xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
     xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -115,21 +134,17 @@ LOOP = """<?xml version="1.0" encoding="UTF-8"?>
     <ssd:Elements>
       <ssd:Component name="a" source="Faulty.fmu">
         <ssd:Connectors>
-          <ssd:Connector name="u" kind="input"><ssc:Real/></ssd:Connector>
-          <ssd:Connector name="y" kind="output"><ssc:Real/></ssd:Connector>
+          <ssd:Connector name="u.x" kind="input"><ssc:Real/></ssd:Connector>
+          <ssd:Connector name="pos.x" kind="output"><ssc:Real/></ssd:Connector>
         </ssd:Connectors>
       </ssd:Component>
       <ssd:Component name="b" source="Faulty.fmu">
         <ssd:Connectors>
-          <ssd:Connector name="u" kind="input"><ssc:Real/></ssd:Connector>
-          <ssd:Connector name="y" kind="output"><ssc:Real/></ssd:Connector>
+          <ssd:Connector name="u.x" kind="input"><ssc:Real/></ssd:Connector>
+          <ssd:Connector name="pos.x" kind="output"><ssc:Real/></ssd:Connector>
         </ssd:Connectors>
       </ssd:Component>
     </ssd:Elements>
-    <ssd:Connections>
-      <ssd:Connection startElement="a" startConnector="y" endElement="b" endConnector="u"/>
-      <ssd:Connection startElement="b" startConnector="y" endElement="a" endConnector="u"/>
-    </ssd:Connections>
   </ssd:System>
 </ssd:SystemStructureDescription>
 """
