@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use contour_cosim::ssp::StartValues;
 use contour_cosim::watchdog::Watchdog;
-use contour_cosim::{End, Error, Experiment, Recording, Scheme, Simulation, System, Trace, Value};
+use contour_cosim::{End, Error, Experiment, Recording, Scheme, Simulation, System, Trace};
 
 const USAGE: &str = r#"usage: contour-cosim run LOOP.ssd|LOOP.ssp [options]
        contour-cosim batch LOOP.ssd|LOOP.ssp [options] [--runs FILE]
@@ -261,10 +261,7 @@ fn csv(trace: &Trace) -> String {
 }
 
 /// One run line of a batch: its id and its start values.
-fn run_line(
-    line: &str,
-    system: &System,
-) -> Result<(serde_json::Value, StartValues), Error> {
+fn run_line(line: &str, system: &System) -> Result<(serde_json::Value, StartValues), Error> {
     let bad = |why: &str| Error::Refused(format!("run line {line:?}: {why}"));
     let parsed: serde_json::Value = serde_json::from_str(line).map_err(|e| bad(&e.to_string()))?;
     let id = parsed

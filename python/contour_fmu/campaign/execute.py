@@ -231,7 +231,8 @@ def run_on_dask(campaign, store, client, progress=None, batch_fn=None):
     """Every pending batch as a task on `client`'s workers; rows written as tasks finish.
     No more batches are in flight than the workers have threads, so a worker's death
     loses only what it was running, on any scheduler; the next batch is submitted before
-    the finished one's rows are written, so a worker does not wait for the disk."""
+    the finished one's rows are written, so a worker does not wait for the disk. Returns
+    the number of tasks submitted."""
     with needs("campaign"):
         from distributed import as_completed
 
@@ -258,8 +259,10 @@ def run_on_dask(campaign, store, client, progress=None, batch_fn=None):
             submitted[future.key] = (batch, attempt)
             running.add(future)
 
+    tasks = 0
     try:
         top_up()
+        tasks = len(submitted)
         while running.count() or retries or pending:
             future = next(running)
             batch, attempt = submitted.pop(future.key)
@@ -268,13 +271,16 @@ def run_on_dask(campaign, store, client, progress=None, batch_fn=None):
             sizer.observe(rows)
             if again:
                 retries.append((batch, 2))
+            before = len(submitted)
             top_up()
+            tasks += len(submitted) - before
             _write(store, progress, rows)
     finally:
         try:
             client.unregister_worker_plugin(plugin.name)
         except Exception:  # noqa: BLE001  a scheduler already gone keeps nothing
             pass
+    return tasks
 
 
 def execute(campaign, out, *, scheduler=None, workers=None, resume=False, serial=False,

@@ -1,13 +1,14 @@
 """Runs on a worker: a batch of a campaign's runs through contour-cosim, the native master
 (engine = "native", the default), in a child process.
 
-The child steps the loop's FMUs at their own cost and streams each run's trajectory back
-(`contour-cosim batch`: a JSON line per run, then its rows as f64); the metrics are
-computed here by the same code as for the fmpy engine, on the same trajectory, so both
-engines give the same rows. The child isolates the worker from the FMUs: an FMU that
-crashes its process (a segfault in a foreign FMU) or a call that hangs past the campaign's
-`timeout` costs the run under way, recorded as "crashed" (with the signal) or "timeout";
-the batch goes on in a new child with the runs after it.
+The child steps the loop's FMUs at their own cost and answers each run line with the
+run's trajectory (`contour-cosim batch`: a JSON line per run, then its rows as f64); it
+stays up for the worker's next batches, so the FMUs are unpacked and loaded once per
+worker. The metrics are computed here by the same code as for the fmpy engine, on the
+same trajectory, so both engines give the same rows. The child isolates the worker from
+the FMUs: an FMU that crashes its process (a segfault in a foreign FMU) or a call that
+hangs past the campaign's `timeout` costs the run under way, recorded as "crashed" (with
+the signal) or "timeout"; the next run starts a new child.
 
 A worker gets the FMU archives and the contour-cosim program as bytes from the campaign's
 worker plugin (execute.CampaignFiles), as it gets the FMUs for fmpy; nothing needs to be
@@ -15,7 +16,6 @@ installed on it but this package.
 """
 
 import json
-import shutil
 import signal
 import subprocess
 import tempfile
@@ -79,12 +79,11 @@ def text(value):
     return str(value)
 
 
-def command(job, folder, runs_file):
-    """contour-cosim's command line for a batch of the job."""
+def command(job, folder):
+    """contour-cosim's command line for the job's runs, read from its standard input."""
     columns = _columns(job.loop)
     args = [str(folder / PROGRAM), "batch", str(folder / "loop.ssd"), "--step", repr(job.step),
-            "--record", ",".join(f"{u}.{n}" for u, n in columns), "--timeout", repr(job.timeout),
-            "--runs", str(runs_file)]
+            "--record", ",".join(f"{u}.{n}" for u, n in columns), "--timeout", repr(job.timeout)]
     if job.stop is None:
         args += ["--until", "interpolator.done", "--settle", repr(job.settle),
                  "--max-stop", repr(job.max_stop)]
@@ -96,11 +95,6 @@ def command(job, folder, runs_file):
 def _columns(loop):
     """The recorded columns, unit by unit in stepping order (as the fmpy runner reads them)."""
     return [(unit, n) for unit in ORDER for u, n in LOOPS[loop].recorded if u == unit]
-
-
-def _read_exactly(stream, size):
-    data = stream.read(size)
-    return data if data is not None and len(data) == size else None
 
 
 def _trace(job, table, steps):
@@ -127,65 +121,108 @@ def _signal_name(number):
         return f"signal {number}"
 
 
-def _one_child(job, folder, runs, scratch):
-    """Rows of `runs` from one contour-cosim process, up to the first run it did not finish
-    (a crash or a timeout, which gets its row); returns (rows, runs not started)."""
-    runs_file = scratch / "runs.jsonl"
-    with open(runs_file, "w") as f:
-        for run_id, start_values in runs:
-            starts = [[unit, name, text(value)] for unit in ORDER
-                      for name, value in start_values.get(unit, {}).items()]
-            f.write(json.dumps({"run": run_id, "start": starts}) + "\n")
-    errors = open(scratch / "stderr.txt", "w+b")
-    child = subprocess.Popen(command(job, folder, runs_file), stdout=subprocess.PIPE, stderr=errors)
-    rows, index = [], 0
+class Ended(Exception):
+    """The child process ended before it answered a run: (exit status, its stderr)."""
+
+
+class Child:
+    """A contour-cosim process of the job, kept for the batches that follow (its FMUs
+    unpacked and loaded once per worker process): a run line in, the run's result out."""
+
+    def __init__(self, job, folder):
+        self.errors = tempfile.TemporaryFile(dir=folder)
+        self.process = subprocess.Popen(command(job, folder), stdin=subprocess.PIPE,
+                                        stdout=subprocess.PIPE, stderr=self.errors)
+        header = self.process.stdout.readline()
+        if not header:
+            self.ended()
+        self.width = len(json.loads(header)["columns"])
+
+    def ended(self):
+        """Raises Ended with the exit status and what the child said."""
+        for stream in (self.process.stdin, self.process.stdout):
+            try:
+                stream.close()
+            except OSError:  # a broken pipe: the child is gone
+                pass
+        status = self.process.wait()
+        self.errors.seek(0)
+        said = self.errors.read().decode(errors="replace").strip()
+        self.errors.close()
+        raise Ended(status, said)
+
+    def run(self, run_id, start_values):
+        """(head, table): the child's result line and, when ok, its rows t_0..t_k."""
+        starts = [[unit, name, text(value)] for unit in ORDER
+                  for name, value in start_values.get(unit, {}).items()]
+        try:
+            self.process.stdin.write((json.dumps({"run": run_id, "start": starts}) + "\n").encode())
+            self.process.stdin.flush()
+        except OSError:
+            self.ended()
+        line = self.process.stdout.readline()
+        if not line:
+            self.ended()
+        head = json.loads(line)
+        if head["run"] != run_id:
+            raise RunFailed(f"contour-cosim answered run {head['run']} for run {run_id}")
+        if head["status"] != "ok":
+            return head, None
+        size = (head["steps"] + 1) * self.width * 8
+        data = self.process.stdout.read(size)
+        if data is None or len(data) != size:
+            self.ended()
+        return head, np.frombuffer(data, dtype="<f8").reshape(head["steps"] + 1, self.width)
+
+    def close(self):
+        try:
+            self.ended()
+        except Ended:
+            pass
+
+
+_children = {}  # command line -> Child, for this process's lifetime
+
+
+def _child(job, folder):
+    key = tuple(command(job, folder))
+    if key not in _children:
+        # One child at a time: another campaign's is not needed any more.
+        for other in _children.values():
+            other.close()
+        _children.clear()
+        _children[key] = Child(job, folder)
+    return _children[key]
+
+
+def _ended_row(run_id, ended, began, metrics):
+    """The row of the run a child's end took: crashed, timeout; anything else raises."""
+    status, said = ended.args
+    if status < 0:
+        return _row(run_id, "crashed", f"the FMUs' process was killed by {_signal_name(-status)} "
+                    f"(signal {-status})", began, metrics)
+    if status == native.TIMEOUT_STATUS:
+        return _row(run_id, "timeout", said.removeprefix("contour-cosim: "), began, metrics)
+    raise RunFailed(f"contour-cosim stopped (exit status {status}): {said[-2000:]}")
+
+
+def run_one(job, folder, run_id, start_values):
+    """The row of one run through this process's child (made anew after a crash)."""
+    began = time.perf_counter()
     try:
-        began = time.perf_counter()
-        header = child.stdout.readline()
-        width = len(json.loads(header)["columns"]) if header else 0
-        while index < len(runs):
-            line = child.stdout.readline()
-            if not line:
-                break
-            head = json.loads(line)
-            run_id, start_values = runs[index]
-            if head["run"] != run_id:
-                raise RunFailed(f"contour-cosim answered run {head['run']} for run {run_id}")
-            if head["status"] == "ok":
-                steps = head["steps"]
-                data = _read_exactly(child.stdout, (steps + 1) * width * 8)
-                if data is None:
-                    break
-                table = np.frombuffer(data, dtype="<f8").reshape(steps + 1, width)
-                try:
-                    values = campaign_metrics.compute(
-                        job.loop, job.metrics, _trace(job, table, steps),
-                        start_values.get("interpolator", {}), job.interpolator_variables)
-                    rows.append(_row(run_id, "ok", "", began, job.metrics, values))
-                except Exception as e:  # noqa: BLE001  every failure of a run is its row's message
-                    rows.append(_row(run_id, "error", f"{type(e).__name__}: {e}", began, job.metrics))
-            else:
-                rows.append(_row(run_id, "error", head["message"], began, job.metrics))
-            index += 1
-            began = time.perf_counter()
-    finally:
-        child.stdout.close()
-        status = child.wait()
-        errors.seek(0)
-        said = errors.read().decode(errors="replace").strip()
-        errors.close()
-    if index < len(runs):
-        run_id = runs[index][0]
-        if status < 0:
-            rows.append(_row(run_id, "crashed", f"the FMUs' process was killed by "
-                             f"{_signal_name(-status)} (signal {-status})", began, job.metrics))
-        elif status == native.TIMEOUT_STATUS:
-            rows.append(_row(run_id, "timeout", said.removeprefix("contour-cosim: "), began,
-                             job.metrics))
-        else:
-            raise RunFailed(f"contour-cosim stopped (exit status {status}): {said[-2000:]}")
-        index += 1
-    return rows, runs[index:]
+        head, table = _child(job, folder).run(run_id, start_values)
+    except Ended as ended:
+        _children.pop(tuple(command(job, folder)), None)
+        return _ended_row(run_id, ended, began, job.metrics)
+    if table is None:
+        return _row(run_id, "error", head["message"], began, job.metrics)
+    try:
+        values = campaign_metrics.compute(job.loop, job.metrics, _trace(job, table, head["steps"]),
+                                          start_values.get("interpolator", {}),
+                                          job.interpolator_variables)
+    except Exception as e:  # noqa: BLE001  every failure of a run is its row's message
+        return _row(run_id, "error", f"{type(e).__name__}: {e}", began, job.metrics)
+    return _row(run_id, "ok", "", began, job.metrics, values)
 
 
 def run_batch(job, runs, archives=None):
@@ -201,15 +238,7 @@ def run_batch(job, runs, archives=None):
     else:
         raise RunFailed(f"{worker_name()} has no copy of the campaign's FMUs and contour-cosim "
                         "(the campaign's worker plugin did not run here)")
-    scratch = Path(tempfile.mkdtemp(prefix="batch-", dir=folder))
-    rows = []
-    try:
-        while runs:
-            done, runs = _one_child(job, folder, runs, scratch)
-            rows.extend(done)
-    finally:
-        shutil.rmtree(scratch, ignore_errors=True)
-    return rows
+    return [run_one(job, folder, run_id, start_values) for run_id, start_values in runs]
 
 
 def local_program():
