@@ -151,6 +151,8 @@ bench: fmus ccc-tune $(VENV)/.test-installed
 	-$(PYTHON) benches/tuning_vs_pyswarms_fmu.py --particles 6 --iters 5 \
 		--json $(BENCH_REPORT)/tuning_vs_pyswarms_fmu.json
 	-$(PYTHON) benches/pso_tables.py --json $(BENCH_REPORT)/pso_tables.json
+	-$(CARGO) build --release -p contour-fmu --example closed_loop_timing
+	-$(PYTHON) benches/native_throughput.py --json $(BENCH_REPORT)/native_throughput.json
 	-$(PYTHON) benches/campaign_scaling.py --json $(BENCH_REPORT)/campaign_scaling.json
 	$(PYTHON) benches/report.py
 

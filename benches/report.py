@@ -3,7 +3,7 @@
 Reads what the bench parts leave in <target>/bench-report/ (<target> is $CARGO_TARGET_DIR,
 else target/): fmu_abi.json (benches/fmu_abi.rs), c_harness.json and
 c_harness_callgrind.json (benches/c_harness/run.sh), fuzzy_vs_skfuzzy.json,
-tuning_vs_pyswarms_fmu.json, pso_tables.json and campaign_scaling.json (the Python
+tuning_vs_pyswarms_fmu.json, pso_tables.json, native_throughput.json and campaign_scaling.json (the Python
 benches' --json), plus
 criterion's own estimates in <target>/criterion/. Prints the page and writes it to
 <target>/bench-report/report.md. A figure that is missing, or older than the run's start
@@ -103,6 +103,7 @@ def page():
     tuning = load("tuning_vs_pyswarms_fmu.json")
     pso = load("pso_tables.json")
     campaign = load("campaign_scaling.json")
+    throughput = load("native_throughput.json")
     harness = load("c_harness.json")
     instructions = load("c_harness_callgrind.json").get("instructions_per_sample") or {}
     med = lambda name: dig(abi, "median_s_per_sample", name)  # noqa: E731
@@ -171,15 +172,41 @@ def page():
     p100k, p1k = criterion("five_axis/path_100k"), criterion("five_axis/path_1k")
     lines.append(line("in process (five_axis, criterion medians)", ratio(p100k, p1k), f"{seconds(p100k)} vs {seconds(p1k)}", "{:.3f}"))
 
-    lines.append("\nCampaigns on a Dask LocalCluster (two-axis circle runs, medians of paired rounds)")
+    lines.append("\nCo-simulation through the FMUs, two-axis circle (2 001 samples, fuzzy CCC), runs/s on one core")
+    rates = throughput.get("runs_per_s") or {}
+    fmpy_rate = rates.get("fmpy_campaign")
+    native_over = dig(throughput, "native_over_fmpy")
+    lines.append(line("native master (contour-cosim) / campaign runner on fmpy", native_over,
+                      (f"{rates.get('native', 0):.4g} vs {fmpy_rate:.3g} runs/s; target >= 30x: "
+                       + ("met" if native_over >= 30 else "MISSED")) if native_over and fmpy_rate else "",
+                      "{:.1f}x"))
+    over_in_process = dig(throughput, "native_over_in_process")
+    lines.append(line("time per run, native master / in-process simulator", over_in_process,
+                      (f"in process {rates.get('in_process', 0):.4g} runs/s; target <= 2x: "
+                       + ("met" if over_in_process <= 2 else "MISSED")) if over_in_process else "",
+                      "{:.2f}x"))
+    lines.append(line("campaign batch, native engine / fmpy engine (metrics in Python included)",
+                      dig(throughput, "native_campaign_over_fmpy"),
+                      f"{rates.get('native_campaign', 0):.4g} runs/s" if rates else "", "{:.1f}x"))
+
+    engine = campaign.get("engine", "fmpy")
+    lines.append(f"\nCampaigns on a Dask LocalCluster ({engine} engine, two-axis circle runs, medians of paired rounds)")
     one, two = dig(campaign, "one_worker_runs_per_s"), dig(campaign, "two_workers_runs_per_s")
-    lines.append(line("runs/s, 2 workers / 1 worker", dig(campaign, "scaling_two_over_one"),
-                      f"{two:.3g} vs {one:.3g} runs/s" if one and two else ""))
+    scaling = dig(campaign, "scaling_two_over_one")
+    lines.append(line("runs/s, 2 workers / 1 worker", scaling,
+                      (f"{two:.4g} vs {one:.4g} runs/s; target >= 1.7x: " + ("met" if scaling >= 1.7 else "MISSED"))
+                      if one and two and scaling else ""))
     overhead, plain = dig(campaign, "overhead_per_run_s"), dig(campaign, "plain_runs_per_s")
-    lines.append(line("time per run, 1 worker / plain Python loop",
+    lines.append(line("time per run, 1 worker / plain process",
                       None if dig(campaign, "overhead_fraction") is None else 1 + campaign["overhead_fraction"],
-                      f"{seconds(overhead)} more per run; plain loop {plain:.3g} runs/s" if overhead and plain else "",
+                      f"{seconds(overhead)} more per run; plain {plain:.4g} runs/s" if overhead and plain else "",
                       "{:.3f}"))
+    million = campaign.get("million_runs") or {}
+    if million:
+        lines.append(f"  costs: {seconds(campaign['per_task_s'])} per task, {seconds(campaign['per_file_s'])} "
+                     f"per row file, {seconds(campaign['per_row_s'])} per row; a 1 M-run campaign: "
+                     f"{million['tasks']} tasks, {million['hours_2_local_workers']:.2f} h on 2 local workers, "
+                     f"{million['hours_64_workers'] * 60:.1f} min on 64 workers")
 
     small = [("fuzzy eval", criterion("fuzzy_evaluate_three_outputs")),
              ("2-axis sample", criterion("controller_sample_fuzzy")),
