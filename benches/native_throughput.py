@@ -10,7 +10,9 @@ ways, timed in turn in each round:
 
 Targets (issue 25): native ≥ 30× fmpy, and within 2× of in-process. The ratios are the
 medians of the rounds' ratios (the machine's speed drifts; each round times the four
-within seconds).
+within seconds). Then `ccc-tune` at the paper's budget (50 × 100 circle runs, both cores)
+in process and with every candidate through the FMUs (`--loop`), twice each in turn
+(target: ≤ 3×), and whether both found the same optimum.
 
     .venv/bin/python benches/native_throughput.py [--rounds 5] [--json FILE]
 """
@@ -98,6 +100,21 @@ def campaign_batch(directory, engine, runs):
     return (time.perf_counter() - began) / runs
 
 
+def tuning(directory):
+    """(seconds in process, seconds through the FMUs, same optimum) of ccc-tune at the
+    paper's budget."""
+    spent, found = {}, {}
+    for name, extra in (("in_process", []), ("fmus", ["--loop", str(repo.fmu_dir() / "two_axis.ssd")])):
+        out = Path(directory) / f"tuned-{name}.json"
+        began = time.perf_counter()
+        subprocess.run([str(repo.ccc_tune()), "--out", str(out), *extra], check=True,
+                       capture_output=True)
+        spent[name] = time.perf_counter() - began
+        found[name] = json.loads(out.read_text())
+    same = all(found["fmus"][k] == found["in_process"][k] for k in ("factors", "fitness_mm", "history_mm"))
+    return spent["in_process"], spent["fmus"], same
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=5)
@@ -113,6 +130,7 @@ def main():
             starts.append(start)
             times["native_campaign"].append(campaign_batch(directory, "native", RUNS["native_campaign"]))
             times["fmpy_campaign"].append(campaign_batch(directory, "fmpy", RUNS["fmpy_campaign"]))
+        tunes = [tuning(directory) for _ in range(2)]
     per_round = lambda a, b: statistics.median(x / y for x, y in zip(times[a], times[b]))  # noqa: E731
     figures = {
         "rounds": args.rounds, "runs_per_round": RUNS, "seconds_per_run": times,
@@ -121,6 +139,9 @@ def main():
         "native_campaign_over_fmpy": per_round("fmpy_campaign", "native_campaign"),
         "native_over_in_process": per_round("native", "in_process"),
         "native_start_s": statistics.median(starts),
+        "tuning_s": {"in_process": [t[0] for t in tunes], "fmus": [t[1] for t in tunes]},
+        "tuning_fmus_over_in_process": statistics.median(t[1] / t[0] for t in tunes),
+        "tuning_same_optimum": all(t[2] for t in tunes),
     }
     rate = figures["runs_per_s"]
     print(f"two-axis circle, 2 001 samples, fuzzy CCC; runs/s on one core, medians of {args.rounds} rounds")
@@ -133,6 +154,10 @@ def main():
     print(f"  native time / in-process time {figures['native_over_in_process']:6.2f}x (target <= 2)")
     print(f"  contour-cosim's start (unpack and load three FMUs; once per campaign worker): "
           f"{figures['native_start_s'] * 1e3:.0f} ms")
+    print(f"  ccc-tune, paper's budget, through the FMUs / in process: "
+          f"{figures['tuning_fmus_over_in_process']:.2f}x (target <= 3; "
+          + ", ".join(f"{f:.1f} s vs {i:.1f} s" for i, f, _ in tunes)
+          + f"); same optimum: {figures['tuning_same_optimum']}")
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)
         args.json.write_text(json.dumps(figures, indent=1) + "\n")

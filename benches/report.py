@@ -185,6 +185,11 @@ def page():
                       (f"in process {rates.get('in_process', 0):.4g} runs/s; target <= 2x: "
                        + ("met" if over_in_process <= 2 else "MISSED")) if over_in_process else "",
                       "{:.2f}x"))
+    tune_ratio = dig(throughput, "tuning_fmus_over_in_process")
+    same = throughput.get("tuning_same_optimum")
+    lines.append(line("ccc-tune at the paper's budget, --loop / in process", tune_ratio,
+                      (f"target <= 3x: " + ("met" if tune_ratio <= 3 else "MISSED")
+                       + f"; same optimum: {'yes' if same else 'NO'}") if tune_ratio else "", "{:.2f}x"))
     lines.append(line("campaign batch, native engine / fmpy engine (metrics in Python included)",
                       dig(throughput, "native_campaign_over_fmpy"),
                       f"{rates.get('native_campaign', 0):.4g} runs/s" if rates else "", "{:.1f}x"))

@@ -97,6 +97,18 @@ impl SystemStructure {
         self.components.iter().find(|c| c.name == name)
     }
 
+    /// Runs the component `name` from the FMU `source` instead (the same connectors).
+    pub fn replace_source(&mut self, name: &str, source: &Path) -> Result<(), Error> {
+        let file = self.file.display().to_string();
+        let component = self
+            .components
+            .iter_mut()
+            .find(|c| c.name == name)
+            .ok_or_else(|| Error::Refused(format!("{file}: no component {name:?} to replace")))?;
+        component.source = source.to_path_buf();
+        Ok(())
+    }
+
     /// The start values of the parameter set `name`.
     pub fn parameter_set(&self, name: &str) -> Result<&StartValues, Error> {
         self.parameter_sets

@@ -91,7 +91,11 @@ impl System {
     /// Reads the SSP file `file` and loads its FMUs (an FMU named by several components is
     /// unpacked once); every error names the file it is about.
     pub fn load(file: &Path) -> Result<System, Error> {
-        let structure = SystemStructure::read(file)?;
+        System::from_structure(SystemStructure::read(file)?)
+    }
+
+    /// Loads the FMUs of `structure` (read, and perhaps with a component's FMU replaced).
+    pub fn from_structure(structure: SystemStructure) -> Result<System, Error> {
         let mut loaded: HashMap<PathBuf, Arc<Fmu>> = HashMap::new();
         let mut units = Vec::new();
         for name in &structure.order {

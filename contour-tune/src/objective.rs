@@ -28,7 +28,7 @@ pub const UPPER: [f64; 5] = [10.0, 10.0, 340.0, 6800.0, 3.8];
 
 /// Fitness of a run that diverged: above any stable run's (those abort at 10 mm), and
 /// lower the later the divergence, so the swarm still sees a slope.
-const PENALTY_MM: f64 = 1000.0;
+pub const PENALTY_MM: f64 = 1000.0;
 
 /// What the swarm minimises.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -97,6 +97,11 @@ impl ContourObjective {
 
     pub fn ts(&self) -> f64 {
         self.simulator.config().ts
+    }
+
+    /// The prepared closed loop (reference samples, true-error index).
+    pub fn simulator(&self) -> &Simulator {
+        &self.simulator
     }
 
     /// Metrics of the closed loop with these factors.

@@ -41,6 +41,8 @@ def tune(program, out, *args):
     (["--plant", "granite"], "unknown plant 'granite'"),
     (["--threads", "0"], "--threads must be at least 1"),
     (["--bogus", "1"], "unknown option '--bogus'"),
+    (["--loop", "/nonexistent/loop.ssd"], "--loop: /nonexistent/loop.ssd: cannot read it"),
+    (["--plant", "/nonexistent/Plant.fmu"], "/nonexistent/Plant.fmu: no such FMU"),
 ])
 def test_bad_input_is_refused_and_nothing_is_written(ccc_tune, tmp_path, args, words):
     out = tmp_path / "tuned.json"
@@ -97,3 +99,24 @@ def test_the_circle_tunes_at_the_papers_feed_however_it_is_spelled(ccc_tune, tmp
     assert done.returncode == 0, done.stderr
     # The paper's circle: 10 mm radius, one turn in 2 s.
     assert json.loads(out.read_text())["settings"]["feed_mm_per_s"] == 10 * np.pi
+
+
+def test_tuning_through_the_fmus_finds_the_in_process_optimum_bit_for_bit(ccc_tune, fmu_dir, tmp_path):
+    """ccc-tune --loop (every candidate through the shipped two-axis SSP file and its FMUs
+    in contour-cosim) and --plant (the same loop, the plant FMU named): the same history,
+    factors and fitness as the in-process tuner with the same seed, because the FMU loop
+    reproduces the in-process one bit for bit."""
+    budget = ["--path", "trident", "--swarm", 6, "--iters", 3, "--seed", 5, "--threads", 2]
+    results = {}
+    for name, extra in (("in_process", []), ("loop", ["--loop", fmu_dir / "two_axis.ssd"]),
+                        ("plant", ["--plant", fmu_dir / "XYServoPlant.fmu"])):
+        out = tmp_path / f"{name}.json"
+        done = tune(ccc_tune, out, *budget, *extra)
+        assert done.returncode == 0, done.stderr
+        results[name] = json.loads(out.read_text())
+    for name in ("loop", "plant"):
+        for key in ("factors", "fitness_mm", "history_mm"):
+            assert results[name][key] == results["in_process"][key], (name, key)
+        assert results[name]["settings"]["loop"] == str(fmu_dir / "two_axis.ssd")
+    assert "loop" not in results["in_process"]["settings"]
+    assert 0 < results["loop"]["fitness_mm"] < 0.01  # mm: a few µm on the trident

@@ -142,9 +142,7 @@ impl<const D: usize, P: ReferencePath<D>> Simulator<D, P> {
             plant: ServoAxes::new(self.config.plant, start.point),
             controller,
             k: 0,
-            hint: start.u,
-            acc: Accumulator::default(),
-            divergence: None,
+            judge: Judge::new(self),
             finished: false,
         })
     }
@@ -167,6 +165,81 @@ impl<const D: usize, P: ReferencePath<D>> Simulator<D, P> {
     /// Metrics with another controller configuration, without storing the time series.
     pub fn metrics_with(&self, controller: &ControllerConfig<D>) -> Result<Metrics, ConfigError> {
         Ok(self.start_with(controller)?.finish())
+    }
+
+    /// Metrics of a run made elsewhere (the same loop through FMUs, say) from its actual
+    /// positions at t_0, t_1, …: each judged as a run here judges its sample (the same
+    /// true error, search hint, abort rule and sums), so a loop that reproduces this
+    /// simulator gets these metrics bit for bit. Positions past the planned samples are
+    /// not judged.
+    pub fn metrics_of(&self, positions: impl IntoIterator<Item = Vector<D>>) -> Metrics {
+        let mut judge = Judge::new(self);
+        for (k, actual) in positions.into_iter().take(self.samples()).enumerate() {
+            if let Some(v) = actual.iter().copied().find(|v| !v.is_finite()) {
+                judge.diverge(self, k, DivergenceKind::NonFinite, v);
+            }
+            if judge.divergence.is_some() || judge.judge(self, k, actual).is_none() {
+                break;
+            }
+        }
+        judge.acc.metrics(judge.divergence)
+    }
+}
+
+/// What a run's samples are judged by: the true error (searched from the last sample's
+/// foot), the abort rule and the metrics' sums. A run here and [`Simulator::metrics_of`]
+/// share it, so they agree bit for bit.
+#[derive(Clone, Copy, Debug)]
+struct Judge {
+    /// Foot parameter of the previous sample's true error (search hint).
+    hint: f64,
+    acc: Accumulator,
+    divergence: Option<Divergence>,
+}
+
+impl Judge {
+    fn new<const D: usize, P: ReferencePath<D>>(sim: &Simulator<D, P>) -> Judge {
+        Judge {
+            hint: sim.references[0].u,
+            acc: Accumulator::default(),
+            divergence: None,
+        }
+    }
+
+    fn diverge<const D: usize, P: ReferencePath<D>>(
+        &mut self,
+        sim: &Simulator<D, P>,
+        k: usize,
+        kind: DivergenceKind,
+        value: f64,
+    ) {
+        self.divergence = Some(Divergence {
+            k,
+            t: k as f64 * sim.config.ts,
+            kind,
+            value,
+        });
+    }
+
+    /// The true error of sample `k` at `actual`, counted; None when the run diverges there.
+    fn judge<const D: usize, P: ReferencePath<D>>(
+        &mut self,
+        sim: &Simulator<D, P>,
+        k: usize,
+        actual: Vector<D>,
+    ) -> Option<f64> {
+        let truth = P::true_error(&sim.truth, actual, self.hint);
+        if !truth.error.is_finite() {
+            self.diverge(sim, k, DivergenceKind::NonFinite, truth.error);
+            return None;
+        }
+        if truth.error.abs() > sim.config.abort_error {
+            self.diverge(sim, k, DivergenceKind::ErrorLimit, truth.error.abs());
+            return None;
+        }
+        self.hint = truth.u;
+        self.acc.add(k >= sim.transient_k, truth.error.abs());
+        Some(truth.error)
     }
 }
 
@@ -204,17 +277,14 @@ pub struct Run<'a, const D: usize = 2, P: ReferencePath<D> = Path> {
     plant: ServoAxes<D>,
     controller: CrossCoupledController<P::Estimator, D>,
     k: usize,
-    /// Foot parameter of the previous sample's true error (search hint).
-    hint: f64,
-    acc: Accumulator,
-    divergence: Option<Divergence>,
+    judge: Judge,
     finished: bool,
 }
 
 impl<const D: usize, P: ReferencePath<D>> Run<'_, D, P> {
     /// Metrics of the samples so far.
     pub fn metrics(&self) -> Metrics {
-        self.acc.metrics(self.divergence)
+        self.judge.acc.metrics(self.judge.divergence)
     }
 
     /// Runs the remaining samples and returns the metrics.
@@ -234,12 +304,7 @@ impl<const D: usize, P: ReferencePath<D>> Run<'_, D, P> {
     }
 
     fn diverge(&mut self, kind: DivergenceKind, value: f64) -> Option<Record<D>> {
-        self.divergence = Some(Divergence {
-            k: self.k,
-            t: self.k as f64 * self.sim.config.ts,
-            kind,
-            value,
-        });
+        self.judge.diverge(self.sim, self.k, kind, value);
         self.finished = true;
         None
     }
@@ -270,15 +335,10 @@ impl<const D: usize, P: ReferencePath<D>> Iterator for Run<'_, D, P> {
         if let Some(v) = first_non_finite(&actual, &out.u) {
             return self.diverge(DivergenceKind::NonFinite, v);
         }
-        let truth = P::true_error(&sim.truth, actual, self.hint);
-        if !truth.error.is_finite() {
-            return self.diverge(DivergenceKind::NonFinite, truth.error);
-        }
-        if truth.error.abs() > sim.config.abort_error {
-            return self.diverge(DivergenceKind::ErrorLimit, truth.error.abs());
-        }
-        self.hint = truth.u;
-        self.acc.add(k >= sim.transient_k, truth.error.abs());
+        let Some(true_error) = self.judge.judge(sim, k, actual) else {
+            self.finished = true;
+            return None;
+        };
         if k + 1 < sim.references.len() {
             self.plant.step(out.u, ts);
             self.k += 1;
@@ -291,7 +351,7 @@ impl<const D: usize, P: ReferencePath<D>> Iterator for Run<'_, D, P> {
             t: k as f64 * ts,
             reference: reference.point,
             actual,
-            true_error: truth.error,
+            true_error,
             estimated_error: out.contour.error,
             gains: [kp, ki, kd],
             u: out.u,
@@ -318,6 +378,32 @@ mod tests {
         let s = Simulator::new(c).unwrap();
         assert_eq!(s.samples(), 3001);
         assert!(s.references()[3000].done);
+    }
+
+    #[test]
+    fn metrics_of_a_runs_positions_are_the_runs_metrics_bit_for_bit() {
+        let mut config = SimConfig::builtin("trident").unwrap();
+        config.transient = 0.1;
+        let sim = Simulator::new(config).unwrap();
+        let run = sim.run();
+        assert_eq!(
+            sim.metrics_of(run.trace.actual.iter().copied()),
+            run.metrics
+        );
+        assert!(run.metrics.settled_samples < run.metrics.samples);
+        // A position that is not finite ends the judged run there, as a run here ends.
+        let mut positions = run.trace.actual.clone();
+        positions[700].x = f64::NAN;
+        let m = sim.metrics_of(positions);
+        assert_eq!((m.samples, m.divergence.unwrap().k), (700, 700));
+        assert_eq!(m.divergence.unwrap().kind, DivergenceKind::NonFinite);
+        // One far off the path is an error-limit divergence.
+        let mut positions = run.trace.actual.clone();
+        positions[10].y += 100.0;
+        assert_eq!(
+            sim.metrics_of(positions).divergence.unwrap().kind,
+            DivergenceKind::ErrorLimit
+        );
     }
 
     #[test]

@@ -11,6 +11,8 @@ use std::time::Instant;
 
 use contour_core::path::Path;
 use contour_core::sim::preset_feed;
+use contour_cosim::{System, SystemStructure};
+use contour_tune::fmu_objective::FmuObjective;
 use contour_tune::objective::{ContourObjective, Fitness, FACTOR_NAMES, LOWER, UPPER};
 use contour_tune::{minimize, Algorithm, PsoSettings};
 use serde_json::json;
@@ -18,12 +20,18 @@ use serde_json::json;
 const USAGE: &str = "\
 usage: ccc-tune [--path circle|infinity|trident|FILE] [--feed MM_PER_S] [--swarm 50]
                 [--iters 100] [--algorithm improved|standard] [--seed 1] [--out tuned.json]
-                [--lower a,b,c,d,e] [--upper a,b,c,d,e] [--plant paper|mismatched]
-                [--fitness mean|max] [--threads N]
+                [--lower a,b,c,d,e] [--upper a,b,c,d,e] [--plant paper|mismatched|PLANT.fmu]
+                [--loop LOOP.ssd|LOOP.ssp] [--fitness mean|max] [--threads N]
 
 Minimises the mean (or max) |true contour error| of the closed loop interpolator -> fuzzy-PID CCC
 -> XYServoPlant over the factors (ke, kde, kp, ki, kd) of ContourCCC2D. The feed defaults
-to 10*pi mm/s on the circle (the paper's) and 50 mm/s elsewhere.";
+to 10*pi mm/s on the circle (the paper's) and 50 mm/s elsewhere.
+
+By default the loop runs in process, with the test plant's paper or mismatched data.
+--loop runs every candidate through the FMUs of an SSP file instead (units interpolator,
+controller, plant; contour-cosim, instances reused per thread); --plant PLANT.fmu runs them
+through the shipped two-axis loop with that plant (the loop of --loop, by default
+two_axis.ssd in the fmu folder beside this program's: target/fmu).";
 
 struct Options {
     path: String,
@@ -36,6 +44,7 @@ struct Options {
     lower: Vec<f64>,
     upper: Vec<f64>,
     plant: String,
+    loop_file: Option<PathBuf>,
     fitness: Fitness,
     threads: Option<usize>,
 }
@@ -66,6 +75,7 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
         lower: LOWER.to_vec(),
         upper: UPPER.to_vec(),
         plant: "paper".into(),
+        loop_file: None,
         fitness: Fitness::Mean,
         threads: None,
     };
@@ -100,6 +110,7 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
             "--lower" => o.lower = parse_list(value, "--lower")?,
             "--upper" => o.upper = parse_list(value, "--upper")?,
             "--plant" => o.plant = value.clone(),
+            "--loop" => o.loop_file = Some(PathBuf::from(value)),
             "--fitness" => o.fitness = value.parse()?,
             "--threads" => o.threads = Some(count("--threads")?),
             other => return Err(format!("unknown option '{other}'")),
@@ -123,7 +134,34 @@ fn run(o: Options) -> Result<(), String> {
     }
     let path = Path::from_spec(&o.path, None).map_err(|e| format!("--path: {e}"))?;
     let feed = o.feed.unwrap_or_else(|| preset_feed(&path));
-    let objective = ContourObjective::new(path, feed, &o.plant, o.fitness)?;
+    let plant_fmu = o.plant.ends_with(".fmu").then(|| PathBuf::from(&o.plant));
+    let preset = if plant_fmu.is_some() {
+        "paper"
+    } else {
+        o.plant.as_str()
+    };
+    let objective = ContourObjective::new(path, feed, preset, o.fitness)?;
+    let through_fmus = o.loop_file.is_some() || plant_fmu.is_some();
+    let loop_file = match (&o.loop_file, through_fmus) {
+        (Some(file), _) => Some(file.clone()),
+        (None, true) => Some(default_loop()?),
+        (None, false) => None,
+    };
+    let system = if let Some(loop_file) = &loop_file {
+        let mut structure = SystemStructure::read(loop_file).map_err(|e| format!("--loop: {e}"))?;
+        if let Some(plant) = &plant_fmu {
+            structure
+                .replace_source("plant", plant)
+                .map_err(|e| format!("--plant: {e}"))?;
+        }
+        Some(System::from_structure(structure).map_err(|e| e.to_string())?)
+    } else {
+        None
+    };
+    let objective = match &system {
+        Some(system) => Objective::Fmus(FmuObjective::new(system, objective, &o.path, feed)?),
+        None => Objective::InProcess(objective),
+    };
     let settings = PsoSettings {
         algorithm: o.algorithm,
         swarm: o.swarm,
@@ -171,7 +209,7 @@ fn run(o: Options) -> Result<(), String> {
         .zip(&result.best)
         .map(|(name, value)| (name.to_string(), json!(value)))
         .collect();
-    let document = json!({
+    let mut document = json!({
         "factors": factors,
         "fitness_mm": result.fitness,
         "history_mm": result.history,
@@ -180,7 +218,7 @@ fn run(o: Options) -> Result<(), String> {
             "feed_mm_per_s": feed,
             "plant": o.plant,
             "fitness": o.fitness,
-            "ts_s": objective.ts(),
+            "ts_s": objective.reference().ts(),
             "algorithm": settings.algorithm,
             "swarm": settings.swarm,
             "iterations": settings.iterations,
@@ -190,6 +228,9 @@ fn run(o: Options) -> Result<(), String> {
             "seed": settings.seed,
         },
     });
+    if let Some(loop_file) = &loop_file {
+        document["settings"]["loop"] = json!(loop_file.display().to_string());
+    }
     let text = serde_json::to_string_pretty(&document).map_err(|e| e.to_string())? + "\n";
     // Written beside the target and renamed into place: a failed write leaves nothing.
     let partial = o.out.with_extension("json.partial");
@@ -208,6 +249,38 @@ fn run(o: Options) -> Result<(), String> {
         o.out.display()
     );
     Ok(())
+}
+
+/// The in-process objective, or the same through FMUs.
+enum Objective<'a> {
+    InProcess(ContourObjective),
+    Fmus(FmuObjective<'a>),
+}
+
+impl Objective<'_> {
+    fn evaluate(&self, factors: &[f64]) -> f64 {
+        match self {
+            Objective::InProcess(o) => o.evaluate(factors),
+            Objective::Fmus(o) => o.evaluate(factors),
+        }
+    }
+
+    fn reference(&self) -> &ContourObjective {
+        match self {
+            Objective::InProcess(o) => o,
+            Objective::Fmus(o) => o.reference(),
+        }
+    }
+}
+
+/// The shipped two-axis loop beside this program's build: <target>/fmu/two_axis.ssd.
+fn default_loop() -> Result<PathBuf, String> {
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find this program: {e}"))?;
+    let target = exe
+        .parent()
+        .and_then(|p| p.parent())
+        .ok_or("this program has no target folder")?;
+    Ok(target.join("fmu").join("two_axis.ssd"))
 }
 
 fn main() -> ExitCode {
