@@ -145,8 +145,19 @@ impl Library {
         // SAFETY: loading a library runs its initialisers; an FMU's library is code the
         // user asked to run, which is what a co-simulation master is for.
         let library = unsafe { libloading::Library::new(&file) }.map_err(|e| {
+            // pythonfmu's binary takes Python's symbols from the process it is loaded into.
+            let text = e.to_string();
+            let hint = if text.contains("undefined symbol: _Py")
+                || text.contains("undefined symbol: Py")
+            {
+                " (a pythonfmu FMU: load libpython first, LD_PRELOAD=<its libpython3.x.so>, with \
+                 PYTHONPATH naming the site-packages that hold pythonfmu; \
+                 contour_fmu.native.pythonfmu_environment() gives both)"
+            } else {
+                ""
+            };
             Error::Refused(format!(
-                "{}: cannot load {}: {e}",
+                "{}: cannot load {}: {text}{hint}",
                 fmu.display(),
                 file.display()
             ))

@@ -7,6 +7,7 @@ same numbers bit for bit (tests/fmpy/test_native_runner.py).
 """
 
 import io
+import os
 import signal
 import subprocess
 from pathlib import Path
@@ -65,15 +66,32 @@ def arguments(ssd, parameter_set=None, start=None, step=None, stop=None, scheme=
     return args
 
 
-def run(ssd, **options):
+def pythonfmu_environment():
+    """What a pythonfmu FMU needs in contour-cosim's process, from this Python: its
+    libpython loaded first (pythonfmu's binary takes Python's symbols from the process,
+    which in fmpy is Python itself) and this Python's packages on the path (the FMU's
+    script imports pythonfmu)."""
+    import site
+    import sysconfig
+
+    library = Path(sysconfig.get_config_var("LIBDIR")) / sysconfig.get_config_var("LDLIBRARY")
+    if not library.is_file():
+        raise RunFailed(f"{library} is missing: this Python has no shared libpython, which a "
+                        f"pythonfmu FMU needs outside Python")
+    return {"LD_PRELOAD": str(library), "PYTHONPATH": os.pathsep.join(site.getsitepackages())}
+
+
+def run(ssd, env=None, **options):
     """Runs the loop of the SSP file `ssd` once: `parameter_set` (a name in the file),
     `start` ({unit: {variable: value}}, after the parameter set), `step` and `stop` (s;
     default: the file's default experiment), `scheme` ("gauss-seidel" or "jacobi"), `record`
     ([(unit, variable)]; default: every output), `timeout` (s per FMU call), or `until`
     ("unit.variable", a Boolean) with `settle` and `max_stop` instead of `stop`. Returns a
     structured array, one row per t_k from t_0 to the end: "time" and "unit.variable"
-    columns."""
-    done = subprocess.run(arguments(ssd, **options), capture_output=True, text=True)
+    columns. `env` holds further environment variables for the program (e.g.
+    `pythonfmu_environment()`)."""
+    done = subprocess.run(arguments(ssd, **options), capture_output=True, text=True,
+                          env=None if env is None else {**os.environ, **env})
     if done.returncode < 0:
         number = -done.returncode
         raise Crashed(number, f"contour-cosim was killed by {signal.Signals(number).name} "

@@ -111,6 +111,98 @@ def shipped(name):
     return read(SHIPPED / f"{name}.ssd")
 
 
+def _variables(fmu):
+    """{name: (causality, type)} of the FMU archive `fmu`, from its model description."""
+    import zipfile
+
+    with zipfile.ZipFile(fmu) as archive:
+        root = ET.fromstring(archive.read("modelDescription.xml"))
+    found = {}
+    for variable in root.iter("ScalarVariable"):
+        typed = next(child for child in variable if child.tag in ("Real", "Integer", "Enumeration",
+                                                                   "Boolean", "String"))
+        kind = "Integer" if typed.tag == "Enumeration" else typed.tag
+        found[variable.get("name")] = (variable.get("causality", "local"), kind)
+    return found
+
+
+def _xml_value(kind, value):
+    if kind == "Boolean":
+        return "true" if value else "false"
+    return repr(float(value)) if kind == "Real" else str(value)
+
+
+def write_loop(file, name, units, order, connections, initial_copies=(), start_values=None,
+               step=None):
+    """Writes a loop as an SSP 1.0 system structure description at `file`, readable by
+    `read`, by contour-cosim and by libcosim: `units` (component -> FMU file, an absolute
+    path or one relative to the file's folder), the Gauss-Seidel `order`, `connections` and
+    `initial_copies` as (source unit, output, destination unit, input), `start_values`
+    ({unit: {variable: value}}) as the parameter set "default", and `step` (s) as the
+    default experiment's fixed step. Each connector's kind and type come from its FMU's
+    model description."""
+    file = Path(file)
+    start_values = start_values or {}
+    described = {unit: _variables(Path(fmu) if Path(fmu).is_absolute() else file.parent / fmu)
+                 for unit, fmu in units.items()}
+    used = {unit: [] for unit in units}
+    for src, out, dst, inp in [*connections, *initial_copies]:
+        for unit, variable in ((src, out), (dst, inp)):
+            if variable not in described[unit]:
+                raise ValueError(f"{units[unit]} ({unit}) has no variable {variable!r}")
+            if variable not in used[unit]:
+                used[unit].append(variable)
+    for unit, values in start_values.items():
+        for variable in values:
+            if variable not in described[unit]:
+                raise ValueError(f"{units[unit]} ({unit}) has no variable {variable!r}")
+            if variable not in used[unit]:
+                used[unit].append(variable)
+    from xml.sax.saxutils import quoteattr
+
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>',
+             f'<ssd:SystemStructureDescription xmlns:ssd="{SSD}" xmlns:ssc="{SSC}" xmlns:ssv="{SSV}"',
+             f'    xmlns:osp="https://opensimulationplatform.com/SSP/OSPAnnotations" xmlns:cf="{LOOP}"',
+             f'    version="1.0" name={quoteattr(name)} generationTool="contour-fmu">',
+             f'  <ssd:System name={quoteattr(name)}>', "    <ssd:Elements>"]
+    for unit, fmu in units.items():
+        lines.append(f'      <ssd:Component name={quoteattr(unit)} source={quoteattr(str(fmu))} '
+                     'type="application/x-fmu-sharedlibrary">')
+        lines.append("        <ssd:Connectors>")
+        for variable in used[unit]:
+            causality, kind = described[unit][variable]
+            lines.append(f'          <ssd:Connector name={quoteattr(variable)} kind={quoteattr(causality)}>'
+                         f'<ssc:{kind}/></ssd:Connector>')
+        lines.append("        </ssd:Connectors>")
+        if start_values.get(unit):
+            lines += ["        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>",
+                      '          <ssv:ParameterSet version="1.0" name="default"><ssv:Parameters>']
+            for variable, value in start_values[unit].items():
+                kind = described[unit][variable][1]
+                lines.append(f'            <ssv:Parameter name={quoteattr(variable)}><ssv:{kind} '
+                             f'value={quoteattr(_xml_value(kind, value))}/></ssv:Parameter>')
+            lines += ["          </ssv:Parameters></ssv:ParameterSet>",
+                      "        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>"]
+        lines.append("      </ssd:Component>")
+    lines += ["    </ssd:Elements>", "    <ssd:Connections>"]
+    ends = lambda c: (f'startElement={quoteattr(c[0])} startConnector={quoteattr(c[1])} '  # noqa: E731
+                      f'endElement={quoteattr(c[2])} endConnector={quoteattr(c[3])}')
+    lines += [f"      <ssd:Connection {ends(c)}/>" for c in connections]
+    lines += ["    </ssd:Connections>", "    <ssd:Annotations>",
+              f'      <ssc:Annotation type="{LOOP_ANNOTATION}">',
+              f'        <cf:Loop order={quoteattr(" ".join(order))}>']
+    lines += [f"          <cf:InitialCopy {ends(c)}/>" for c in initial_copies]
+    lines += ["        </cf:Loop>", "      </ssc:Annotation>", "    </ssd:Annotations>", "  </ssd:System>"]
+    if step is not None:
+        lines += ['  <ssd:DefaultExperiment startTime="0.0"><ssd:Annotations>',
+                  '    <ssc:Annotation type="com.opensimulationplatform"><osp:Algorithm>'
+                  f'<osp:FixedStepAlgorithm baseStepSize="{float(step)!r}"/></osp:Algorithm></ssc:Annotation>',
+                  "  </ssd:Annotations></ssd:DefaultExperiment>"]
+    lines.append("</ssd:SystemStructureDescription>")
+    file.write_text("\n".join(lines) + "\n")
+    return file
+
+
 def with_sources(file, sources):
     """The text of the SSP file `file` with the FMU files of some components renamed
     (`sources`: component name -> file name); the rest unchanged."""

@@ -22,6 +22,7 @@ import sys
 import numpy as np
 import pytest
 
+from contour_fmu import native, ssp
 from contour_fmu.master import Master, Unit, closed_loop
 from contour_fmu.wiring import drive_loop_connections, drive_loop_start
 from helpers.checkout import REPO
@@ -43,12 +44,12 @@ def slide_fmu(tmp_path_factory):
     return str(out / "FrictionSlide.fmu")
 
 
-def drive_loop(fmu_dir, slide, step, ccc, coulomb=COULOMB):
-    """The SI loop: positions in mm at every communication point."""
+def drive_units(fmu_dir, slide, ccc, coulomb=COULOMB):
+    """The SI loop's units, in stepping order, with their start values."""
     si = fmu_dir.parent / "fmu-si"
     mechanics = dict(m=J * K**2, b=B * K**2, Fc=coulomb * K)
     drive = dict(Kvp=CT * KVP * K**2, Kvi=CT * KVI * K**2, effortMax=1e9)
-    units = [
+    return [
         Unit("controller", str(si / "ContourCCC2D.fmu"), {"ccc.enable": ccc}),
         Unit("drive_x", str(si / "ServoDrive.fmu"), drive),
         Unit("drive_y", str(si / "ServoDrive.fmu"), drive),
@@ -56,7 +57,12 @@ def drive_loop(fmu_dir, slide, step, ccc, coulomb=COULOMB):
         Unit("axis_y", slide, mechanics),
         Unit("interpolator", str(si / "PathInterpolator2D.fmu"), {"path": "circle"}),
     ]
-    with Master(units, drive_loop_connections(), step, 2.0, initial=drive_loop_start()) as master:
+
+
+def drive_loop(fmu_dir, slide, step, ccc, coulomb=COULOMB, stop=2.0):
+    """The SI loop: positions in mm at every communication point."""
+    units = drive_units(fmu_dir, slide, ccc, coulomb)
+    with Master(units, drive_loop_connections(), step, stop, initial=drive_loop_start()) as master:
         before, _ = master.run([("axis_x", "x"), ("axis_y", "x")])
     return np.column_stack([before["axis_x.x"], before["axis_y.x"]]) * 1e3
 
@@ -104,3 +110,24 @@ def test_the_nc_drives_a_foreign_si_plant_through_servo_drives(fmu_dir, slide_fm
           f"differ by {mismatch * 1e3:.3f} um")
     assert effect > 2e-3
     assert mismatch < 0.05 * effect
+
+
+def test_the_drive_loop_with_a_pythonfmu_plant_runs_in_contour_cosim_as_in_fmpy(fmu_dir, slide_fmu,
+                                                                                cosim, tmp_path):
+    """The same loop as an SSP file (contour_fmu.ssp.write_loop) run by the native master,
+    with the pythonfmu slides loaded into its process (libpython preloaded): fmpy's
+    trajectory bit for bit, and without libpython a refusal that says what to do."""
+    step, stop = 2e-4, 0.3
+    units = drive_units(fmu_dir, slide_fmu, ccc=True)
+    ssd = ssp.write_loop(tmp_path / "drive_loop.ssd", "drive_loop", {u.name: u.path for u in units},
+                         [u.name for u in units], drive_loop_connections(), drive_loop_start(),
+                         {u.name: u.start_values for u in units}, step=step)
+    rows = native.run(ssd, parameter_set="default", stop=stop, record=[("axis_x", "x"), ("axis_y", "x")],
+                      env=native.pythonfmu_environment())
+    ours = np.column_stack([rows["axis_x.x"], rows["axis_y.x"]])[:-1] * 1e3
+    theirs = drive_loop(fmu_dir, slide_fmu, step, True, stop=stop)
+    assert len(ours) == len(theirs) == round(stop / step)
+    assert np.array_equal(ours, theirs)
+    assert np.ptp(ours[:, 1]) > 1.0  # mm: the loop moved along the circle
+    with pytest.raises(native.RunFailed, match="a pythonfmu FMU: load libpython first"):
+        native.run(ssd, parameter_set="default", stop=stop, env={"LD_PRELOAD": ""})
