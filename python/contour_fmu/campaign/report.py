@@ -17,7 +17,6 @@ from pathlib import Path
 import numpy as np
 
 from ..extras import needs
-from .store import STATUSES
 from .metrics import unit_of
 
 SCALE = {"mm": (1e3, "µm"), "rad": (1e6, "µrad")}
@@ -65,6 +64,8 @@ def summary(campaign, table, out):
     """The Markdown text of OUT/summary.md."""
     c = table.to_pydict()
     metrics, first = campaign.metrics, campaign.metrics[0]
+    from .store import STATUSES  # pyarrow: a campaign extra, which a summary's table needs anyway
+
     statuses = {s: c["status"].count(s) for s in STATUSES}
     wall = np.nansum(np.asarray(c["wall_time_s"], float))
     lines = [f"# Campaign: {campaign.name}", "",
