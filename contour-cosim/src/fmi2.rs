@@ -11,7 +11,7 @@
 use std::ffi::{c_char, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
 use std::ptr::NonNull;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 use contour_fmu::fmi2::bindings::*;
@@ -109,6 +109,9 @@ struct Api {
 /// An FMU's shared library, open. It stays loaded while an [`Instance`] of it lives.
 pub struct Library {
     api: Api,
+    /// Set when any instance's call returned fmi2Fatal: FMI 2.0 then allows no further
+    /// call into the FMU, for any of its instances.
+    fatal: AtomicBool,
     // Last: the functions above point into it.
     _library: libloading::Library,
 }
@@ -204,6 +207,7 @@ impl Library {
         };
         Ok(Library {
             api,
+            fatal: AtomicBool::new(false),
             _library: library,
         })
     }
@@ -320,16 +324,15 @@ pub struct Instance {
     component: NonNull<c_void>,
     library: Arc<Library>,
     activity: Arc<Activity>,
-    // Boxed: the FMU keeps pointers to both for its lifetime.
-    _callbacks: Box<fmi2CallbackFunctions>,
-    sink: Box<LogSink>,
-    /// Set when a call returned fmi2Fatal: the FMU may then not be called again.
-    fatal: bool,
+    // The FMU keeps pointers to both for its lifetime: owned as raw pointers (from
+    // Box::into_raw), freed after fmi2FreeInstance, never moved meanwhile.
+    callbacks: NonNull<fmi2CallbackFunctions>,
+    sink: NonNull<LogSink>,
 }
 
 // SAFETY: FMI 2.0 lets an instance be called from any thread, one call at a time; an
-// `Instance` is only called through `&mut self` (or `&self` for reads that the standard
-// allows between calls), never from two threads at once.
+// `Instance` is only called through `&mut self`, and `&self` reaches only the sink's
+// mutex, never from two threads at once.
 unsafe impl Send for Instance {}
 
 impl Instance {
@@ -347,18 +350,21 @@ impl Instance {
         let c_guid = CString::new(guid).map_err(|_| "the GUID holds a NUL".to_string())?;
         let c_uri = CString::new(file_uri(resources))
             .map_err(|_| "the resource path holds a NUL".to_string())?;
-        let sink = Box::new(LogSink {
+        if library.fatal.load(Ordering::Relaxed) {
+            return Err("not instantiated: a call of this FMU returned Fatal earlier".into());
+        }
+        let sink = NonNull::from(Box::leak(Box::new(LogSink {
             receive,
             messages: Mutex::new(Vec::new()),
             echo,
-        });
-        let callbacks = Box::new(fmi2CallbackFunctions {
+        })));
+        let callbacks = NonNull::from(Box::leak(Box::new(fmi2CallbackFunctions {
             logger: Some(contour_cosim_logger),
             allocateMemory: Some(libc::calloc),
             freeMemory: Some(libc::free),
             stepFinished: None,
-            componentEnvironment: &*sink as *const LogSink as *mut c_void,
-        });
+            componentEnvironment: sink.as_ptr() as *mut c_void,
+        })));
         activity.bump();
         // SAFETY: every pointer is valid for the call; callbacks and sink outlive the
         // instance (freed after fmi2FreeInstance).
@@ -368,23 +374,28 @@ impl Instance {
                 fmi2Type_fmi2CoSimulation,
                 c_guid.as_ptr(),
                 c_uri.as_ptr(),
-                &*callbacks,
+                callbacks.as_ptr(),
                 fmi2False as fmi2Boolean,
                 fmi2False as fmi2Boolean,
             )
         };
         activity.bump();
+        // SAFETY: both came from Box::leak above and nothing else owns them.
+        let free_both = || unsafe {
+            drop(Box::from_raw(callbacks.as_ptr()));
+            drop(Box::from_raw(sink.as_ptr()));
+        };
         match NonNull::new(component) {
             Some(component) => Ok(Instance {
                 component,
                 library,
                 activity,
-                _callbacks: callbacks,
+                callbacks,
                 sink,
-                fatal: false,
             }),
             None => {
-                let said = sink
+                // SAFETY: the FMU made no instance, so it keeps no pointer to the sink.
+                let said = unsafe { sink.as_ref() }
                     .messages
                     .lock()
                     .map(|m| {
@@ -394,6 +405,7 @@ impl Instance {
                             .join("; ")
                     })
                     .unwrap_or_default();
+                free_both();
                 Err(format!(
                     "fmi2Instantiate returned NULL{}",
                     if said.is_empty() {
@@ -406,9 +418,19 @@ impl Instance {
         }
     }
 
+    fn sink(&self) -> &LogSink {
+        // SAFETY: owned by this instance until its drop; the FMU only reads it through
+        // the logger callback, which takes the mutex.
+        unsafe { self.sink.as_ref() }
+    }
+
+    fn fatal(&self) -> bool {
+        self.library.fatal.load(Ordering::Relaxed)
+    }
+
     /// The latest messages the FMU logged (at most 64), oldest first.
     pub fn messages(&self) -> Vec<Message> {
-        self.sink
+        self.sink()
             .messages
             .lock()
             .map(|m| m.clone())
@@ -416,7 +438,7 @@ impl Instance {
     }
 
     pub fn clear_messages(&self) {
-        if let Ok(mut m) = self.sink.messages.lock() {
+        if let Ok(mut m) = self.sink().messages.lock() {
             m.clear();
         }
     }
@@ -426,10 +448,10 @@ impl Instance {
         call: &'static str,
         run: impl FnOnce(&Api, fmi2Component) -> fmi2Status,
     ) -> Result<(), CallFailed> {
-        if self.fatal {
+        if self.fatal() {
             return Err(CallFailed {
                 call,
-                status: "not called: an earlier call returned Fatal",
+                status: "not called: a call of this FMU returned Fatal earlier",
             });
         }
         self.activity.bump();
@@ -438,7 +460,9 @@ impl Instance {
         match status {
             fmi2Status_fmi2OK | fmi2Status_fmi2Warning => Ok(()),
             other => {
-                self.fatal |= other == fmi2Status_fmi2Fatal;
+                if other == fmi2Status_fmi2Fatal {
+                    self.library.fatal.store(true, Ordering::Relaxed);
+                }
                 Err(CallFailed {
                     call,
                     status: status_name(other),
@@ -579,14 +603,51 @@ impl Instance {
 
 impl Drop for Instance {
     fn drop(&mut self) {
-        // After fmi2Fatal the standard allows no further call; the instance is leaked.
-        if !self.fatal {
-            self.activity.bump();
-            // SAFETY: a live component, freed once.
-            unsafe { (self.library.api.free_instance)(self.component.as_ptr()) };
-            self.activity.bump();
+        if self.fatal() {
+            // After fmi2Fatal the standard allows no further call: the instance is
+            // leaked with everything it may still point to, its library included.
+            std::mem::forget(self.library.clone());
+            return;
         }
+        self.activity.bump();
+        // SAFETY: a live component, freed once; then the FMU holds no pointer to the
+        // callbacks or the sink, which came from Box::leak in `new`.
+        unsafe {
+            (self.library.api.free_instance)(self.component.as_ptr());
+            drop(Box::from_raw(self.callbacks.as_ptr()));
+            drop(Box::from_raw(self.sink.as_ptr()));
+        }
+        self.activity.bump();
     }
+}
+
+/// Whether a call of this FMU returned fmi2Fatal: the process must not call it again.
+pub fn is_fatal(library: &Library) -> bool {
+    library.fatal.load(Ordering::Relaxed)
+}
+
+/// Gives this process's standard output to its caller alone: returns a file writing to
+/// what was file descriptor 1, which then points at standard error. What an FMU prints
+/// (a C printf, a pythonfmu print) goes to standard error and cannot corrupt results
+/// written to the returned file.
+pub fn private_stdout() -> std::io::Result<std::fs::File> {
+    use std::os::fd::FromRawFd;
+    // SAFETY: dup and dup2 on the process's own standard descriptors; the duplicate is
+    // owned by the returned File alone.
+    unsafe {
+        let duplicate = libc::dup(1);
+        if duplicate < 0 || libc::dup2(2, 1) < 0 {
+            return Err(std::io::Error::last_os_error());
+        }
+        Ok(std::fs::File::from_raw_fd(duplicate))
+    }
+}
+
+/// Ends the process at once with `status`, running no exit handler or library destructor:
+/// a hung FMU call still holds whatever locks they might need.
+pub fn abandon_process(status: i32) -> ! {
+    // SAFETY: _exit is async-signal-safe and never returns.
+    unsafe { libc::_exit(status) }
 }
 
 /// The `file:` URI of a folder (RFC 8089), as fmuResourceLocation wants it: without a
@@ -594,9 +655,13 @@ impl Drop for Instance {
 fn file_uri(folder: &Path) -> String {
     let absolute: PathBuf = std::path::absolute(folder).unwrap_or_else(|_| folder.to_path_buf());
     let mut uri = String::from("file://");
+    // A Windows path starts with its drive: file:///C:/...
+    if !absolute.to_string_lossy().starts_with(['/', '\\']) {
+        uri.push('/');
+    }
     for byte in absolute.to_string_lossy().bytes() {
         match byte {
-            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'/' | b'-' | b'_' | b'.' | b'~' => {
+            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'/' | b'-' | b'_' | b'.' | b'~' | b':' => {
                 uri.push(byte as char)
             }
             b'\\' => uri.push('/'),

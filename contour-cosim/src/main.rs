@@ -4,8 +4,10 @@
 use std::io::{BufRead, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::time::Duration;
 
+use contour_cosim::fmi2::{self, Activity};
 use contour_cosim::ssp::StartValues;
 use contour_cosim::watchdog::Watchdog;
 use contour_cosim::{End, Error, Experiment, Recording, Scheme, Simulation, System, Trace};
@@ -43,10 +45,14 @@ options:
 
 exit status: 0 done; 1 the run failed (an FMU call returned an error; batch: never, each
 run says); 2 refused before any run (a file, the wiring or an option; batch: also a run
-line it cannot read); 3 timeout (batch: of the first run without its result line)."#;
+line without a run id); 3 timeout (batch: of the first run without its result line);
+4 (batch) an FMU returned fmi2Fatal in the last run answered: it may not be called again
+in this process, so the next runs need a new one."#;
 
 /// Exit status of a timeout (the run's other statuses: 0 done, 1 failed, 2 refused).
 const TIMEOUT_STATUS: i32 = 3;
+/// Exit status of a batch that stopped after a run in which an FMU returned fmi2Fatal.
+const FATAL_STATUS: i32 = 4;
 
 struct Options {
     command: String,
@@ -66,11 +72,18 @@ struct Options {
     log: bool,
 }
 
+/// The most seconds an option takes (about 30 years).
+const MAX_SECONDS: f64 = 1e9;
+
 fn seconds(option: &str, text: &str) -> Result<f64, Error> {
     text.parse::<f64>()
         .ok()
-        .filter(|v| v.is_finite() && *v >= 0.0)
-        .ok_or_else(|| Error::Refused(format!("{option} wants a number of seconds, not {text:?}")))
+        .filter(|v| v.is_finite() && (0.0..=MAX_SECONDS).contains(v))
+        .ok_or_else(|| {
+            Error::Refused(format!(
+                "{option} wants a number of seconds from 0 to {MAX_SECONDS:e}, not {text:?}"
+            ))
+        })
 }
 
 fn parse(args: &[String]) -> Result<Options, Error> {
@@ -192,50 +205,69 @@ fn setup(options: &Options, system: &System) -> Result<Setup, Error> {
     })
 }
 
-fn run(options: &Options) -> Result<(), Error> {
-    let system = System::load(&options.file)?;
-    if options.command == "check" {
-        for unit in &system.units {
-            println!(
-                "{}: {} ({})",
-                unit.name,
-                unit.fmu.description.model_name,
-                unit.fmu.file.display()
-            );
-        }
-        println!(
-            "{} connections, {} initial copies",
-            system.connections.len(),
-            system.initial_copies.len()
+fn run(options: &Options) -> Result<Outcome, Error> {
+    // Watched from the start: loading runs the FMU libraries' initialisers, and the first
+    // instantiation comes before any result; the watchdog is dropped last.
+    let activity = Arc::new(Activity::default());
+    let timeout = Duration::from_secs_f64(options.timeout.max(1e-3));
+    let _watchdog = Watchdog::start(activity.clone(), timeout, move || {
+        eprintln!(
+            "contour-cosim: timeout: an FMU call did not return within {} s",
+            timeout.as_secs_f64()
         );
-        return Ok(());
-    }
-    let setup = setup(options, &system)?;
+        // The hung call keeps its thread, and may hold locks that exit handlers need:
+        // only ending the process at once frees it.
+        fmi2::abandon_process(TIMEOUT_STATUS);
+    });
+    // Results go to a descriptor of their own: what an FMU prints goes to stderr.
     let mut output: Box<dyn Write> = match &options.output {
         Some(path) => Box::new(
             std::fs::File::create(path)
                 .map_err(|e| Error::Refused(format!("{}: {e}", path.display())))?,
         ),
-        None => Box::new(std::io::stdout().lock()),
+        None => Box::new(std::io::BufWriter::new(fmi2::private_stdout().map_err(
+            |e| Error::Failed(format!("cannot set the standard output aside: {e}")),
+        )?)),
     };
-    let mut simulation = Simulation::new(&system, options.scheme, options.log)?;
-    let timeout = Duration::from_secs_f64(options.timeout.max(1e-3));
-    let _watchdog = Watchdog::start(simulation.activity(), timeout, move || {
-        eprintln!(
-            "contour-cosim: timeout: an FMU call did not return within {} s",
-            timeout.as_secs_f64()
+    let system = System::load(&options.file)?;
+    if options.command == "check" {
+        let mut text = String::new();
+        for unit in &system.units {
+            text += &format!(
+                "{}: {} ({})\n",
+                unit.name,
+                unit.fmu.description.model_name,
+                unit.fmu.file.display()
+            );
+        }
+        text += &format!(
+            "{} connections, {} initial copies\n",
+            system.connections.len(),
+            system.initial_copies.len()
         );
-        // The hung call keeps its thread; only ending the process frees it.
-        std::process::exit(TIMEOUT_STATUS);
-    });
-    let written = if options.command == "batch" {
-        batch(options, &system, &setup, &mut simulation, &mut output)
-    } else {
-        let start_values = system.start_values(&setup.starts)?;
-        let trace = simulation.run(&setup.experiment, &start_values, &setup.recording)?;
-        output.write_all(csv(&trace).as_bytes())
-    };
-    written
+        return write_out(&mut output, text.as_bytes()).map(|()| Outcome::Done);
+    }
+    let setup = setup(options, &system)?;
+    let mut simulation = Simulation::watched(&system, options.scheme, options.log, activity)?;
+    if options.command == "batch" {
+        return batch(options, &system, &setup, &mut simulation, &mut output);
+    }
+    let start_values = system.start_values(&setup.starts)?;
+    let trace = simulation.run(&setup.experiment, &start_values, &setup.recording)?;
+    write_out(&mut output, csv(&trace).as_bytes()).map(|()| Outcome::Done)
+}
+
+/// How a command ended, when it did not fail.
+enum Outcome {
+    Done,
+    /// A batch stopped after a run in which an FMU returned fmi2Fatal: the process may
+    /// not call that FMU again, a new one takes the next runs.
+    Fatal,
+}
+
+fn write_out(output: &mut dyn Write, bytes: &[u8]) -> Result<(), Error> {
+    output
+        .write_all(bytes)
         .and_then(|()| output.flush())
         .map_err(|e| Error::Failed(format!("cannot write the results: {e}")))
 }
@@ -260,35 +292,43 @@ fn csv(trace: &Trace) -> String {
     text
 }
 
-/// One run line of a batch: its id and its start values.
-fn run_line(line: &str, system: &System) -> Result<(serde_json::Value, StartValues), Error> {
+/// The id of a batch's run line.
+fn run_id(line: &str) -> Result<serde_json::Value, Error> {
+    serde_json::from_str::<serde_json::Value>(line)
+        .ok()
+        .and_then(|parsed| parsed.get("run").cloned())
+        .ok_or_else(|| {
+            Error::Refused(format!(
+                "run line {line:?}: not a JSON object with a \"run\""
+            ))
+        })
+}
+
+/// The start values of a batch's run line.
+fn run_line(line: &str, system: &System) -> Result<StartValues, Error> {
     let bad = |why: &str| Error::Refused(format!("run line {line:?}: {why}"));
     let parsed: serde_json::Value = serde_json::from_str(line).map_err(|e| bad(&e.to_string()))?;
-    let id = parsed
-        .get("run")
-        .cloned()
-        .ok_or_else(|| bad("no \"run\""))?;
     let mut starts = Vec::new();
-    for triple in parsed
-        .get("start")
-        .and_then(|s| s.as_array())
-        .map_or(&[][..], |a| a.as_slice())
-    {
-        let Some([unit, name, text]) = triple
+    let listed = match parsed.get("start") {
+        None => &[][..],
+        Some(list) => list
             .as_array()
-            .and_then(|t| <&[_; 3]>::try_from(t.as_slice()).ok())
-            .map(|t| t.each_ref().map(|v| v.as_str()))
-        else {
-            return Err(bad("a start value is not [UNIT, VARIABLE, TEXT]"));
-        };
-        let (Some(unit), Some(name), Some(text)) = (unit, name, text) else {
+            .map(Vec::as_slice)
+            .ok_or_else(|| bad("\"start\" is not a list"))?,
+    };
+    for triple in listed {
+        let texts: Option<Vec<&str>> = triple
+            .as_array()
+            .filter(|t| t.len() == 3)
+            .and_then(|t| t.iter().map(|v| v.as_str()).collect());
+        let Some([unit, name, text]) = texts.as_deref() else {
             return Err(bad(
                 "a start value is not [UNIT, VARIABLE, TEXT] of strings",
             ));
         };
         starts.push(system.parse_start_value(unit, name, text)?);
     }
-    Ok((id, starts))
+    Ok(starts)
 }
 
 fn batch(
@@ -297,52 +337,47 @@ fn batch(
     setup: &Setup,
     simulation: &mut Simulation,
     output: &mut dyn Write,
-) -> std::io::Result<()> {
+) -> Result<Outcome, Error> {
     let input: Box<dyn BufRead> = match &options.runs {
-        Some(path) => Box::new(std::io::BufReader::new(std::fs::File::open(path)?)),
+        Some(path) => Box::new(std::io::BufReader::new(
+            std::fs::File::open(path)
+                .map_err(|e| Error::Refused(format!("{}: {e}", path.display())))?,
+        )),
         None => Box::new(std::io::stdin().lock()),
     };
-    writeln!(
-        output,
-        "{}",
-        serde_json::json!({ "columns": setup.recording.columns() })
-    )?;
-    output.flush()?;
+    let columns = serde_json::json!({ "columns": setup.recording.columns() });
+    write_out(output, format!("{columns}\n").as_bytes())?;
     let mut bytes = Vec::new();
     for line in input.lines() {
-        let line = line?;
+        let line = line.map_err(|e| Error::Failed(format!("cannot read the run lines: {e}")))?;
         if line.trim().is_empty() {
             continue;
         }
-        let (id, mut starts) = match run_line(&line, system) {
-            Ok(parsed) => parsed,
-            Err(e) => {
-                eprintln!("contour-cosim: {e}");
-                std::process::exit(2);
-            }
-        };
-        starts.splice(0..0, setup.starts.iter().cloned());
-        let result = system
-            .start_values(&starts)
-            .and_then(|values| simulation.run(&setup.experiment, &values, &setup.recording));
+        // A line without a run id cannot be answered; one with an id gets an error row.
+        let id = run_id(&line)?;
+        let result = run_line(&line, system).and_then(|mut starts| {
+            starts.splice(0..0, setup.starts.iter().cloned());
+            let values = system.start_values(&starts)?;
+            simulation.run(&setup.experiment, &values, &setup.recording)
+        });
         let (status, message, steps) = match &result {
             Ok(trace) => ("ok", String::new(), trace.steps),
             Err(e) => ("error", e.to_string(), 0),
         };
-        writeln!(
-            output,
-            "{}",
-            serde_json::json!({ "run": id, "status": status, "message": message, "steps": steps })
-        )?;
-        if let Ok(trace) = result {
-            bytes.clear();
+        bytes.clear();
+        let head =
+            serde_json::json!({ "run": id, "status": status, "message": message, "steps": steps });
+        bytes.extend_from_slice(format!("{head}\n").as_bytes());
+        if let Ok(trace) = &result {
             bytes.extend(trace.values.iter().flat_map(|v| v.to_le_bytes()));
-            output.write_all(&bytes)?;
         }
         // The caller reads as runs finish, and knows which run a crash took.
-        output.flush()?;
+        write_out(output, &bytes)?;
+        if simulation.fatal() {
+            return Ok(Outcome::Fatal);
+        }
     }
-    Ok(())
+    Ok(Outcome::Done)
 }
 
 fn main() -> ExitCode {
@@ -352,7 +387,11 @@ fn main() -> ExitCode {
         return ExitCode::SUCCESS;
     }
     match parse(&args).and_then(|options| run(&options)) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(Outcome::Done) => ExitCode::SUCCESS,
+        Ok(Outcome::Fatal) => {
+            eprintln!("contour-cosim: an FMU returned fmi2Fatal; its functions may not be called again in this process");
+            ExitCode::from(FATAL_STATUS as u8)
+        }
         Err(e) => {
             eprintln!("contour-cosim: {e}");
             ExitCode::from(match e {

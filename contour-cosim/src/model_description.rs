@@ -45,6 +45,8 @@ pub struct ModelDescription {
     pub guid: String,
     pub model_identifier: String,
     pub can_handle_variable_step: bool,
+    /// canBeInstantiatedOnlyOncePerProcess: one instance of it at a time in a process.
+    pub once_per_process: bool,
     pub variables: Vec<Variable>,
     by_name: HashMap<String, usize>,
 }
@@ -135,6 +137,8 @@ impl ModelDescription {
             model_identifier,
             can_handle_variable_step: co_simulation
                 .attribute("canHandleVariableCommunicationStepSize")
+                == Some("true"),
+            once_per_process: co_simulation.attribute("canBeInstantiatedOnlyOncePerProcess")
                 == Some("true"),
             variables,
             by_name,

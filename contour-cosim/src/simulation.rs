@@ -62,6 +62,27 @@ pub struct Experiment {
 }
 
 impl Experiment {
+    /// The most rows a run's trace can have.
+    pub fn longest(&self) -> usize {
+        match &self.end {
+            End::Time(stop) => self.steps(*stop) + 1,
+            End::Signal {
+                settle, max_stop, ..
+            } => self.steps(*max_stop) + self.steps(*settle) + 1,
+        }
+    }
+
+    /// Refuses a trace of `columns` that could hold more than `MAX_VALUES` values.
+    pub fn check_trace(&self, columns: usize) -> Result<(), Error> {
+        if self.longest().saturating_mul(columns) > MAX_VALUES {
+            return Err(Error::Refused(format!(
+                "{} rows of {columns} recorded columns is more than {MAX_VALUES} values; record fewer columns or a shorter run",
+                self.longest()
+            )));
+        }
+        Ok(())
+    }
+
     /// Refuses a step or an end that is not a positive finite number of seconds, or that
     /// would take more than `MAX_STEPS` steps.
     pub fn checked(self) -> Result<Experiment, Error> {
@@ -116,8 +137,12 @@ impl Experiment {
     }
 }
 
-/// The longest run, in steps (a trace of 10 columns is then 800 MB).
+/// The longest run, in steps.
 pub const MAX_STEPS: usize = 10_000_000;
+/// The most values a run's trace may hold (steps + 1 rows × columns): 800 MB.
+pub const MAX_VALUES: usize = 100_000_000;
+/// Values reserved for a trace up front, at most.
+const RESERVED_VALUES: usize = 1 << 24;
 
 /// Values recorded at every t_k of a run, t_0 to t_n (after the last step): row k holds
 /// every column at t_k, before the step from t_k.
@@ -275,6 +300,16 @@ impl<'a> Simulation<'a> {
     /// Instantiates every unit of `system`, in the step order. `echo` prints what the
     /// FMUs log on stderr (otherwise it only goes into the messages of failed runs).
     pub fn new(system: &'a System, scheme: Scheme, echo: bool) -> Result<Simulation<'a>, Error> {
+        Simulation::watched(system, scheme, echo, Arc::new(Activity::default()))
+    }
+
+    /// As `new`, counting the FMU calls in `activity` (which a watchdog may already watch).
+    pub fn watched(
+        system: &'a System,
+        scheme: Scheme,
+        echo: bool,
+        activity: Arc<Activity>,
+    ) -> Result<Simulation<'a>, Error> {
         let (first, before_step) = match scheme {
             Scheme::Jacobi => (
                 transfers(&system.connections),
@@ -306,7 +341,7 @@ impl<'a> Simulation<'a> {
             system,
             scheme,
             instances: Vec::new(),
-            activity: Arc::new(Activity::default()),
+            activity,
             echo,
             used: false,
             first,
@@ -327,8 +362,10 @@ impl<'a> Simulation<'a> {
     }
 
     fn instantiate(&mut self) -> Result<(), Error> {
+        // All or none: a unit that fails leaves no half-made set behind.
         self.instances.clear();
         self.used = false;
+        let mut instances = Vec::with_capacity(self.system.units.len());
         for unit in &self.system.units {
             let fmu = &unit.fmu;
             let instance = Instance::new(
@@ -340,9 +377,19 @@ impl<'a> Simulation<'a> {
                 self.echo,
             )
             .map_err(|why| Error::Failed(format!("{}: {why}", unit.name)))?;
-            self.instances.push(instance);
+            instances.push(instance);
         }
+        self.instances = instances;
         Ok(())
+    }
+
+    /// Whether a call of one of the loop's FMUs returned fmi2Fatal: none of that FMU's
+    /// functions may be called again in this process.
+    pub fn fatal(&self) -> bool {
+        self.system
+            .units
+            .iter()
+            .any(|u| crate::fmi2::is_fatal(&u.fmu.library))
     }
 
     /// A failed call as the run's error: the unit, the call, its status, when, and the
@@ -472,8 +519,11 @@ impl<'a> Simulation<'a> {
             ),
         };
         let width = recording.columns.len();
+        experiment.check_trace(width)?;
+        // Exact for a run to a stop time; a run to a signal usually ends well before its
+        // longest, so it starts smaller and grows (never while the FMUs step a sample).
         let rows = limit + settle + 1;
-        let mut values = Vec::with_capacity(rows * width);
+        let mut values = Vec::with_capacity((rows * width).min(RESERVED_VALUES));
         self.buffers
             .fit(recording.groups.iter().map(|g| g.value_references.len()));
         let mut k = 0;

@@ -236,6 +236,13 @@ fn parse(text: &str, file: &Path, folder: &Path) -> Result<SystemStructure, Erro
         }
     }
     let names: Vec<&str> = components.iter().map(|c| c.name.as_str()).collect();
+    if let Some(twice) = names
+        .iter()
+        .enumerate()
+        .find_map(|(i, n)| names[..i].contains(n).then_some(n))
+    {
+        return Err(refused(format!("two components are named {twice:?}")));
+    }
     let checked = |node: roxmltree::Node, what: &str| -> Result<Connection, Error> {
         let end = |element: &str, connector: &str| -> Result<Port, Error> {
             let unit = node.attribute(element).unwrap_or("");
@@ -416,6 +423,15 @@ mod tests {
         .to_string();
         assert!(
             message.contains("does not list each component once"),
+            "{message}"
+        );
+        let twice = ELEMENTS.replace(
+            r#"name="b" source="sub/B.fmu""#,
+            r#"name="a" source="sub/B.fmu""#,
+        );
+        let message = read(&twice).err().unwrap().to_string();
+        assert!(
+            message.contains("two components are named \"a\""),
             "{message}"
         );
         assert!(parse("<x", Path::new("l.ssd"), Path::new(""))

@@ -120,6 +120,21 @@ impl System {
                 fmu,
             });
         }
+        for unit in &units {
+            let sharing: Vec<&str> = units
+                .iter()
+                .filter(|u| Arc::ptr_eq(&u.fmu, &unit.fmu))
+                .map(|u| u.name.as_str())
+                .collect();
+            if unit.fmu.description.once_per_process && sharing.len() > 1 {
+                return Err(Error::Refused(format!(
+                    "{}: {} can be instantiated only once per process (canBeInstantiatedOnlyOncePerProcess), so it cannot serve {}",
+                    structure.file.display(),
+                    unit.fmu.file.display(),
+                    sharing.join(" and ")
+                )));
+            }
+        }
         let mut system = System {
             structure,
             units,
@@ -256,6 +271,14 @@ impl System {
             VariableType::String => Value::String(text.to_string()),
         };
         Ok((unit.to_string(), name.to_string(), value))
+    }
+
+    /// Whether one of the loop's FMUs allows only one instance per process: the loop then
+    /// runs once at a time in a process.
+    pub fn once_per_process(&self) -> bool {
+        self.units
+            .iter()
+            .any(|u| u.fmu.description.once_per_process)
     }
 
     /// Every output of every unit, in the step order: what a run records by default.

@@ -1,11 +1,13 @@
 //! The tuner's objective through FMUs: every candidate's closed loop runs through the
 //! loop of an SSP file (the user's own plant FMU, say) in contour-cosim, and its actual
-//! positions are judged as the in-process objective judges its own (the same reference,
+//! positions and commands are judged as the in-process objective judges its own (the same reference,
 //! true error and score: [`Simulator::metrics_of`](contour_core::sim::Simulator::metrics_of)).
 //! A loop that reproduces the in-process simulator therefore scores every candidate bit
 //! for bit alike, and the swarm takes the same path.
 //!
-//! The instances are made once per evaluating thread and reset between runs (fmi2Reset).
+//! The instances are made once per evaluating thread and reset between runs (fmi2Reset);
+//! a loop with an FMU that allows one instance per process runs one candidate at a time,
+//! and one whose FMU returned fmi2Fatal scores every later candidate as a failed run.
 
 use std::sync::Mutex;
 
@@ -30,6 +32,7 @@ pub struct FmuObjective<'a> {
     fixed: Vec<(Resolved, Value)>,
     factors: Vec<Resolved>,
     idle: Mutex<Vec<Simulation<'a>>>,
+    one_at_a_time: Option<Mutex<()>>,
 }
 
 impl<'a> FmuObjective<'a> {
@@ -67,11 +70,14 @@ impl<'a> FmuObjective<'a> {
             &[
                 (PLANT.into(), "pos.x".into()),
                 (PLANT.into(), "pos.y".into()),
+                (CONTROLLER.into(), "u.x".into()),
+                (CONTROLLER.into(), "u.y".into()),
             ],
         )
         .map_err(|e| format!("the loop: {e}"))?;
-        // The run's samples t_0 … t_(n-1), as the in-process run has them.
-        let steps = reference.simulator().samples().saturating_sub(1).max(1);
+        // The run's samples t_0 … t_(n-1), as the in-process run has them, and one step
+        // more for the controller's command at the last sample.
+        let steps = reference.simulator().samples().max(1);
         let experiment = Experiment {
             step: reference.ts(),
             end: End::Time(steps as f64 * reference.ts()),
@@ -86,6 +92,7 @@ impl<'a> FmuObjective<'a> {
             fixed,
             factors,
             idle: Mutex::new(Vec::new()),
+            one_at_a_time: system.once_per_process().then(|| Mutex::new(())),
         })
     }
 
@@ -94,8 +101,14 @@ impl<'a> FmuObjective<'a> {
         &self.reference
     }
 
-    /// One run of the loop with these factors: the plant's positions at t_0 … t_(n-1).
-    fn positions(&self, factors: &[f64]) -> Result<Vec<Vector<2>>, String> {
+    /// One run of the loop with these factors: the plant's positions at t_0 … t_(n-1)
+    /// with the controller's command at each.
+    fn samples(&self, factors: &[f64]) -> Result<Vec<(Vector<2>, Vector<2>)>, String> {
+        // A loop with an FMU that allows one instance per process runs one at a time.
+        let _alone = match &self.one_at_a_time {
+            Some(lock) => Some(lock.lock().map_err(|e| e.to_string())?),
+            None => None,
+        };
         let taken = self.idle.lock().map_err(|e| e.to_string())?.pop();
         let mut simulation = match taken {
             Some(s) => s,
@@ -112,20 +125,29 @@ impl<'a> FmuObjective<'a> {
         let trace = simulation
             .run(&self.experiment, &start, &self.recording)
             .map_err(|e| e.to_string());
-        self.idle
-            .lock()
-            .map_err(|e| e.to_string())?
-            .push(simulation);
+        if !simulation.fatal() {
+            self.idle
+                .lock()
+                .map_err(|e| e.to_string())?
+                .push(simulation);
+        }
         let trace = trace?;
-        Ok((0..=trace.steps)
-            .map(|k| Vector::<2>::new(trace.row(k)[0], trace.row(k)[1]))
+        // Row k: the position at t_k; the command of sample k is in row k + 1.
+        Ok((0..trace.steps)
+            .map(|k| {
+                let (now, next) = (trace.row(k), trace.row(k + 1));
+                (
+                    Vector::<2>::new(now[0], now[1]),
+                    Vector::<2>::new(next[2], next[3]),
+                )
+            })
             .collect())
     }
 
     /// The fitness (mm) of these factors, as [`ContourObjective::evaluate`] gives it; a run
     /// the FMUs end (an error) scores as a run that cannot start.
     pub fn evaluate(&self, factors: &[f64]) -> f64 {
-        match self.positions(factors) {
+        match self.samples(factors) {
             Ok(positions) => self
                 .reference
                 .score(&self.reference.simulator().metrics_of(positions)),

@@ -103,6 +103,10 @@ name = "hang"
 parameters = {{ "plant.fault" = 2, "plant.fault_time" = 0.2 }}
 
 [[variants]]
+name = "fatal"
+parameters = {{ "plant.fault" = 4, "plant.fault_time" = 0.1 }}
+
+[[variants]]
 name = "fine again"
 parameters = {{ "plant.fault_time" = 0.1 }}
 """
@@ -110,19 +114,21 @@ parameters = {{ "plant.fault_time" = 0.1 }}
 
 def test_a_plant_that_segfaults_or_hangs_costs_its_run_only(fmus, cosim, tmp_path):
     """On two Dask workers: the segfault is "crashed" with its signal, the hang "timeout"
-    after the campaign's 1 s; the runs after them in the same batches run; --resume runs
-    none of them again."""
+    after the campaign's 1 s, fmi2Fatal an error (and a new process for the next run, since
+    the FMU may not be called again); the runs after them in the same batches run;
+    --resume runs none of them again."""
     faulty_fmu.build(tmp_path)
     c = campaign(tmp_path, FAULTY, fmus=fmus, plant=tmp_path / "Faulty.fmu")
     out = tmp_path / "out"
     table = execute(c, out, workers=2, show_progress=False).consolidate()
     rows = table.to_pydict()
-    assert rows["status"] == ["ok", "crashed", "timeout", "ok"], rows["message"]
+    assert rows["status"] == ["ok", "crashed", "timeout", "error", "ok"], rows["message"]
     assert "killed by SIGSEGV (signal 11)" in rows["message"][1]
     assert "did not return within 1 s" in rows["message"][2]
-    assert math.isnan(rows["contour_error.max"][1]) and math.isnan(rows["contour_error.max"][2])
+    assert "plant: fmi2DoStep returned Fatal at t = 0.1" in rows["message"][3]
+    assert all(math.isnan(rows["contour_error.max"][k]) for k in (1, 2, 3))
     # The ideal axes follow the circle closely: real values, equal for equal runs.
-    assert 0 < rows["contour_error.max"][0] == rows["contour_error.max"][3] < 1.0
+    assert 0 < rows["contour_error.max"][0] == rows["contour_error.max"][4] < 1.0
     files = sorted(p.name for p in (out / "rows").iterdir())
     again = execute(c, out, resume=True, serial=True, show_progress=False).consolidate()
     assert sorted(p.name for p in (out / "rows").iterdir()) == files  # nothing ran

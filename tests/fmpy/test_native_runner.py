@@ -228,3 +228,18 @@ def test_a_foreign_fmu_runs_and_one_that_hangs_or_crashes_ends_the_run_clearly(c
         native.run(ssd, step=0.01, stop=1.0, scheme=scheme,
                    start={"a": {"fault": faulty_fmu.SEGFAULT, "fault_time": 0.2}})
     assert crashed.value.signal == 11
+
+
+def test_what_an_fmu_prints_on_stdout_does_not_reach_the_results(cosim, tmp_path):
+    """An FMU's printf goes to standard error: the CSV is the quiet run's, and the lines
+    are on stderr."""
+    ssd = faulty_fmu.build(tmp_path)
+    start = {"a": {"pos0.x": 1.0, "u.x": 2.0}}
+    quiet = native.run(ssd, step=0.01, stop=0.2, start=start, record=[("a", "pos.x")])
+    chatty = {**start, "a": {**start["a"], "fault": faulty_fmu.CHATTY}}
+    args = native.arguments(ssd, step=0.01, stop=0.2, start=chatty, record=[("a", "pos.x")])
+    done = subprocess.run(args, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "chatty" not in done.stdout and done.stderr.count("chatty FMU at t =") == 20
+    loud = native.run(ssd, step=0.01, stop=0.2, start=chatty, record=[("a", "pos.x")])
+    assert np.array_equal(loud["a.pos.x"], quiet["a.pos.x"])

@@ -168,19 +168,25 @@ impl<const D: usize, P: ReferencePath<D>> Simulator<D, P> {
     }
 
     /// Metrics of a run made elsewhere (the same loop through FMUs, say) from its actual
-    /// positions at t_0, t_1, …: each judged as a run here judges its sample (the same
-    /// true error, search hint, abort rule and sums), so a loop that reproduces this
-    /// simulator gets these metrics bit for bit. Positions past the planned samples are
-    /// not judged.
-    pub fn metrics_of(&self, positions: impl IntoIterator<Item = Vector<D>>) -> Metrics {
+    /// positions at t_0, t_1, … and the commands the controller gave there: each sample
+    /// judged as a run here judges its own (a non-finite position or command, the true
+    /// error searched from the last foot, the abort rule, the sums), so a loop that
+    /// reproduces this simulator gets these metrics bit for bit. Samples past the planned
+    /// ones are not judged; a run that gives fewer ends diverged where it stopped.
+    pub fn metrics_of(&self, samples: impl IntoIterator<Item = (Vector<D>, Vector<D>)>) -> Metrics {
         let mut judge = Judge::new(self);
-        for (k, actual) in positions.into_iter().take(self.samples()).enumerate() {
-            if let Some(v) = actual.iter().copied().find(|v| !v.is_finite()) {
+        let mut judged = 0;
+        for (k, (actual, u)) in samples.into_iter().take(self.samples()).enumerate() {
+            if let Some(v) = first_non_finite(&actual, &u) {
                 judge.diverge(self, k, DivergenceKind::NonFinite, v);
             }
             if judge.divergence.is_some() || judge.judge(self, k, actual).is_none() {
                 break;
             }
+            judged = k + 1;
+        }
+        if judge.divergence.is_none() && judged < self.samples() {
+            judge.diverge(self, judged, DivergenceKind::NonFinite, f64::NAN);
         }
         judge.acc.metrics(judge.divergence)
     }
@@ -386,24 +392,38 @@ mod tests {
         config.transient = 0.1;
         let sim = Simulator::new(config).unwrap();
         let run = sim.run();
-        assert_eq!(
-            sim.metrics_of(run.trace.actual.iter().copied()),
-            run.metrics
-        );
+        let samples = || {
+            run.trace
+                .actual
+                .iter()
+                .copied()
+                .zip(run.trace.u.iter().copied())
+        };
+        assert_eq!(sim.metrics_of(samples()), run.metrics);
         assert!(run.metrics.settled_samples < run.metrics.samples);
-        // A position that is not finite ends the judged run there, as a run here ends.
-        let mut positions = run.trace.actual.clone();
-        positions[700].x = f64::NAN;
-        let m = sim.metrics_of(positions);
-        assert_eq!((m.samples, m.divergence.unwrap().k), (700, 700));
-        assert_eq!(m.divergence.unwrap().kind, DivergenceKind::NonFinite);
+        // A position or a command that is not finite ends the judged run there, as a run
+        // here ends.
+        for (k, in_command) in [(700, false), (900, true)] {
+            let mut given: Vec<_> = samples().collect();
+            if in_command {
+                given[k].1.y = f64::INFINITY;
+            } else {
+                given[k].0.x = f64::NAN;
+            }
+            let m = sim.metrics_of(given);
+            assert_eq!((m.samples, m.divergence.unwrap().k), (k, k));
+            assert_eq!(m.divergence.unwrap().kind, DivergenceKind::NonFinite);
+        }
         // One far off the path is an error-limit divergence.
-        let mut positions = run.trace.actual.clone();
-        positions[10].y += 100.0;
+        let mut given: Vec<_> = samples().collect();
+        given[10].0.y += 100.0;
         assert_eq!(
-            sim.metrics_of(positions).divergence.unwrap().kind,
+            sim.metrics_of(given).divergence.unwrap().kind,
             DivergenceKind::ErrorLimit
         );
+        // A run that stops short ends diverged where it stopped.
+        let m = sim.metrics_of(samples().take(50));
+        assert_eq!((m.samples, m.divergence.unwrap().k), (50, 50));
     }
 
     #[test]

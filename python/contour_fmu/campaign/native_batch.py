@@ -19,6 +19,7 @@ import json
 import signal
 import subprocess
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -125,9 +126,17 @@ class Ended(Exception):
     """The child process ended before it answered a run: (exit status, its stderr)."""
 
 
+# contour-cosim batch's exit status after a run in which an FMU returned fmi2Fatal: the
+# run was answered, and the next needs a new process.
+FATAL_STATUS = 4
+# Seconds a child that was told to stop may take to end before it is killed.
+END_WAIT = 30.0
+
+
 class Child:
     """A contour-cosim process of the job, kept for the batches that follow (its FMUs
-    unpacked and loaded once per worker process): a run line in, the run's result out."""
+    unpacked and loaded once per worker process): a run line in, the run's result out.
+    A child that answers out of turn or garbled is killed: it is never read again."""
 
     def __init__(self, job, folder):
         self.errors = tempfile.TemporaryFile(dir=folder)
@@ -136,20 +145,37 @@ class Child:
         header = self.process.stdout.readline()
         if not header:
             self.ended()
-        self.width = len(json.loads(header)["columns"])
+        try:
+            self.width = len(json.loads(header)["columns"])
+        except (ValueError, KeyError, TypeError):
+            self.garbled(f"a first line that is not its columns: {header[:200]!r}")
 
-    def ended(self):
+    def ended(self, kill=False):
         """Raises Ended with the exit status and what the child said."""
+        if kill:
+            self.process.kill()
         for stream in (self.process.stdin, self.process.stdout):
             try:
                 stream.close()
             except OSError:  # a broken pipe: the child is gone
                 pass
-        status = self.process.wait()
+        try:
+            status = self.process.wait(timeout=END_WAIT)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            status = self.process.wait()
         self.errors.seek(0)
         said = self.errors.read().decode(errors="replace").strip()
         self.errors.close()
         raise Ended(status, said)
+
+    def garbled(self, what):
+        """Kills the child and raises RunFailed: its answers can no longer be trusted."""
+        try:
+            self.ended(kill=True)
+        except Ended:
+            pass
+        raise RunFailed(f"contour-cosim answered {what}")
 
     def run(self, run_id, start_values):
         """(head, table): the child's result line and, when ok, its rows t_0..t_k."""
@@ -163,16 +189,20 @@ class Child:
         line = self.process.stdout.readline()
         if not line:
             self.ended()
-        head = json.loads(line)
-        if head["run"] != run_id:
-            raise RunFailed(f"contour-cosim answered run {head['run']} for run {run_id}")
-        if head["status"] != "ok":
+        try:
+            head = json.loads(line)
+            answered, ok, steps = head["run"], head["status"] == "ok", int(head["steps"])
+        except (ValueError, KeyError, TypeError):
+            self.garbled(f"a line that is not a run's result: {line[:200]!r}")
+        if answered != run_id:
+            self.garbled(f"run {answered} for run {run_id}")
+        if not ok:
             return head, None
-        size = (head["steps"] + 1) * self.width * 8
+        size = (steps + 1) * self.width * 8
         data = self.process.stdout.read(size)
         if data is None or len(data) != size:
             self.ended()
-        return head, np.frombuffer(data, dtype="<f8").reshape(head["steps"] + 1, self.width)
+        return head, np.frombuffer(data, dtype="<f8").reshape(steps + 1, self.width)
 
     def close(self):
         try:
@@ -182,6 +212,9 @@ class Child:
 
 
 _children = {}  # command line -> Child, for this process's lifetime
+# A worker with several threads runs batches at once: one of them talks to the child at a
+# time (a pipe carries one conversation).
+_lock = threading.Lock()
 
 
 def _child(job, folder):
@@ -202,17 +235,33 @@ def _ended_row(run_id, ended, began, metrics):
         return _row(run_id, "crashed", f"the FMUs' process was killed by {_signal_name(-status)} "
                     f"(signal {-status})", began, metrics)
     if status == native.TIMEOUT_STATUS:
-        return _row(run_id, "timeout", said.removeprefix("contour-cosim: "), began, metrics)
+        last = said.splitlines()[-1] if said else "an FMU call did not return in time"
+        return _row(run_id, "timeout", last.removeprefix("contour-cosim: "), began, metrics)
     raise RunFailed(f"contour-cosim stopped (exit status {status}): {said[-2000:]}")
+
+
+def _answer(job, folder, run_id, start_values):
+    """The child's (head, table) for a run; a child that had stopped after an FMU's
+    fmi2Fatal in the run before is replaced and asked again."""
+    for attempt in (1, 2):
+        try:
+            return _child(job, folder).run(run_id, start_values)
+        except Ended as ended:
+            _children.pop(tuple(command(job, folder)), None)
+            if ended.args[0] != FATAL_STATUS or attempt == 2:
+                raise
+        except RunFailed:
+            _children.pop(tuple(command(job, folder)), None)
+            raise
 
 
 def run_one(job, folder, run_id, start_values):
     """The row of one run through this process's child (made anew after a crash)."""
     began = time.perf_counter()
     try:
-        head, table = _child(job, folder).run(run_id, start_values)
+        with _lock:
+            head, table = _answer(job, folder, run_id, start_values)
     except Ended as ended:
-        _children.pop(tuple(command(job, folder)), None)
         return _ended_row(run_id, ended, began, job.metrics)
     if table is None:
         return _row(run_id, "error", head["message"], began, job.metrics)

@@ -3,7 +3,8 @@
 campaign takes it as the plant): velocity commands `u.x`, `u.y` in, positions `pos.x`,
 `pos.y` out (ideal axes: pos += u·h), starting at `pos0.*`. At `fault_time` its fmi2DoStep
 does what the Integer parameter `fault` says: 0 nothing, 1 dereferences NULL (SIGSEGV), 2
-spins forever. Every other fmi2 function a master may look up exists and returns fmi2Error
+spins forever, 3 prints a line on standard output at every step from then on, 4 returns
+fmi2Fatal. Every other fmi2 function a master may look up exists and returns fmi2Error
 where it does nothing."""
 
 import subprocess
@@ -11,9 +12,10 @@ import zipfile
 from pathlib import Path
 
 GUID = "{5c0e5a77-1c4e-4d0c-9a44-000000000fa1}"
-NONE, SEGFAULT, HANG = 0, 1, 2
+NONE, SEGFAULT, HANG, CHATTY, FATAL = 0, 1, 2, 3, 4
 
 SOURCE = r"""
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 typedef void *C;
@@ -73,6 +75,8 @@ EXPORT int fmi2DoStep(C c, double t, double h, int no_prior) {
     if (m->fault != 0 && t >= m->r[6]) {
         if (m->fault == 1) { volatile int *nothing = NULL; *nothing = 1; }
         if (m->fault == 2) { volatile int spin = 1; while (spin) {} }
+        if (m->fault == 3) { printf("chatty FMU at t = %g\\n", t); }
+        if (m->fault == 4) { return 4; }
     }
     m->r[2] += m->r[0] * h;
     m->r[3] += m->r[1] * h;
