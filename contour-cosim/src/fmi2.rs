@@ -119,7 +119,13 @@ pub struct Library {
 impl Library {
     /// Opens `binaries/<platform>/<model_identifier>.so` (or .dylib, .dll) of the FMU
     /// unpacked in `folder`; `fmu` names the FMU in messages.
-    pub fn open(folder: &Path, model_identifier: &str, fmu: &Path) -> Result<Library, Error> {
+    /// The library's initialisers run while `activity` counts a call under way.
+    pub fn open(
+        folder: &Path,
+        model_identifier: &str,
+        fmu: &Path,
+        activity: &Activity,
+    ) -> Result<Library, Error> {
         let binaries = folder.join("binaries");
         let file = binaries
             .join(PLATFORM)
@@ -147,7 +153,10 @@ impl Library {
         }
         // SAFETY: loading a library runs its initialisers; an FMU's library is code the
         // user asked to run, which is what a co-simulation master is for.
-        let library = unsafe { libloading::Library::new(&file) }.map_err(|e| {
+        activity.bump();
+        let opened = unsafe { libloading::Library::new(&file) };
+        activity.bump();
+        let library = opened.map_err(|e| {
             // pythonfmu's binary takes Python's symbols from the process it is loaded into.
             let text = e.to_string();
             let hint = if text.contains("undefined symbol: _Py")
@@ -222,7 +231,7 @@ impl Activity {
     pub fn count(&self) -> u64 {
         self.0.load(Ordering::Relaxed)
     }
-    fn bump(&self) {
+    pub(crate) fn bump(&self) {
         self.0.fetch_add(1, Ordering::Relaxed);
     }
 }

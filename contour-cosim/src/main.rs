@@ -10,7 +10,9 @@ use std::time::Duration;
 use contour_cosim::fmi2::{self, Activity};
 use contour_cosim::ssp::StartValues;
 use contour_cosim::watchdog::Watchdog;
-use contour_cosim::{End, Error, Experiment, Recording, Scheme, Simulation, System, Trace};
+use contour_cosim::{
+    End, Error, Experiment, Recording, Scheme, Simulation, System, SystemStructure, Trace,
+};
 
 const USAGE: &str = r#"usage: contour-cosim run LOOP.ssd|LOOP.ssp [options]
        contour-cosim batch LOOP.ssd|LOOP.ssp [options] [--runs FILE]
@@ -229,7 +231,7 @@ fn run(options: &Options) -> Result<Outcome, Error> {
             |e| Error::Failed(format!("cannot set the standard output aside: {e}")),
         )?)),
     };
-    let system = System::load(&options.file)?;
+    let system = System::from_structure(SystemStructure::read(&options.file)?, &activity)?;
     if options.command == "check" {
         let mut text = String::new();
         for unit in &system.units {

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::archive::{unpack, Unpacked};
-use crate::fmi2::Library;
+use crate::fmi2::{Activity, Library};
 use crate::model_description::{ModelDescription, Variable, VariableType};
 use crate::ssp::{Connection, SystemStructure, Value};
 use crate::Error;
@@ -22,7 +22,8 @@ pub struct Fmu {
 }
 
 impl Fmu {
-    pub fn load(file: &Path) -> Result<Fmu, Error> {
+    /// Unpacks and describes the FMU `file` and opens its library (counted in `activity`).
+    pub fn load(file: &Path, activity: &Activity) -> Result<Fmu, Error> {
         if !file.is_file() {
             return Err(Error::Refused(format!("{}: no such FMU", file.display())));
         }
@@ -39,6 +40,7 @@ impl Fmu {
             unpacked.path(),
             &description.model_identifier,
             file,
+            activity,
         )?);
         Ok(Fmu {
             file: file.to_path_buf(),
@@ -91,11 +93,15 @@ impl System {
     /// Reads the SSP file `file` and loads its FMUs (an FMU named by several components is
     /// unpacked once); every error names the file it is about.
     pub fn load(file: &Path) -> Result<System, Error> {
-        System::from_structure(SystemStructure::read(file)?)
+        System::from_structure(SystemStructure::read(file)?, &Activity::default())
     }
 
-    /// Loads the FMUs of `structure` (read, and perhaps with a component's FMU replaced).
-    pub fn from_structure(structure: SystemStructure) -> Result<System, Error> {
+    /// Loads the FMUs of `structure` (read, and perhaps with a component's FMU replaced);
+    /// opening their libraries counts as calls in `activity`, which a watchdog may watch.
+    pub fn from_structure(
+        structure: SystemStructure,
+        activity: &Activity,
+    ) -> Result<System, Error> {
         let mut loaded: HashMap<PathBuf, Arc<Fmu>> = HashMap::new();
         let mut units = Vec::new();
         for name in &structure.order {
@@ -105,7 +111,7 @@ impl System {
             let fmu = match loaded.get(&component.source) {
                 Some(fmu) => fmu.clone(),
                 None => {
-                    let fmu = Arc::new(Fmu::load(&component.source).map_err(|e| {
+                    let fmu = Arc::new(Fmu::load(&component.source, activity).map_err(|e| {
                         Error::Refused(format!(
                             "{}: component {name}: {e}",
                             structure.file.display()

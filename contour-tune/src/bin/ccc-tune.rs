@@ -11,6 +11,7 @@ use std::time::Instant;
 
 use contour_core::path::Path;
 use contour_core::sim::preset_feed;
+use contour_cosim::fmi2::Activity;
 use contour_cosim::{System, SystemStructure};
 use contour_tune::fmu_objective::FmuObjective;
 use contour_tune::objective::{ContourObjective, Fitness, FACTOR_NAMES, LOWER, UPPER};
@@ -154,7 +155,7 @@ fn run(o: Options) -> Result<(), String> {
                 .replace_source("plant", plant)
                 .map_err(|e| format!("--plant: {e}"))?;
         }
-        Some(System::from_structure(structure).map_err(|e| e.to_string())?)
+        Some(System::from_structure(structure, &Activity::default()).map_err(|e| e.to_string())?)
     } else {
         None
     };
