@@ -13,6 +13,7 @@
 //! `five_axis/plan_1k` and `five_axis/plan_100k`: planning the reference of a hemisphere
 //! raster of 1 000 and of 100 000 CL points (docs/design/five-axis.md §5.3b).
 
+use contour_core::math;
 use std::hint::black_box;
 
 use contour_core::control::{CccMode, FiveAxisConfig, FiveAxisController};
@@ -63,10 +64,10 @@ fn helix(n: usize) -> Vec<(Joints, Joints)> {
     let q = |k: usize| {
         let t = k as f64 * 2.5e-3;
         Joints::new(
-            30.0 + 20.0 * t.cos(),
-            10.0 + 20.0 * t.sin(),
+            30.0 + 20.0 * math::cos(t),
+            10.0 + 20.0 * math::sin(t),
             0.8 * t,
-            0.35 + 0.1 * (0.3 * t).sin(),
+            0.35 + 0.1 * math::sin(0.3 * t),
             t,
         )
     };

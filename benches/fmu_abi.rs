@@ -44,6 +44,7 @@
 //! in short chunks (see [`PASSES`]: robust to other processes on a shared machine), and
 //! writes them to `<target>/bench-report/fmu_abi.json` for benches/report.py.
 
+use contour_core::math;
 use std::ffi::CString;
 use std::hint::black_box;
 use std::path::PathBuf;
@@ -505,7 +506,13 @@ fn spiral_program(n: usize) -> String {
     for k in 1..=n {
         let phi = (k as f64 * 0.4).sqrt();
         let r = 5.0 + 0.5 * phi;
-        writeln!(text, "X{:.4} Y{:.4}", r * phi.cos(), r * phi.sin()).expect("a String");
+        writeln!(
+            text,
+            "X{:.4} Y{:.4}",
+            r * math::cos(phi),
+            r * math::sin(phi)
+        )
+        .expect("a String");
     }
     let file = std::env::temp_dir().join(format!("fmu_abi_spiral_{n}.ngc"));
     std::fs::write(&file, text).expect("the temporary folder is writable");
@@ -682,10 +689,10 @@ fn helix(n: usize) -> Vec<[f64; 10]> {
     let q = |k: usize| {
         let t = k as f64 * 2.5e-3;
         [
-            30.0 + 20.0 * t.cos(),
-            10.0 + 20.0 * t.sin(),
+            30.0 + 20.0 * math::cos(t),
+            10.0 + 20.0 * math::sin(t),
             0.8 * t,
-            0.35 + 0.1 * (0.3 * t).sin(),
+            0.35 + 0.1 * math::sin(0.3 * t),
             t,
         ]
     };

@@ -7,6 +7,7 @@
 //! hint-accelerated index result (hint = the generating parameter).
 
 use contour_core::contour::planar::{true_error, TrueErrorIndex};
+use contour_core::math;
 use contour_core::path::{builtin, Curve};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
@@ -35,7 +36,7 @@ fn main() {
         .map(|_| {
             let u = rng.random_range(a..b);
             let e = path.eval(u);
-            let s = e.d1[0].hypot(e.d1[1]);
+            let s = math::hypot(e.d1[0], e.d1[1]);
             let span = if rng.random_bool(0.8) { 2.0 } else { 20.0 };
             let off = rng.random_range(-span..span);
             let p = [e.p[0] - off * e.d1[1] / s, e.p[1] + off * e.d1[0] / s];

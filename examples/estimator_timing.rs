@@ -2,6 +2,7 @@
 //! point lags 35 samples (P position loop, Kpp = 28.5 s⁻¹, Ts = 1 ms) and sits 50 µm off
 //! the path. Usage: `estimator_timing [PATH]` (default trident).
 
+use contour_core::math;
 use std::time::Instant;
 
 use contour_core::contour::planar::{true_error, FreeCurveEstimator, TrueErrorIndex};
@@ -19,7 +20,7 @@ fn main() {
     let actual: Vec<[f64; 2]> = (0..samples.len())
         .map(|k| {
             let e = path.eval(samples[k.saturating_sub(35)].u);
-            let s = e.d1[0].hypot(e.d1[1]);
+            let s = math::hypot(e.d1[0], e.d1[1]);
             [e.p[0] + 0.05 * e.d1[1] / s, e.p[1] - 0.05 * e.d1[0] / s]
         })
         .collect();

@@ -29,6 +29,7 @@
 use contour_core::control::CccMode;
 use contour_core::geometry::Vector;
 use contour_core::kinematics::{Joints, Pose, TableTiltingAc};
+use contour_core::math;
 use contour_core::path::ToolPath;
 use contour_core::plant::{ServoAxes, ServoAxesParams};
 use contour_core::sim::{simulate_five_axis, FiveAxisSimConfig};
@@ -121,9 +122,9 @@ fn command(t: f64) -> Vector<5> {
     Vector::<5>::new(
         if t < 0.05 { 20.0 } else { -35.0 },
         (400.0 * t).min(60.0),
-        30.0 * (tau * 7.0 * t).sin(),
+        30.0 * math::sin(tau * 7.0 * t),
         if (0.02..0.12).contains(&t) { 0.8 } else { -0.3 },
-        5.0 * t + 2.0 * (tau * 3.0 * t).sin(),
+        5.0 * t + 2.0 * math::sin(tau * 3.0 * t),
     )
 }
 

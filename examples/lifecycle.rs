@@ -8,6 +8,7 @@
 #[path = "../tests/abi/common/linked.rs"]
 mod linked;
 
+use contour_core::math;
 use std::ffi::CString;
 use std::ptr;
 
@@ -35,7 +36,7 @@ fn cycle(
         let c = instantiate_started(model, &name, functions);
         for k in 0..5 {
             let values: Vec<f64> = (0..inputs.len())
-                .map(|j| (0.01 * (k + n) as f64 + j as f64).sin())
+                .map(|j| math::sin(0.01 * (k + n) as f64 + j as f64))
                 .collect();
             assert_eq!(
                 fmi2SetReal(c, inputs.as_ptr(), inputs.len(), values.as_ptr()),

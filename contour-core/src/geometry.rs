@@ -6,6 +6,7 @@
 //! what the planar code has always used, so results stay bit-identical across the move
 //! to generic dimensions. clippy.toml forbids the nalgebra method to keep it that way.
 
+use crate::math;
 use nalgebra::SVector;
 
 /// A point or vector in `D` dimensions, mm (or mm and rad for machine joints).
@@ -15,7 +16,7 @@ pub type Vector<const D: usize> = SVector<f64, D>;
 pub type Vector2 = Vector<2>;
 
 /// Euclidean length, never overflowing: in one and two dimensions `hypot` (exact for
-/// D = 1, equal to `x.hypot(y)` for D = 2); from three on the square root of the sum of
+/// D = 1, equal to `math::hypot(x, y)` for D = 2); from three on the square root of the sum of
 /// squares — a fifth of the cost of folding `hypot`, within 2 ulp — when that sum is a
 /// normal number far from overflow, else the `hypot` fold.
 #[inline]
@@ -29,7 +30,7 @@ pub fn norm<const D: usize>(v: &Vector<D>) -> f64 {
     // Starting from |v₀| rather than hypot(0, v₀) saves a libm call per length: in the
     // plane one hypot, as before.
     match v.as_slice().split_first() {
-        Some((first, rest)) => rest.iter().fold(first.abs(), |acc, &x| acc.hypot(x)),
+        Some((first, rest)) => rest.iter().fold(first.abs(), |acc, &x| math::hypot(acc, x)),
         None => 0.0,
     }
 }
@@ -78,7 +79,7 @@ pub fn angle_between(u: &Vector<3>, v: &Vector<3>) -> f64 {
     if cross == 0.0 && dot == 0.0 {
         0.0
     } else {
-        cross.atan2(dot)
+        math::atan2(cross, dot)
     }
 }
 
@@ -93,8 +94,8 @@ pub fn slerp(a: &Vector<3>, b: &Vector<3>, t: f64) -> Option<Vector<3>> {
         // sin θ ≈ θ: the linear blend, normalised, is exact to rounding here.
         return unit(&(a * (1.0 - t) + b * t));
     }
-    let s = angle.sin();
-    Some(a * (((1.0 - t) * angle).sin() / s) + b * ((t * angle).sin() / s))
+    let s = math::sin(angle);
+    Some(a * (math::sin((1.0 - t) * angle) / s) + b * (math::sin(t * angle) / s))
 }
 
 #[cfg(test)]
@@ -108,7 +109,7 @@ mod tests {
             let v = slerp(&z, &x, t).unwrap();
             let a = t * std::f64::consts::FRAC_PI_2;
             assert!(
-                (v - Vector::<3>::new(a.sin(), 0.0, a.cos())).amax() < 1e-15,
+                (v - Vector::<3>::new(math::sin(a), 0.0, math::cos(a))).amax() < 1e-15,
                 "t={t}"
             );
         }
@@ -122,7 +123,7 @@ mod tests {
         assert_eq!(norm(&v), 5.0);
         // Bit-identical to hypot (what the planar code used before generic dimensions).
         let w = Vector2::new(0.1, 0.7);
-        assert_eq!(norm(&w).to_bits(), 0.1f64.hypot(0.7).to_bits());
+        assert_eq!(norm(&w).to_bits(), math::hypot(0.1f64, 0.7).to_bits());
         // No overflow where Σx² would be infinite.
         let big = Vector::<3>::new(1e200, 1e200, 1e200);
         assert!((norm(&big) / (1e200 * 3f64.sqrt()) - 1.0).abs() < 1e-15);
@@ -131,7 +132,7 @@ mod tests {
         assert_eq!(norm(&Vector::<0>::zeros()), 0.0);
         assert_eq!(
             norm(&Vector2::new(-0.1, -0.7)).to_bits(),
-            0.1f64.hypot(0.7).to_bits()
+            math::hypot(0.1f64, 0.7).to_bits()
         );
     }
 

@@ -15,6 +15,7 @@
 //! nearest the previous C. At A = 0 (tool along the C axis) C does not move the tool
 //! axis: the previous C is kept, and the Jacobian loses rank (the controller damps it).
 
+use crate::math;
 use nalgebra::{Matrix3, SMatrix};
 use serde::{Deserialize, Serialize};
 
@@ -63,23 +64,23 @@ impl Default for TableTiltingAc {
 }
 
 fn rx(angle: f64) -> Matrix3<f64> {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = math::sincos(angle);
     Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
 }
 
 fn rz(angle: f64) -> Matrix3<f64> {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = math::sincos(angle);
     Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
 }
 
 /// d/dθ of rx(θ) and rz(θ).
 fn drx(angle: f64) -> Matrix3<f64> {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = math::sincos(angle);
     Matrix3::new(0.0, 0.0, 0.0, 0.0, -s, -c, 0.0, c, -s)
 }
 
 fn drz(angle: f64) -> Matrix3<f64> {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = math::sincos(angle);
     Matrix3::new(-s, -c, 0.0, c, -s, 0.0, 0.0, 0.0, 0.0)
 }
 
@@ -94,8 +95,8 @@ pub fn unwrap_near(angle: f64, near: f64) -> f64 {
 /// when A = 0). The other branch is (−A, C + π).
 pub fn axis_angles(axis: &Vector<3>) -> (f64, f64) {
     (
-        axis[0].hypot(axis[1]).atan2(axis[2]),
-        axis[0].atan2(axis[1]),
+        math::atan2(math::hypot(axis[0], axis[1]), axis[2]),
+        math::atan2(axis[0], axis[1]),
     )
 }
 
@@ -122,8 +123,8 @@ impl TableTiltingAc {
             return None;
         }
         let o = pose.axis / length;
-        let sideways = o[0].hypot(o[1]);
-        let a_angle = sideways.atan2(o[2]);
+        let sideways = math::hypot(o[0], o[1]);
+        let a_angle = math::atan2(sideways, o[2]);
         let c_angle = if sideways < VERTICAL || !previous_c.is_finite() {
             if previous_c.is_finite() {
                 previous_c
@@ -131,7 +132,7 @@ impl TableTiltingAc {
                 0.0
             }
         } else {
-            unwrap_near(o[0].atan2(o[1]), previous_c)
+            unwrap_near(math::atan2(o[0], o[1]), previous_c)
         };
         Some(self.joints_at(&pose.tip, a_angle, c_angle))
     }
@@ -215,8 +216,8 @@ mod tests {
         let m = TableTiltingAc::default();
         for q in joints() {
             let (x, y, z) = (q[0], q[1], q[2]);
-            let (sa, ca) = q[3].sin_cos();
-            let (sc, cc) = q[4].sin_cos();
+            let (sa, ca) = math::sincos(q[3]);
+            let (sc, cc) = math::sincos(q[4]);
             let pose = m.forward(&q);
             let tip = Vector::<3>::new(
                 cc * x + sc * ca * y + sc * sa * z,

@@ -16,6 +16,7 @@ pub mod control;
 pub mod geometry;
 pub mod kinematics;
 pub mod limits;
+pub mod math;
 pub mod path;
 pub mod plant;
 pub mod sim;

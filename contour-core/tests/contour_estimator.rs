@@ -55,6 +55,7 @@ use contour_core::contour::planar::{
 };
 use contour_core::contour::ContourEstimator;
 use contour_core::geometry::Vector2;
+use contour_core::math;
 use contour_core::path::{builtin, Curve, Interpolator, Path};
 
 const TS: f64 = 1e-3;
@@ -98,12 +99,12 @@ fn seg_dist(p: Vector2, a: Vector2, b: Vector2) -> f64 {
     } else {
         0.0
     };
-    (p[0] - a[0] - t * abx).hypot(p[1] - a[1] - t * aby)
+    math::hypot(p[0] - a[0] - t * abx, p[1] - a[1] - t * aby)
 }
 
 fn curvature(path: &Path, u: f64) -> f64 {
     let e = path.eval(u);
-    let s = e.d1[0].hypot(e.d1[1]);
+    let s = math::hypot(e.d1[0], e.d1[1]);
     (e.d1[0] * e.d2[1] - e.d1[1] * e.d2[0]) / (s * s * s)
 }
 
@@ -131,7 +132,7 @@ impl Geometry {
                     }
                     // Cheap reject: the segment is within one chord of its first vertex.
                     let (dx, dy) = (pts[j][0] - pts[i][0], pts[j][1] - pts[i][1]);
-                    if dx.hypot(dy) - CLEARANCE_CHORD >= best {
+                    if math::hypot(dx, dy) - CLEARANCE_CHORD >= best {
                         continue;
                     }
                     best = best.min(seg_dist(pts[i], pts[j], pts[j + 1]));
@@ -147,7 +148,7 @@ impl Geometry {
         for i in 0..n - 1 {
             let ds = {
                 let (dx, dy) = (pts[i + 1][0] - pts[i][0], pts[i + 1][1] - pts[i][1]);
-                dx.hypot(dy)
+                math::hypot(dx, dy)
             };
             if ds > 0.5 * CLEARANCE_CHORD {
                 kappa_slope = kappa_slope.max((kappa[i + 1] - kappa[i]).abs() / ds);
@@ -192,7 +193,7 @@ struct Stats {
 
 fn normal_at(path: &Path, u: f64) -> (Vector2, Vector2) {
     let e = path.eval(u);
-    let s = e.d1[0].hypot(e.d1[1]);
+    let s = math::hypot(e.d1[0], e.d1[1]);
     (e.p, Vector2::new(-e.d1[1] / s, e.d1[0] / s))
 }
 
@@ -257,7 +258,7 @@ fn run(
                     st.max_dev_lagging = st.max_dev_lagging.max(dev);
                 }
                 st.peak_true = st.peak_true.max(t.error.abs());
-                let dn = (e.normal[0] - t.normal[0]).hypot(e.normal[1] - t.normal[1]);
+                let dn = math::hypot(e.normal[0] - t.normal[0], e.normal[1] - t.normal[1]);
                 st.max_normal_dev = st.max_normal_dev.max(dn);
                 st.points += 1;
             }

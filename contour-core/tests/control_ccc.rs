@@ -10,6 +10,7 @@ use contour_core::control::{
     FuzzyFactor, FuzzyFactors, Gain, Parameter, PidGains,
 };
 use contour_core::geometry::Vector2;
+use contour_core::math;
 use serde::{Deserialize, Serialize};
 
 /// Exact contour error of a circle (docs/design/two-axis.md §4.1), computed here independently.
@@ -23,7 +24,7 @@ struct CircleEstimator {
 impl ContourEstimator for CircleEstimator {
     fn estimate(&mut self, _reference: Vector2, actual: Vector2) -> ContourEstimate {
         let d = [actual[0] - self.centre[0], actual[1] - self.centre[1]];
-        let rho = d[0].hypot(d[1]);
+        let rho = math::hypot(d[0], d[1]);
         let s = if self.ccw { 1.0 } else { -1.0 };
         ContourEstimate {
             error: s * (rho - self.radius),
@@ -66,7 +67,7 @@ impl ContourEstimator for Scripted {
 fn est(error: f64, angle: f64) -> ContourEstimate {
     ContourEstimate {
         error,
-        normal: Vector2::new(angle.cos(), angle.sin()),
+        normal: Vector2::new(math::cos(angle), math::sin(angle)),
     }
 }
 
@@ -413,7 +414,7 @@ fn defaults_are_documented_values() {
 /// Circle of the paper: centre (−10, 0), radius 10, counter-clockwise, half a turn per s.
 fn circle_point(t: f64) -> [f64; 2] {
     let a = std::f64::consts::PI * t;
-    [10.0 * a.cos() - 10.0, 10.0 * a.sin()]
+    [10.0 * math::cos(a) - 10.0, 10.0 * math::sin(a)]
 }
 
 fn circle_controller(mode: CccMode) -> CrossCoupledController<CircleEstimator> {

@@ -18,6 +18,7 @@
 use contour_core::control::{FiveAxisConfig, FiveAxisController};
 use contour_core::geometry::{self, Vector};
 use contour_core::kinematics::{Joints, Pose, TableTiltingAc};
+use contour_core::math;
 
 type V3 = Vector<3>;
 
@@ -42,21 +43,33 @@ impl Eight {
     }
 
     fn tip(&self, t: f64) -> V3 {
-        V3::new(self.a * t.sin(), self.b * (2.0 * t).sin(), 0.0)
+        V3::new(self.a * math::sin(t), self.b * math::sin(2.0 * t), 0.0)
     }
 
     fn velocity(&self, t: f64) -> V3 {
-        V3::new(self.a * t.cos(), 2.0 * self.b * (2.0 * t).cos(), 0.0)
+        V3::new(
+            self.a * math::cos(t),
+            2.0 * self.b * math::cos(2.0 * t),
+            0.0,
+        )
     }
 
     fn axis(&self, t: f64) -> V3 {
-        let (lean, tilt) = (2.5f64.to_radians() * t.cos(), 25f64.to_radians());
-        V3::new(lean.sin() * tilt.cos(), tilt.sin(), lean.cos() * tilt.cos())
+        let (lean, tilt) = (2.5f64.to_radians() * math::cos(t), 25f64.to_radians());
+        V3::new(
+            math::sin(lean) * math::cos(tilt),
+            math::sin(tilt),
+            math::cos(lean) * math::cos(tilt),
+        )
     }
 
     fn bend_radius(&self, t: f64) -> f64 {
         let v = self.velocity(t);
-        let acceleration = V3::new(-self.a * t.sin(), -4.0 * self.b * (2.0 * t).sin(), 0.0);
+        let acceleration = V3::new(
+            -self.a * math::sin(t),
+            -4.0 * self.b * math::sin(2.0 * t),
+            0.0,
+        );
         geometry::norm(&v).powi(3) / geometry::norm(&v.cross(&acceleration))
     }
 
@@ -114,11 +127,11 @@ impl Eight {
 fn offset(tau: f64, loop_end: f64) -> Joints {
     let w = std::f64::consts::TAU;
     Joints::new(
-        0.04 * (w * 0.9 * tau + 0.3).sin(),
-        0.1 * (w * (tau - loop_end) / 1.5).cos().powi(3),
-        0.01 * (w * 0.4 * tau + 2.0).sin(),
-        3.5e-4 * (w * 0.7 * tau + 0.5).sin(),
-        5e-4 * (w * 0.5 * tau + 1.5).sin(),
+        0.04 * math::sin(w * 0.9 * tau + 0.3),
+        0.1 * math::cos(w * (tau - loop_end) / 1.5).powi(3),
+        0.01 * math::sin(w * 0.4 * tau + 2.0),
+        3.5e-4 * math::sin(w * 0.7 * tau + 0.5),
+        5e-4 * math::sin(w * 0.5 * tau + 1.5),
     )
 }
 

@@ -5,6 +5,7 @@
 use contour_core::geometry::{self, Vector};
 use contour_core::kinematics::{Pose, TableTiltingAc};
 use contour_core::limits::{JointLimits, PathLimits};
+use contour_core::math;
 use contour_core::path::plan::{Plan, PlannedSample};
 
 type V3 = Vector<3>;
@@ -21,9 +22,9 @@ fn tilting_pass(beside: f64) -> Vec<Pose> {
             Pose {
                 tip: V3::new(-30.0 + 60.0 * f, 0.0, 0.0),
                 axis: V3::new(
-                    theta.sin() * beside.cos(),
-                    beside.sin(),
-                    theta.cos() * beside.cos(),
+                    math::sin(theta) * math::cos(beside),
+                    math::sin(beside),
+                    math::cos(theta) * math::cos(beside),
                 ),
             }
         })
@@ -38,7 +39,7 @@ fn dome_raster(passes: i32) -> Vec<Pose> {
     let mut poses = Vec::new();
     for (k, j) in (-passes..=passes).enumerate() {
         let y = 2.0 * j as f64;
-        let half = ((r * 45f64.to_radians().sin()).powi(2) - y * y).sqrt();
+        let half = ((r * math::sin(45f64.to_radians())).powi(2) - y * y).sqrt();
         let steps = (2.0 * half / 0.5).ceil() as usize;
         for i in 0..=steps {
             let f = i as f64 / steps as f64;

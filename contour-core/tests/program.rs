@@ -3,6 +3,7 @@
 //! the reader's geometry, the exact distance to it (`TrueErrorIndex`, any hint) and the
 //! constant-feed interpolator on it are checked against the test's own closed forms.
 
+use contour_core::math;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use contour_core::contour::planar::TrueErrorIndex;
@@ -14,7 +15,7 @@ use rand::{RngExt, SeedableRng};
 
 /// |v|, the test's own.
 fn size(v: Vector2) -> f64 {
-    v[0].hypot(v[1])
+    math::hypot(v[0], v[1])
 }
 
 /// A piece of the part as the test knows it.
@@ -31,14 +32,14 @@ impl Piece {
             Piece::Line(a, b) => Vector2::new(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])),
             Piece::Arc(c, r, a0, sweep) => {
                 let phi = a0 + t * sweep;
-                Vector2::new(c[0] + r * phi.cos(), c[1] + r * phi.sin())
+                Vector2::new(c[0] + r * math::cos(phi), c[1] + r * math::sin(phi))
             }
         }
     }
 
     fn length(&self) -> f64 {
         match *self {
-            Piece::Line(a, b) => (b[0] - a[0]).hypot(b[1] - a[1]),
+            Piece::Line(a, b) => math::hypot(b[0] - a[0], b[1] - a[1]),
             Piece::Arc(_, r, _, sweep) => r * sweep.abs(),
         }
     }
@@ -55,7 +56,7 @@ impl Piece {
             Piece::Arc(c, _, a0, sweep) => {
                 let q = p - Vector2::from(c);
                 // How far round from the start, in the direction of travel.
-                let turned = (sweep.signum() * (q[1].atan2(q[0]) - a0)).rem_euclid(2.0 * PI);
+                let turned = (sweep.signum() * (math::atan2(q[1], q[0]) - a0)).rem_euclid(2.0 * PI);
                 let t = if turned <= sweep.abs() {
                     turned / sweep.abs()
                 } else if size(p - self.at(0.0)) <= size(p - self.at(1.0)) {
@@ -64,7 +65,7 @@ impl Piece {
                     1.0
                 };
                 let phi = a0 + t * sweep;
-                let tangent = Vector2::new(-phi.sin(), phi.cos()) * sweep.signum();
+                let tangent = Vector2::new(-math::sin(phi), math::cos(phi)) * sweep.signum();
                 (size(p - self.at(t)), t, tangent)
             }
         }
@@ -251,7 +252,7 @@ fn beyond_a_sharp_corner_the_sign_says_outside() {
     for corner in corners {
         for k in 0..360 {
             let phi = (k as f64 + 0.5).to_radians();
-            let p = corner + Vector2::new(phi.cos(), phi.sin());
+            let p = corner + Vector2::new(math::cos(phi), math::sin(phi));
             for hint in [0.0, 15.0, 30.0] {
                 let e = index.error(p, hint).error;
                 let want = if inside(p) { -1.0 } else { 1.0 };

@@ -14,17 +14,22 @@ use contour_core::contour::five_axis::run_evaluation::{
 };
 use contour_core::geometry::{norm, Vector};
 use contour_core::kinematics::{Joints, Pose, TableTiltingAc};
+use contour_core::math;
 use contour_core::path::load_poses;
 
 type V3 = Vector<3>;
 
 /// The built-in figure eight's shape (docs/design/five-axis.md §5.3a): tip and unit axis at t.
 fn eight(t: f64) -> (V3, V3) {
-    let lean = 15f64.to_radians() * t.cos();
+    let lean = 15f64.to_radians() * math::cos(t);
     let tilt = 25f64.to_radians();
     (
-        V3::new(20.0 * t.sin(), 10.0 * (2.0 * t).sin(), 0.0),
-        V3::new(lean.sin() * tilt.cos(), tilt.sin(), lean.cos() * tilt.cos()),
+        V3::new(20.0 * math::sin(t), 10.0 * math::sin(2.0 * t), 0.0),
+        V3::new(
+            math::sin(lean) * math::cos(tilt),
+            math::sin(tilt),
+            math::cos(lean) * math::cos(tilt),
+        ),
     )
 }
 
@@ -32,7 +37,7 @@ fn eight(t: f64) -> (V3, V3) {
 /// a fine grid), as a CAM system would post a smooth curve.
 fn arc_length_table() -> (Vec<f64>, Vec<f64>) {
     let n = 400_000;
-    let speed = |t: f64| (400.0 * t.cos().powi(2) + 400.0 * (2.0 * t).cos().powi(2)).sqrt();
+    let speed = |t: f64| (400.0 * math::cos(t).powi(2) + 400.0 * math::cos(2.0 * t).powi(2)).sqrt();
     let (mut ts, mut s) = (vec![0.0], vec![0.0]);
     for i in 1..=n {
         let (a, b) = (
@@ -54,13 +59,15 @@ fn t_at(table: &(Vec<f64>, Vec<f64>), arc: f64) -> f64 {
 
 /// Turns `v` by `angle` about the unit `axis` (Rodrigues).
 fn rotate(v: &V3, axis: &V3, angle: f64) -> V3 {
-    v * angle.cos() + axis.cross(v) * angle.sin() + axis * axis.dot(v) * (1.0 - angle.cos())
+    v * math::cos(angle)
+        + axis.cross(v) * math::sin(angle)
+        + axis * axis.dot(v) * (1.0 - math::cos(angle))
 }
 
 /// The unit axis a fraction `f` of the way from `a` to `b` along their great circle.
 fn turn_toward(a: &V3, b: &V3, f: f64) -> V3 {
     let cross = a.cross(b);
-    let angle = norm(&cross).atan2(a.dot(b));
+    let angle = math::atan2(norm(&cross), a.dot(b));
     if norm(&cross) == 0.0 {
         return *a;
     }
@@ -68,7 +75,7 @@ fn turn_toward(a: &V3, b: &V3, f: f64) -> V3 {
 }
 
 fn angle(a: &V3, b: &V3) -> f64 {
-    norm(&a.cross(b)).atan2(a.dot(b))
+    math::atan2(norm(&a.cross(b)), a.dot(b))
 }
 
 /// The reference read as straight moves at global parameter u (segment ⌊u⌋).
@@ -187,15 +194,16 @@ fn figure_eight_case() -> Case {
         let arc = total * (0.002 + 0.996 * k as f64 / (n - 1) as f64);
         let t = t_at(&table, arc);
         let (tip, axis) = eight(t);
-        let along = V3::new(20.0 * t.cos(), 20.0 * (2.0 * t).cos(), 0.0);
+        let along = V3::new(20.0 * math::cos(t), 20.0 * math::cos(2.0 * t), 0.0);
         let along = along / norm(&along);
         let normal = V3::new(-along[1], along[0], 0.0);
-        let tip = tip + normal * (0.2 + 0.1 * (5.0 * t).sin()) + V3::z() * 0.03 * (3.0 * t).sin();
-        let across = axis.cross(&V3::new((7.0 * t).cos(), (7.0 * t).sin(), 0.3));
+        let tip =
+            tip + normal * (0.2 + 0.1 * math::sin(5.0 * t)) + V3::z() * 0.03 * math::sin(3.0 * t);
+        let across = axis.cross(&V3::new(math::cos(7.0 * t), math::sin(7.0 * t), 0.3));
         let across = across / norm(&across);
         let pose = Pose {
             tip,
-            axis: rotate(&axis, &across, 1e-3 * (1.0 + 0.5 * (11.0 * t).cos())),
+            axis: rotate(&axis, &across, 1e-3 * (1.0 + 0.5 * math::cos(11.0 * t))),
         };
         let q = machine.inverse(&pose, c).unwrap();
         c = q[4];

@@ -4,6 +4,7 @@
 
 use contour_core::contour::planar::{true_error, Estimator, EstimatorKind};
 use contour_core::control::{CccMode, ControllerConfig, CrossCoupledController, PidGains};
+use contour_core::math;
 use contour_core::path::{builtin, Interpolator};
 use contour_core::plant::{XyTable, XyTableParams};
 use contour_core::sim::{
@@ -140,7 +141,7 @@ fn trace_follows_the_documented_sample_sequence() {
     // 100 ms after the path end the table has nearly caught up with the end point.
     let end = config.path.end_point();
     let last = tr.actual[tr.len() - 1];
-    assert!((last[0] - end[0]).hypot(last[1] - end[1]) < 0.1);
+    assert!(math::hypot(last[0] - end[0], last[1] - end[1]) < 0.1);
 }
 
 #[test]

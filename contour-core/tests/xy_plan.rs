@@ -6,6 +6,7 @@
 
 use contour_core::contour::planar::{true_error, TrueErrorIndex};
 use contour_core::geometry::Vector2;
+use contour_core::math;
 use contour_core::path::plan::{XyLimits, XyReference};
 use contour_core::path::program::parse_program;
 use contour_core::path::Path;
@@ -37,7 +38,7 @@ fn samples(path: &Path, limits: XyLimits) -> (Vec<Vector2>, XyReference) {
 }
 
 fn norm(v: Vector2) -> f64 {
-    v[0].hypot(v[1])
+    math::hypot(v[0], v[1])
 }
 
 struct Case {
@@ -295,7 +296,7 @@ fn the_exact_distance_to_a_blended_program_is_the_dense_samples_nearest() {
         for k in 0..100 {
             let phi = k as f64 * 0.2;
             let radius = 0.001 + 0.0005 * (k % 37) as f64;
-            let p = middle + Vector2::new(phi.cos(), phi.sin()) * radius;
+            let p = middle + Vector2::new(math::cos(phi), math::sin(phi)) * radius;
             let sampled = blends
                 .iter()
                 .flat_map(|b| b.iter().map(|&q| norm(p - q)))

@@ -13,6 +13,7 @@
 //!   F_min = min (|pᵢ − c₀| − R₀).
 
 use contour_core::geometry::{norm, Vector2};
+use contour_core::math;
 use nalgebra::{Matrix3, Vector3};
 
 /// A circle in the plane, mm.
@@ -31,7 +32,7 @@ impl Circle {
     /// The angle of `p` seen from the centre, rad.
     pub fn angle(&self, p: &Vector2) -> f64 {
         let d = p - self.centre;
-        d.y.atan2(d.x)
+        math::atan2(d.y, d.x)
     }
 }
 
@@ -148,7 +149,8 @@ mod tests {
         (0..n)
             .map(|k| {
                 let t = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
-                circle.centre + (circle.radius + deviation(t)) * Vector2::new(t.cos(), t.sin())
+                circle.centre
+                    + (circle.radius + deviation(t)) * Vector2::new(math::cos(t), math::sin(t))
             })
             .collect()
     }
@@ -184,7 +186,7 @@ mod tests {
             centre: Vector2::new(1.0, 2.0),
             radius: 25.0,
         };
-        let f = figures(&on(&circle, |t| 0.004 * (2.0 * t).cos(), 720), &circle).unwrap();
+        let f = figures(&on(&circle, |t| 0.004 * math::cos(2.0 * t), 720), &circle).unwrap();
         assert!(norm(&(f.lsc.centre - circle.centre)) < 1e-9);
         assert!((f.lsc.radius - 25.0).abs() < 1e-9);
         assert!((f.circular_deviation - 0.008).abs() < 1e-9);

@@ -247,6 +247,7 @@ impl Statistics {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use contour_core::math;
     use contour_core::path::program::parse_program;
 
     fn program(text: &str) -> Path {
@@ -286,7 +287,7 @@ mod tests {
             .collect();
         for k in 0..=400 {
             let phi = -std::f64::consts::FRAC_PI_2 + std::f64::consts::TAU * k as f64 / 400.0;
-            points.push(centre + Vector2::new(phi.cos(), phi.sin()) * 5.01);
+            points.push(centre + Vector2::new(math::cos(phi), math::sin(phi)) * 5.01);
         }
         points.extend((1..100).map(|k| Vector2::new(10.0 + 0.1 * k as f64, -0.01)));
         let samples = evaluate(&geometry, &points);

@@ -4,6 +4,7 @@
 //! envelope (min and max of each bucket), so a million samples cost no more to draw than
 //! two thousand. `--circle`: the ballbar plot of the ISO 230-4 circular test.
 
+use contour_core::math;
 use std::path::Path;
 
 use contour_core::contour::five_axis::run_evaluation::SampleContourError;
@@ -214,8 +215,8 @@ pub fn ballbar(
     let drawn = |p: &Vector2| {
         let d = p - nominal.centre;
         let r = nominal.radius + m * deviation(p);
-        let a = d.y.atan2(d.x);
-        (r * a.cos(), r * a.sin())
+        let a = math::atan2(d.y, d.x);
+        (r * math::cos(a), r * math::sin(a))
     };
     let extent = 1.4 * nominal.radius;
     let root = BitMapBackend::new(file, (900, 900)).into_drawing_area();
@@ -240,7 +241,7 @@ pub fn ballbar(
         .map_err(|e| fail(&e))?;
     let nominal_circle = (0..=720).map(|k| {
         let a = std::f64::consts::PI * k as f64 / 360.0;
-        (nominal.radius * a.cos(), nominal.radius * a.sin())
+        (nominal.radius * math::cos(a), nominal.radius * math::sin(a))
     });
     chart
         .draw_series(LineSeries::new(nominal_circle, BLACK.mix(0.4)))

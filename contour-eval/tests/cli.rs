@@ -1,6 +1,7 @@
 //! Runs the `contour-eval` binary on measured runs made here from a known displacement
 //! of the tilted helix, so the expected errors are analytic, and on bad inputs.
 
+use contour_core::math;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -53,7 +54,7 @@ fn displaced_helix_csv() -> (String, Vec<f64>) {
         // The tool leans toward the helix's centre line: outward is the other way.
         let outward = geometry::unit(&V3::new(-axis[0], -axis[1], 0.0)).unwrap();
         let about = geometry::unit(&V3::z().cross(&axis)).unwrap();
-        let turned = axis * TILT.cos() + about.cross(&axis) * TILT.sin();
+        let turned = axis * math::cos(TILT) + about.cross(&axis) * math::sin(TILT);
         let moved = Pose {
             tip: tip + outward * OFFSET,
             axis: turned,
@@ -398,7 +399,7 @@ fn the_reference_is_read_as_straight_moves_unless_smooth_is_asked_for() {
     // The tool leans in the x–z plane by 0.3 + 0.5·φ: a great circle, so slerping
     // between two points turns it linearly in φ.
     let lean = |phi: f64| 0.3 + 0.5 * phi;
-    let axis = |phi: f64| V3::new(lean(phi).sin(), 0.0, lean(phi).cos());
+    let axis = |phi: f64| V3::new(math::sin(lean(phi)), 0.0, math::cos(lean(phi)));
     let mut cl = String::from("PARTNO/ARC\n");
     for i in 0..=16 {
         let phi = step * i as f64;
@@ -406,8 +407,8 @@ fn the_reference_is_read_as_straight_moves_unless_smooth_is_asked_for() {
         writeln!(
             cl,
             "GOTO/{},{},0,{},{},{}",
-            radius * phi.cos(),
-            radius * phi.sin(),
+            radius * math::cos(phi),
+            radius * math::sin(phi),
             o[0],
             o[1],
             o[2]
@@ -421,7 +422,7 @@ fn the_reference_is_read_as_straight_moves_unless_smooth_is_asked_for() {
     let mut c = 0.0;
     for k in 0..240 {
         let phi = 0.2 + 0.4 * k as f64 / 239.0;
-        let tip = V3::new(phi.cos(), phi.sin(), 0.0) * outside;
+        let tip = V3::new(math::cos(phi), math::sin(phi), 0.0) * outside;
         let q = machine
             .inverse(
                 &Pose {
@@ -449,8 +450,8 @@ fn the_reference_is_read_as_straight_moves_unless_smooth_is_asked_for() {
             .map(|i| {
                 let (a, b) = (step * i as f64, step * (i + 1) as f64);
                 let (pa, pb) = (
-                    V3::new(a.cos(), a.sin(), 0.0) * radius,
-                    V3::new(b.cos(), b.sin(), 0.0) * radius,
+                    V3::new(math::cos(a), math::sin(a), 0.0) * radius,
+                    V3::new(math::cos(b), math::sin(b), 0.0) * radius,
                 );
                 let f = ((tip - pa).dot(&(pb - pa)) / (pb - pa).norm_squared()).clamp(0.0, 1.0);
                 let distance = geometry::norm(&(pa + (pb - pa) * f - tip));
@@ -513,7 +514,7 @@ fn the_reference_is_read_as_straight_moves_unless_smooth_is_asked_for() {
         apart = apart.max(st - mt);
     }
     // Near the chords' middles the readings are a sagitta (1.56 µm) apart.
-    let sagitta = radius * (1.0 - (step / 2.0).cos());
+    let sagitta = radius * (1.0 - math::cos(step / 2.0));
     assert!(
         apart > 0.99 * sagitta && apart < sagitta + 3e-7,
         "{apart} vs {sagitta}"

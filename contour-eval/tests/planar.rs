@@ -3,6 +3,7 @@
 //! errors from the test's own closed forms; blended corners; a slot whose return pass
 //! lies nearer the outgoing one; the columns deciding the kind of run; bad inputs.
 
+use contour_core::math;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -73,7 +74,10 @@ fn off_line(a: P2, b: P2, f: f64, d: f64, segment: usize) -> Expected {
 fn off_arc(c: P2, r: f64, phi: f64, ccw: bool, d: f64, segment: usize) -> Expected {
     let radius = if ccw { r + d } else { r - d };
     Expected {
-        point: [c[0] + radius * phi.cos(), c[1] + radius * phi.sin()],
+        point: [
+            c[0] + radius * math::cos(phi),
+            c[1] + radius * math::sin(phi),
+        ],
         contour: d,
         segments: vec![segment],
     }
@@ -162,7 +166,7 @@ fn rectangle_points() -> Vec<Expected> {
         [35.0, 20.0],
         [0.0, 20.0],
     );
-    let offset = |k: usize| 0.3 * (0.7 * k as f64).sin();
+    let offset = |k: usize| 0.3 * math::sin(0.7 * k as f64);
     let mut points = Vec::new();
     // Outside the start corner (a vertex of the closed contour): its distance, right.
     points.push(Expected {
@@ -193,7 +197,7 @@ fn rectangle_points() -> Vec<Expected> {
     for k in 1..10 {
         let theta = FRAC_PI_2 * k as f64 / 10.0;
         points.push(Expected {
-            point: [35.0 + 0.1 * theta.cos(), 20.0 + 0.1 * theta.sin()],
+            point: [35.0 + 0.1 * math::cos(theta), 20.0 + 0.1 * math::sin(theta)],
             contour: 0.1,
             segments: vec![2, 3],
         });
@@ -301,7 +305,7 @@ fn blended_corners_change_the_planned_contour_near_them_only() {
     let corners = [[20.0, 0.0], [20.0, 20.0], [0.0, 20.0]];
     let mut points: Vec<P2> = Vec::new();
     let mut near_vertex = Vec::new();
-    let offset = |k: usize| 0.03 * (0.9 * k as f64).sin();
+    let offset = |k: usize| 0.03 * math::sin(0.9 * k as f64);
     let sides = [
         ([0.0, 0.0], [20.0, 0.0]),
         ([20.0, 0.0], [20.0, 20.0]),
@@ -321,11 +325,14 @@ fn blended_corners_change_the_planned_contour_near_them_only() {
             let out = right([b[0] - a[0], b[1] - a[1]]);
             let turn = |t: P2| [-t[1], t[0]];
             let next = turn([b[0] - a[0], b[1] - a[1]]);
-            let start = out[1].atan2(out[0]);
+            let start = math::atan2(out[1], out[0]);
             for k in 0..=10 {
                 let theta = start + FRAC_PI_2 * k as f64 / 10.0;
                 near_vertex.push(points.len());
-                points.push([v[0] + 0.03 * theta.cos(), v[1] + 0.03 * theta.sin()]);
+                points.push([
+                    v[0] + 0.03 * math::cos(theta),
+                    v[1] + 0.03 * math::sin(theta),
+                ]);
             }
             let inward = [-(out[0] + right(next)[0]), -(out[1] + right(next)[1])];
             for k in 0..=10 {
@@ -459,14 +466,14 @@ fn built_in_paths_and_nurbs_files_are_measured_on_the_xy_table() {
     let points: Vec<P2> = (0..200)
         .map(|k| {
             let phi = 2.0 * PI * k as f64 / 200.0;
-            let r = 10.0 + 0.01 * (k as f64 * 0.3).cos();
-            [-10.0 + r * phi.cos(), r * phi.sin()]
+            let r = 10.0 + 0.01 * math::cos(k as f64 * 0.3);
+            [-10.0 + r * math::cos(phi), r * math::sin(phi)]
         })
         .collect();
     let (rows, stdout) = evaluate(&dir, "circle", &points, &[]);
     for (k, row) in rows.iter().enumerate() {
         assert!(
-            (row.contour - 0.01 * (k as f64 * 0.3).cos()).abs() < 1e-12,
+            (row.contour - 0.01 * math::cos(k as f64 * 0.3)).abs() < 1e-12,
             "{k}"
         );
         assert_eq!((row.segment, row.planned), (0, row.contour));

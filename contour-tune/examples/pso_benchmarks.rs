@@ -4,6 +4,7 @@
 //!
 //! Usage: `pso_benchmarks [SEEDS] [SWARM] [ITERATIONS]` (20, 30, 200).
 
+use contour_core::math;
 use contour_tune::{minimize, Algorithm, PsoSettings};
 use serde_json::json;
 
@@ -20,7 +21,7 @@ fn rosenbrock(x: &[f64]) -> f64 {
 fn rastrigin(x: &[f64]) -> f64 {
     10.0 * x.len() as f64
         + x.iter()
-            .map(|v| v * v - 10.0 * (2.0 * std::f64::consts::PI * v).cos())
+            .map(|v| v * v - 10.0 * math::cos(2.0 * std::f64::consts::PI * v))
             .sum::<f64>()
 }
 

@@ -4,6 +4,7 @@
 //! ChaCha8 stream consumed in a fixed order, so the same seed gives the same run
 //! whatever the evaluation order or thread count.
 
+use contour_core::math;
 use rand_chacha::rand_core::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -52,7 +53,7 @@ pub fn coefficients(algorithm: Algorithm, t: usize, iterations: usize) -> (f64, 
         }
         Algorithm::Improved => {
             // The paper's formula was lost; docs/design/two-axis.md §4.4 reconstructs it as this sigmoid.
-            let w = W_END + (W_START - W_END) / (1.0 + (BETA * t as f64 - ALPHA).exp());
+            let w = W_END + (W_START - W_END) / (1.0 + math::exp(BETA * t as f64 - ALPHA));
             let lambda = (w - W_END) / (W_START - W_END);
             let c1 = C_START + (C_END - C_START) * lambda * lambda;
             let c2 = C_END - (C_END - C_START) * lambda * lambda;
@@ -300,7 +301,7 @@ mod tests {
     #[test]
     fn improved_schedule_follows_design() {
         let (w0, c1, c2) = coefficients(Algorithm::Improved, 0, 100);
-        assert!((w0 - (0.4 + 0.5 / (1.0 + (-3.4f64).exp()))).abs() < 1e-15);
+        assert!((w0 - (0.4 + 0.5 / (1.0 + math::exp(-3.4f64)))).abs() < 1e-15);
         assert!((w0 - 0.8838).abs() < 1e-3);
         let lambda = (w0 - 0.4) / 0.5;
         assert!((c1 - (0.5 + 0.5 * lambda * lambda)).abs() < 1e-15);

@@ -29,6 +29,7 @@
 //! difference at all means the models and the simulator have drifted apart.
 
 use contour_core::control::CccMode;
+use contour_core::math;
 use contour_core::sim::{SimConfig, Simulator, Trace};
 use contour_fmu::framework::model::{Environment, Model, ModelInfo};
 use contour_fmu::framework::variables::{Causality, Value, Values, Variable, Vr};
@@ -213,7 +214,7 @@ fn both_modes(name: &str) {
         .actual
         .iter()
         .zip(&off.actual)
-        .map(|(a, b)| (a[0] - b[0]).hypot(a[1] - b[1]))
+        .map(|(a, b)| math::hypot(a[0] - b[0], a[1] - b[1]))
         .fold(0.0, f64::max);
     assert!(diff > 1e-3, "{name}: CCC on/off differ by only {diff} mm");
 }

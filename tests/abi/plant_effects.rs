@@ -3,6 +3,7 @@
 //! exactly as the original, and the effects change the run (they are read at all).
 
 use crate::common::*;
+use contour_core::math;
 use contour_fmu::models::{five_axis_plant, xy_servo_plant as plant};
 
 /// X: Stribeck friction and a current limit; Y: Coulomb friction and backlash.
@@ -35,7 +36,10 @@ fn run(i: &Instance, from: usize, steps: usize) -> Vec<[f64; 4]> {
         .map(|k| {
             let t = k as f64 * 1e-3;
             let w = 2.0 * std::f64::consts::PI * t;
-            assert_eq!(i.set_reals(&u, &[60.0 * w.sin(), 8.0 * w.cos()]), OK);
+            assert_eq!(
+                i.set_reals(&u, &[60.0 * math::sin(w), 8.0 * math::cos(w)]),
+                OK
+            );
             assert_eq!(i.step(t, 1e-3), OK);
             let (_, p) = i.get_reals(&out[0]);
             let (_, v) = i.get_reals(&out[1]);

@@ -3,6 +3,7 @@
 //! nothing but the handle registry, and nothing in a step depends on which thread runs it
 //! or on what the other instances do meanwhile.
 
+use contour_core::math;
 use std::ffi::CString;
 
 use crate::common::linked::{
@@ -44,9 +45,9 @@ fn input(i: usize, j: usize, k: usize) -> f64 {
     let s = 0.002 * k as f64 + 0.37 * i as f64;
     let phase = 0.9 * j as f64;
     match j % 5 {
-        3 => 0.3 + 0.1 * (s + phase).sin(),
+        3 => 0.3 + 0.1 * math::sin(s + phase),
         4 => 0.2 * s + 0.05 * phase,
-        _ => 20.0 * (s + phase).cos() + (i % 7) as f64,
+        _ => 20.0 * math::cos(s + phase) + (i % 7) as f64,
     }
 }
 

@@ -3,6 +3,7 @@
 //! state save/restore (in place, serialized into a fresh instance, and fmusim's
 //! `--initial-fmu-state-file` sequence), and bad parameters.
 
+use contour_core::math;
 use std::collections::BTreeMap;
 
 use crate::common::*;
@@ -41,10 +42,10 @@ fn held_inputs(t: f64) -> [f64; 4] {
     let k = (t / 0.005 + 1e-9).floor();
     let a = 0.05 * k;
     [
-        10.0 * a.cos() - 10.0,
-        10.0 * a.sin(),
-        9.98 * (a - 0.01).cos() - 10.0,
-        9.98 * (a - 0.01).sin(),
+        10.0 * math::cos(a) - 10.0,
+        10.0 * math::sin(a),
+        9.98 * math::cos(a - 0.01) - 10.0,
+        9.98 * math::sin(a - 0.01),
     ]
 }
 
@@ -197,7 +198,7 @@ fn interpolator_outputs_do_not_depend_on_the_communication_step_and_match_the_li
     assert_eq!(shared, 40 + 40);
     // 0.2 s at 40 mm/s: 8 mm along the path from the start point (40.2, -0.1).
     let (x, y, done) = runs[0][&200_000];
-    let travelled = (x - 40.2).hypot(y + 0.1);
+    let travelled = math::hypot(x - 40.2, y + 0.1);
     assert!(travelled > 6.0 && travelled <= 8.0 + 1e-9, "{travelled}");
     assert!(!done);
 }
@@ -471,6 +472,7 @@ fn inconsistent_parameters_are_refused_at_the_end_of_initialization() {
 mod xy_servo_plant {
     use crate::common::plant_vr::{POS_X, POS_Y, U_X, U_Y, VEL_X};
     use crate::common::*;
+    use contour_core::math;
     use contour_fmu::models::xy_servo_plant as plant;
 
     #[test]
@@ -481,7 +483,7 @@ mod xy_servo_plant {
         fine.start();
         let mut t = 0.0;
         for k in 0..20 {
-            let u = [50.0 * (k as f64 * 0.7).sin(), -30.0 + k as f64];
+            let u = [50.0 * math::sin(k as f64 * 0.7), -30.0 + k as f64];
             assert_eq!(coarse.set_reals(&[U_X, U_Y], &u), OK);
             assert_eq!(fine.set_reals(&[U_X, U_Y], &u), OK);
             assert_eq!(coarse.step(t, 0.01), OK);

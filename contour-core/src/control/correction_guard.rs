@@ -17,6 +17,7 @@
 //! are not a whole number of samples reads as one; what the joints cannot do shows in the
 //! position loops instead (`saturated`).
 
+use crate::math;
 use serde::{Deserialize, Serialize};
 
 use crate::kinematics::Joints;
@@ -151,7 +152,7 @@ impl CorrectionGuard {
         }
         let dt = at - self.measured_at;
         if self.measured && self.sent_since && dt > 0.0 {
-            let keep = (-dt / OBEY_WINDOW).exp();
+            let keep = math::exp(-dt / OBEY_WINDOW);
             let l = &self.limits;
             self.short = false;
             self.lagging = false;
@@ -376,7 +377,7 @@ mod tests {
                 lagging.push(k);
             }
             let t = k as f64 * ts;
-            last = peak * (accel / peak * t).sin();
+            last = peak * math::sin(accel / peak * t);
             g.commanded(&Joints::new(last, 0.0, 0.0, 0.0, 0.0));
             let u = if every == 1 { last } else { held };
             for _ in 0..substeps {

@@ -28,6 +28,7 @@
 //! Fixed-size state apart from the mapper's rings (sized once at construction), so
 //! `sample` never allocates.
 
+use crate::math;
 use serde::{Deserialize, Serialize};
 
 use super::ccc_law::{CccStep, VectorLaw};
@@ -648,7 +649,7 @@ impl FiveAxisController {
         let mu = c.damping;
         let mut damping = Joints::repeat(mu);
         let sin_a2 = pose.axis[0] * pose.axis[0] + pose.axis[1] * pose.axis[1];
-        let cone2 = c.pole_cone.sin().powi(2);
+        let cone2 = math::sin(c.pole_cone).powi(2);
         if sin_a2 < cone2 && c.pole_damping > 0.0 {
             damping[4] =
                 (mu * mu + c.pole_damping * c.pole_damping * (1.0 - sin_a2 / cone2)).sqrt();

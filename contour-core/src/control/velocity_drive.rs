@@ -23,6 +23,7 @@
 //! (or angle) for Kvi, so the same law serves a linear axis (N, mm/s) and a rotary one
 //! (N·m, rad/s).
 
+use crate::math;
 use serde::{Deserialize, Serialize};
 
 /// The drive's gains and limits.
@@ -77,7 +78,7 @@ pub struct VelocityDrive {
 /// input held over `h`: 1 − e^(−h/τ), exactly 1 without a lag.
 fn approach(tau: f64, h: f64) -> f64 {
     if tau > 0.0 {
-        -(-h / tau).exp_m1()
+        -math::expm1(-h / tau)
     } else {
         1.0
     }
@@ -188,7 +189,7 @@ mod tests {
                 let effort = drive.step(0.0, 3.0, h);
                 if k % every == 0 {
                     let t = k as f64 * h;
-                    let want = -3.0 * -(-t / 0.004f64).exp_m1();
+                    let want = -3.0 * -math::expm1(-t / 0.004f64);
                     assert!(
                         (effort - want).abs() < 1e-13,
                         "h {h}, t {t}: {effort} vs {want}"
@@ -205,7 +206,7 @@ mod tests {
         let mut drive = VelocityDrive::new(lagged, 0.0).unwrap();
         for k in 1..=50 {
             let effort = drive.step(4.0, 0.0, 1e-3);
-            let want = 120.0 * -(-(k as f64) * 1e-3 / 0.002f64).exp_m1();
+            let want = 120.0 * -math::expm1(-(k as f64) * 1e-3 / 0.002f64);
             assert!((effort - want).abs() < 1e-12, "{k}: {effort} vs {want}");
         }
     }
@@ -273,7 +274,7 @@ mod tests {
             VelocityDrive::new(P, 0.0).unwrap(),
         );
         for k in 0..3000 {
-            let u = 80.0 * (k as f64 * 0.003).sin();
+            let u = 80.0 * math::sin(k as f64 * 0.003);
             let v = 0.5 * u;
             assert_eq!(up.step(u, v, 1e-3), -down.step(-u, -v, 1e-3));
         }

@@ -2,6 +2,7 @@
 //! counter-clockwise). Parameter u ∈ [0, 1], angle φ(u) = φ0 + u·Δφ, so the speed |C'| is
 //! the constant r·|Δφ| and the feed-rate interpolator steps it exactly.
 
+use crate::math;
 use std::f64::consts::PI;
 
 use serde::{Deserialize, Serialize};
@@ -118,7 +119,7 @@ impl Curve for CircularArc {
     fn eval(&self, u: f64) -> CurvePoint {
         let u = clamp_param(u, 0.0, 1.0);
         let phi = self.start_angle + u * self.sweep;
-        let (s, c) = phi.sin_cos();
+        let (s, c) = math::sincos(phi);
         let r = self.radius;
         let w = self.sweep;
         CurvePoint {

@@ -132,6 +132,7 @@ fn cubic_uniform(p: &[[f64; 2]]) -> Nurbs {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math;
     use crate::path::Curve;
 
     #[test]
@@ -167,7 +168,7 @@ mod tests {
         let mut rmin = f64::INFINITY;
         for k in 0..=20000 {
             let e = t.eval(k as f64 / 20000.0);
-            let sp = e.d1[0].hypot(e.d1[1]);
+            let sp = math::hypot(e.d1[0], e.d1[1]);
             let cr = (e.d1[0] * e.d2[1] - e.d1[1] * e.d2[0]).abs();
             rmin = rmin.min(sp.powi(3) / cr);
         }

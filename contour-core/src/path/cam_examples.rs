@@ -4,6 +4,7 @@
 
 use crate::geometry::Vector;
 use crate::kinematics::Pose;
+use crate::math;
 
 /// A straight pass along x of `length` mm in `step` mm CL steps, the tool axis tilting
 /// from +`tilt` to −`tilt` about y (rad), `beside` rad to the side of vertical (0: through
@@ -17,9 +18,9 @@ pub fn tilting_pass(beside: f64, length: f64, step: f64, tilt: f64) -> Vec<Pose>
             Pose {
                 tip: Vector::<3>::new(-length / 2.0 + length * f, 0.0, 0.0),
                 axis: Vector::<3>::new(
-                    theta.sin() * beside.cos(),
-                    beside.sin(),
-                    theta.cos() * beside.cos(),
+                    math::sin(theta) * math::cos(beside),
+                    math::sin(beside),
+                    math::cos(theta) * math::cos(beside),
                 ),
             }
         })
@@ -41,7 +42,9 @@ pub fn dome_raster(
     let mut poses = Vec::new();
     for (k, j) in (-passes..=passes).enumerate() {
         let y = stepover * j as f64 + offset;
-        let half = ((radius * within.sin()).powi(2) - y * y).max(0.0).sqrt();
+        let half = ((radius * math::sin(within)).powi(2) - y * y)
+            .max(0.0)
+            .sqrt();
         let steps = (2.0 * half / step).ceil().max(1.0) as usize;
         for i in 0..=steps {
             let f = i as f64 / steps as f64;

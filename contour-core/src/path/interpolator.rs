@@ -311,6 +311,7 @@ impl<const D: usize, C: Curve<D>> Interpolator<D, C> {
 mod tests {
     use super::*;
     use crate::geometry::Vector2;
+    use crate::math;
     use crate::path::{builtin, Nurbs};
 
     /// Worst relative chord deviation over the whole run (last clamped sample excluded)
@@ -379,8 +380,8 @@ mod tests {
         for k in 1..2000 {
             let s = it.step();
             let t = k as f64 * ts;
-            let x = 10.0 * (std::f64::consts::PI * t).cos() - 10.0;
-            let y = 10.0 * (std::f64::consts::PI * t).sin();
+            let x = 10.0 * math::cos(std::f64::consts::PI * t) - 10.0;
+            let y = 10.0 * math::sin(std::f64::consts::PI * t);
             assert!(
                 (s.point[0] - x).abs() < 1e-9 && (s.point[1] - y).abs() < 1e-9,
                 "k={k}"

@@ -1,6 +1,7 @@
 //! Straight segment from `a` to `b` in any dimension, parameter u ∈ [0, 1]
 //! (C(u) = a + u·(b − a)).
 
+use crate::math;
 use serde::{Deserialize, Serialize};
 
 use super::{clamp_param, Curve, CurvePoint, PathError};
@@ -53,7 +54,7 @@ impl Line<2> {
     /// Direction angle θ of travel, rad (docs/design/two-axis.md §4.1).
     pub fn angle(&self) -> f64 {
         let d = self.b - self.a;
-        d[1].atan2(d[0])
+        math::atan2(d[1], d[0])
     }
 }
 

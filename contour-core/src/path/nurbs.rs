@@ -394,6 +394,7 @@ impl<const D: usize> Curve<D> for Nurbs<D> {
 mod tests {
     use super::*;
     use crate::geometry::Vector2;
+    use crate::math;
 
     /// docs/design/two-axis.md §4.6: exact unit circle, degree 2, 9 control points on a square.
     fn unit_circle() -> Nurbs {
@@ -406,12 +407,15 @@ mod tests {
         for k in 0..=2000 {
             let u = k as f64 / 2000.0;
             let e = c.eval(u);
-            let r = e.p[0].hypot(e.p[1]);
+            let r = math::hypot(e.p[0], e.p[1]);
             assert!((r - 1.0).abs() < 1e-14, "u={u} r={r}");
             assert!((c.point(u)[0] - e.p[0]).abs() < 1e-15);
             // Tangent ⟂ radius, and C''·C radially consistent: d/du (|C|²) = 2 C·C' = 0.
             let dot = e.p[0] * e.d1[0] + e.p[1] * e.d1[1];
-            assert!(dot.abs() < 1e-12 * (1.0 + e.d1[0].hypot(e.d1[1])), "u={u}");
+            assert!(
+                dot.abs() < 1e-12 * (1.0 + math::hypot(e.d1[0], e.d1[1])),
+                "u={u}"
+            );
             // d²/du² |C|² = 2(|C'|² + C·C'') = 0.
             let dd = e.d1[0] * e.d1[0] + e.d1[1] * e.d1[1] + e.p[0] * e.d2[0] + e.p[1] * e.d2[1];
             assert!(
@@ -437,7 +441,7 @@ mod tests {
                 }
                 let e = c.eval(u);
                 let (pm, pp) = (c.eval(u - h), c.eval(u + h));
-                let scale = 1.0 + e.d1[0].hypot(e.d1[1]) + e.d2[0].hypot(e.d2[1]);
+                let scale = 1.0 + math::hypot(e.d1[0], e.d1[1]) + math::hypot(e.d2[0], e.d2[1]);
                 for d in 0..2 {
                     let fd1 = (pp.p[d] - pm.p[d]) / (2.0 * h);
                     let fd2 = (pp.d1[d] - pm.d1[d]) / (2.0 * h);

@@ -3,6 +3,7 @@
 //! point `length` mm up the tool axis) or a sequence of poses joined by straight tip
 //! moves with the axis slerped in between (CL data, sampled built-ins).
 
+use crate::math;
 use std::sync::{Arc, OnceLock};
 
 use serde::{Deserialize, Serialize};
@@ -410,14 +411,18 @@ impl ToolPath {
         let poses: Vec<Pose> = (0..=n)
             .map(|i| {
                 let t = i as f64 / SAMPLES_PER_TURN as f64 * std::f64::consts::TAU;
-                let (s, c) = t.sin_cos();
+                let (s, c) = math::sincos(t);
                 Pose {
                     tip: Vector::<3>::new(
                         30.0 + 20.0 * c,
                         10.0 + 20.0 * s,
                         5.0 * t / std::f64::consts::TAU,
                     ),
-                    axis: Vector::<3>::new(-tilt.sin() * c, -tilt.sin() * s, tilt.cos()),
+                    axis: Vector::<3>::new(
+                        -math::sin(tilt) * c,
+                        -math::sin(tilt) * s,
+                        math::cos(tilt),
+                    ),
                 }
             })
             .collect();
@@ -434,14 +439,14 @@ impl ToolPath {
         let poses: Vec<Pose> = (0..=n)
             .map(|i| {
                 let t = i as f64 / n as f64 * std::f64::consts::TAU;
-                let lean = 15f64.to_radians() * t.cos();
+                let lean = 15f64.to_radians() * math::cos(t);
                 let tilt = 25f64.to_radians();
                 Pose {
-                    tip: Vector::<3>::new(20.0 * t.sin(), 10.0 * (2.0 * t).sin(), 0.0),
+                    tip: Vector::<3>::new(20.0 * math::sin(t), 10.0 * math::sin(2.0 * t), 0.0),
                     axis: Vector::<3>::new(
-                        lean.sin() * tilt.cos(),
-                        tilt.sin(),
-                        lean.cos() * tilt.cos(),
+                        math::sin(lean) * math::cos(tilt),
+                        math::sin(tilt),
+                        math::cos(lean) * math::cos(tilt),
                     ),
                 }
             })
@@ -473,7 +478,7 @@ mod tests {
         let pose = path.pose_at(0.5);
         assert_eq!(pose.tip, V3::new(5.0, 0.0, 0.0));
         let half = std::f64::consts::FRAC_PI_4;
-        assert!((pose.axis - V3::new(half.sin(), 0.0, half.cos())).amax() < 1e-15);
+        assert!((pose.axis - V3::new(math::sin(half), 0.0, math::cos(half))).amax() < 1e-15);
         let opposite = ToolPath::from_poses(&[
             Pose {
                 tip: V3::zeros(),
@@ -500,7 +505,7 @@ mod tests {
         let pose = path.pose_at(0.5);
         assert_eq!(pose.tip, V3::new(5.0, 0.0, 0.0));
         let half = std::f64::consts::FRAC_PI_4;
-        assert!((pose.axis - V3::new(half.sin(), 0.0, half.cos())).amax() < 1e-15);
+        assert!((pose.axis - V3::new(math::sin(half), 0.0, math::cos(half))).amax() < 1e-15);
         let bad = text.replace(
             "[0, 0, 1, 1], \"control_points\": [[0, 0, 100]",
             "[0, 0, 2, 2], \"control_points\": [[0, 0, 100]",
@@ -645,7 +650,7 @@ mod tests {
         for u in [0.0, 12345.5, 80000.0] {
             let p = helix.pose_at(u);
             assert!(
-                ((p.tip[0] - 30.0).hypot(p.tip[1] - 10.0) - 20.0).abs() < 1e-5,
+                (math::hypot(p.tip[0] - 30.0, p.tip[1] - 10.0) - 20.0).abs() < 1e-5,
                 "radius at {u}"
             );
             assert!((angle_between(&p.axis, &V3::z()) - 20f64.to_radians()).abs() < 1e-6);
@@ -658,7 +663,8 @@ mod tests {
         let eight = ToolPath::figure_eight();
         let (start, middle) = (eight.pose_at(0.0), eight.pose_at(40000.0));
         assert!(start.tip.amax() < 1e-12 && middle.tip.amax() < 1e-9);
-        let expected = 2.0 * (15f64.to_radians().sin() * 25f64.to_radians().cos()).asin();
+        let expected =
+            2.0 * math::asin(math::sin(15f64.to_radians()) * math::cos(25f64.to_radians()));
         assert!((angle_between(&start.axis, &middle.axis) - expected).abs() < 1e-9);
         // Never along the C axis: A stays ≥ 25° (less than 1e-9 lost to the chords).
         for i in 0..=8000 {

@@ -2,6 +2,7 @@
 //! friction, backlash in the transmission and the drive's current limit. All off by
 //! default; an axis with none of them is the linear axis of §4.5, integrated exactly.
 
+use crate::math;
 use serde::{Deserialize, Serialize};
 
 /// The nonlinear effects of one axis. Torques are at the motor, like the viscous
@@ -77,7 +78,7 @@ impl AxisEffects {
         let drop = self.breakaway() - self.coulomb;
         if drop > 0.0 && self.stribeck_velocity > 0.0 {
             let r = speed / self.stribeck_velocity;
-            self.coulomb + drop * (-r * r).exp()
+            self.coulomb + drop * math::exp(-r * r)
         } else {
             self.coulomb
         }

@@ -100,6 +100,7 @@ impl<const D: usize> ServoAxes<D> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math;
     use crate::plant::Transmission;
 
     #[test]
@@ -120,7 +121,7 @@ mod tests {
             std::array::from_fn(|i| ServoAxis::new(params[i], start[i]));
         let mut linear_twin = ServoAxis::new(linear, start[1]);
         let command = |k: usize| {
-            let v = (k as f64 * 0.01).sin();
+            let v = math::sin(k as f64 * 0.01);
             Vector::<3>::new(v, 3.0 * v, -2.0 * v)
         };
         for k in 0..200 {
@@ -153,7 +154,7 @@ mod tests {
         for k in 1..=50 {
             axes.step(Vector::<5>::repeat(1.0), 2e-4);
             let t = k as f64 * 2e-4;
-            let v = 1.0 - (-314.0 * t).exp();
+            let v = 1.0 - math::exp(-314.0 * t);
             let x = t - v / 314.0;
             for i in 0..5 {
                 let tolerance = if i < 3 { 1e-3 } else { 1e-9 };

@@ -574,6 +574,7 @@ impl ServoAxis {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math;
 
     /// A step so long that the powers of h·A overflow (1e40 s, 1e57 s) used to make the
     /// matrix exponential square for ever; it is NaN now, which the FMI layer refuses.
@@ -626,8 +627,8 @@ mod tests {
         for k in 1..=200 {
             axis.step(100.0, 1e-3);
             let t = k as f64 * 1e-3;
-            let v = w * -(-b_j * t).exp_m1();
-            let x = w * (t + (-b_j * t).exp_m1() / b_j);
+            let v = w * -math::expm1(-b_j * t);
+            let x = w * (t + math::expm1(-b_j * t) / b_j);
             assert!((axis.velocity() - v).abs() < 1e-9 * w, "t={t}");
             assert!((axis.position() - x).abs() < 1e-9 * w, "t={t}");
             assert_eq!(axis.state[2], 0.0);
@@ -749,7 +750,7 @@ mod tests {
             backlash: 0.01,
             current_max: 80.0,
         });
-        let command = |t: f64| 30.0 * (2.0 * std::f64::consts::PI * t).sin();
+        let command = |t: f64| 30.0 * math::sin(2.0 * std::f64::consts::PI * t);
         let run = |step: f64, every: usize| {
             let mut axis = ServoAxis::new(p, 0.0);
             let mut samples = Vec::new();

@@ -11,6 +11,7 @@ use crate::common::*;
 use contour_core::contour::planar::{Estimator, FreeCurveEstimator};
 use contour_core::control::{ControllerConfig, CrossCoupledController};
 use contour_core::geometry::Vector2;
+use contour_core::math;
 use contour_fmu::framework::variables::Value;
 use contour_fmu::models::{
     contour_ccc_2d as ccc, contour_ccc_5x, line_arc_parameters as geometry,
@@ -32,10 +33,10 @@ const INPUTS: [u32; 4] = [
 fn held_inputs(k: usize) -> [f64; 4] {
     let a = 0.05 * (k / 4) as f64;
     [
-        10.0 * a.cos() - 10.0,
-        10.0 * a.sin(),
-        9.98 * (a - 0.01).cos() - 10.0,
-        9.98 * (a - 0.01).sin(),
+        10.0 * math::cos(a) - 10.0,
+        10.0 * math::sin(a),
+        9.98 * math::cos(a - 0.01) - 10.0,
+        9.98 * math::sin(a - 0.01),
     ]
 }
 

@@ -8,6 +8,7 @@
 use crate::geometry;
 use crate::geometry::angle_between;
 use crate::kinematics::{Joints, Pose, TableTiltingAc};
+use crate::math;
 
 /// mm of tip travel per rad of tool rotation over a whole reference (R of §5.3): makes
 /// angles commensurable with lengths by the part's own ratio. 0 when the tool never turns.
@@ -88,7 +89,7 @@ pub fn evaluate(
     let pose_at = |t: f64| machine.forward(&parabola(q, t));
     let squared = |pose: &Pose| {
         let cross = pose.axis.cross(&reference.axis);
-        let angle = geometry::norm(&cross).atan2(pose.axis.dot(&reference.axis));
+        let angle = math::atan2(geometry::norm(&cross), pose.axis.dot(&reference.axis));
         let tip = geometry::dist(&pose.tip, &reference.tip);
         let value = lambda.0 * tip + lambda.1 * mm_per_rad * angle;
         value * value
@@ -223,7 +224,7 @@ mod tests {
         type Case = (fn(f64) -> f64, f64);
         let cases: [Case; 4] = [
             (|t| (t - 0.3).powi(2) + 1.0, 0.3),
-            (|t| (t - 0.123).cosh(), 0.123),
+            (|t| math::cosh(t - 0.123), 0.123),
             (|t| (t + 0.07).abs() + 0.2 * t * t, -0.07),
             (|t| ((t - 0.01).powi(2) + 1e-6).sqrt(), 0.01),
         ];
@@ -262,7 +263,7 @@ mod tests {
     fn weights_and_ratio_by_hand() {
         let pose = |x: f64, angle: f64| Pose {
             tip: V3::new(x, 0.0, 0.0),
-            axis: V3::new(angle.sin(), 0.0, angle.cos()),
+            axis: V3::new(math::sin(angle), 0.0, math::cos(angle)),
         };
         let path = [pose(0.0, 0.0), pose(3.0, 0.1), pose(6.0, 0.3)];
         assert!((mm_per_rad(&path) - 6.0 / 0.3).abs() < 1e-12);
@@ -302,7 +303,7 @@ mod tests {
         // offset that moved R_i off the curve.
         let e = evaluate(&machine, &target, (1.0, 0.0), 30.0, &q);
         assert!(
-            e.tip > 0.0 && e.tip <= 0.02f64.hypot(0.01) + 1e-12,
+            e.tip > 0.0 && e.tip <= math::hypot(0.02f64, 0.01) + 1e-12,
             "{}",
             e.tip
         );

@@ -238,6 +238,7 @@ mod tests {
     use crate::contour::five_axis::evaluation::parabola;
     use crate::contour::five_axis::hmm::{viterbi_offline, HmmParams, ReferencePolyline};
     use crate::kinematics::Pose;
+    use crate::math;
 
     type V3 = Vector<3>;
 
@@ -252,8 +253,16 @@ mod tests {
         let pose = |t: f64, out: f64, tilt: f64| {
             let lean = 20f64.to_radians() + tilt;
             Pose {
-                tip: V3::new((25.0 + out) * t.cos(), (25.0 + out) * t.sin(), 2.0 * t),
-                axis: V3::new(lean.sin() * t.cos(), lean.sin() * t.sin(), lean.cos()),
+                tip: V3::new(
+                    (25.0 + out) * math::cos(t),
+                    (25.0 + out) * math::sin(t),
+                    2.0 * t,
+                ),
+                axis: V3::new(
+                    math::sin(lean) * math::cos(t),
+                    math::sin(lean) * math::sin(t),
+                    math::cos(lean),
+                ),
             }
         };
         let step = 0.002;
@@ -262,7 +271,7 @@ mod tests {
         let measured = (0..1500)
             .map(|k| {
                 let t = (k as f64 - 30.0).max(0.0) * step;
-                let wobble = (k as f64 * 0.01).sin();
+                let wobble = math::sin(k as f64 * 0.01);
                 let q = machine
                     .inverse(&pose(t, 0.05 * wobble, 1e-3 * wobble), c)
                     .unwrap();

@@ -19,6 +19,7 @@
 
 use super::viterbi::{self, BackTable};
 use crate::geometry::Vector;
+use crate::math;
 
 /// Distance from `p` to the segment a–b. (A plain square root of the squared distance:
 /// this runs band × samples times per mapping, and coordinates in mm are far from
@@ -88,7 +89,7 @@ pub fn segment_cost(
     } else {
         // angle_between with a plain square root (see segment_distance).
         let (direction, cross) = (r[1] - r[0], motion.cross(&(r[1] - r[0])));
-        cross.dot(&cross).sqrt().atan2(motion.dot(&direction))
+        math::atan2(cross.dot(&cross).sqrt(), motion.dot(&direction))
     };
     segment_distance(tip, r[0], r[1])
         + segment_distance(second, s[0], s[1])
@@ -320,7 +321,7 @@ mod tests {
         let tips: Vec<V3> = (0..=40)
             .map(|j| {
                 let t = j as f64 / 40.0 * std::f64::consts::TAU;
-                V3::new(20.0 * t.sin(), 10.0 * (2.0 * t).sin(), 0.0)
+                V3::new(20.0 * math::sin(t), 10.0 * math::sin(2.0 * t), 0.0)
             })
             .collect();
         let axes: Vec<V3> = (0..=40)

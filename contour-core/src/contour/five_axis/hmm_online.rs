@@ -10,6 +10,7 @@
 //! covering the whole reference and a lag covering the whole run it decodes what
 //! [`viterbi_offline`](super::hmm::viterbi_offline) decodes.
 
+use crate::math;
 use serde::{Deserialize, Serialize};
 
 use super::hmm::{segment_cost, HmmParams};
@@ -374,7 +375,7 @@ impl Rotation {
 
     /// `v` turned by `times` the angle.
     fn apply(&self, v: &Vector<3>, times: f64) -> Vector<3> {
-        let (s, c) = (self.angle * times).sin_cos();
+        let (s, c) = math::sincos(self.angle * times);
         let k = &self.axis;
         v * c + k.cross(v) * s + k * (k.dot(v) * (1.0 - c))
     }
@@ -391,13 +392,13 @@ mod tests {
         let tips = (0..n)
             .map(|j| {
                 let t = j as f64 * 0.15;
-                V3::new(30.0 * t.cos(), 30.0 * t.sin(), 0.5 * t)
+                V3::new(30.0 * math::cos(t), 30.0 * math::sin(t), 0.5 * t)
             })
             .collect();
         let axes = (0..n)
             .map(|j| {
-                let lean = 0.4 * (j as f64 * 0.05).sin();
-                V3::new(lean.sin(), 0.0, lean.cos())
+                let lean = 0.4 * math::sin(j as f64 * 0.05);
+                V3::new(math::sin(lean), 0.0, math::cos(lean))
             })
             .collect();
         (tips, axes)
@@ -417,7 +418,7 @@ mod tests {
         let about = geometry::unit(&start.cross(&V3::new(0.3, -1.0, 0.2))).unwrap();
         let pose = |i: usize| {
             let phi = step * i as f64;
-            let tip = (u * phi.cos() + w * phi.sin()) * radius + V3::new(5.0, -2.0, 1.0);
+            let tip = (u * math::cos(phi) + w * math::sin(phi)) * radius + V3::new(5.0, -2.0, 1.0);
             let axis = Rotation {
                 axis: about,
                 angle: turn,

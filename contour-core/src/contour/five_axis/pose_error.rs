@@ -197,6 +197,7 @@ pub fn nearest_segment_near(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math;
 
     type V3 = Vector<3>;
 
@@ -249,15 +250,15 @@ mod tests {
         // the circle has its true foot on the radius through it.
         let (radius, step) = (5.0, 0.01);
         let pose = |phi: f64| Pose {
-            tip: V3::new(radius * phi.cos(), radius * phi.sin(), 0.0),
-            axis: V3::new((0.5 * phi).sin(), 0.0, (0.5 * phi).cos()),
+            tip: V3::new(radius * math::cos(phi), radius * math::sin(phi), 0.0),
+            axis: V3::new(math::sin(0.5 * phi), 0.0, math::cos(0.5 * phi)),
         };
         let mut worst: (f64, f64) = (0.0, 0.0);
         for k in 1..=9 {
             let phi = step * (1.0 + k as f64 / 10.0);
             for offset in [-0.3, 0.3] {
                 let actual = Pose {
-                    tip: V3::new(phi.cos(), phi.sin(), 0.0) * (radius + offset),
+                    tip: V3::new(math::cos(phi), math::sin(phi), 0.0) * (radius + offset),
                     axis: V3::z(),
                 };
                 let e = foot_point_error_between(
@@ -294,8 +295,8 @@ mod tests {
         // foot.
         let (radius, step, offset) = (1.0, 0.03, 0.06);
         let pose = |phi: f64| Pose {
-            tip: V3::new(phi.cos(), phi.sin(), 0.0) * radius,
-            axis: V3::new((0.5 * phi).sin(), 0.0, (0.5 * phi).cos()),
+            tip: V3::new(math::cos(phi), math::sin(phi), 0.0) * radius,
+            axis: V3::new(math::sin(0.5 * phi), 0.0, math::cos(0.5 * phi)),
         };
         let segment =
             |i: usize| (i < 30).then(|| (pose(step * i as f64), pose(step * (i + 1) as f64)));
@@ -303,7 +304,7 @@ mod tests {
         for k in -50..=50 {
             let phi = step * (11.0 + k as f64 / 2000.0);
             let actual = Pose {
-                tip: V3::new(phi.cos(), phi.sin(), 0.0) * (radius + offset),
+                tip: V3::new(math::cos(phi), math::sin(phi), 0.0) * (radius + offset),
                 axis: V3::z(),
             };
             let truth = 0.5 * phi;

@@ -186,6 +186,7 @@ impl Piece {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math;
 
     type V3 = Vector<3>;
 
@@ -208,7 +209,7 @@ mod tests {
         // from the neighbours and chord-long derivatives deviates from the circle by
         // O(θ⁴·r) (here 2.4e-7 mm), where the chord's sagitta is r·θ²/8 = 1.6 µm.
         let pose = |phi: f64| Pose {
-            tip: V3::new(5.0 * phi.cos(), 5.0 * phi.sin(), 0.0),
+            tip: V3::new(5.0 * math::cos(phi), 5.0 * math::sin(phi), 0.0),
             axis: V3::z(),
         };
         let reference: Vec<Pose> = (0..6).map(|i| pose(0.05 * i as f64)).collect();
@@ -220,7 +221,7 @@ mod tests {
         // A point 0.3 mm outside the circle above the piece's middle: its foot on the
         // piece is on the radius through it.
         let phi: f64 = 0.125;
-        let outside = V3::new(phi.cos(), phi.sin(), 0.0) * 5.3;
+        let outside = V3::new(math::cos(phi), math::sin(phi), 0.0) * 5.3;
         let (s, point) = piece.nearest(&outside);
         assert!((s - 0.5).abs() < 1e-6, "{s}");
         assert!((geometry::dist(&point, &outside) - 0.3).abs() < 3e-7);
@@ -246,7 +247,7 @@ mod tests {
             },
         )
         .unwrap();
-        let sagitta = 5.0 * (1.0 - (0.025f64).cos());
+        let sagitta = 5.0 * (1.0 - math::cos(0.025f64));
         assert!((geometry::norm(&e.tip) - 0.3 - sagitta).abs() < 1e-9);
     }
 }

@@ -509,6 +509,7 @@ mod tests {
     use super::*;
     use crate::contour::five_axis::hmm::viterbi_offline;
     use crate::geometry::angle_between;
+    use crate::math;
 
     use rand::rngs::StdRng;
     use rand::{RngExt, SeedableRng};
@@ -517,9 +518,9 @@ mod tests {
 
     fn tilted(lean: f64, azimuth: f64) -> V3 {
         V3::new(
-            lean.sin() * azimuth.sin(),
-            lean.sin() * azimuth.cos(),
-            lean.cos(),
+            math::sin(lean) * math::sin(azimuth),
+            math::sin(lean) * math::cos(azimuth),
+            math::cos(lean),
         )
     }
 
@@ -532,7 +533,11 @@ mod tests {
             let step = rng.random_range(0.3..2.0);
             let last = *tips.last().unwrap();
             tips.push(
-                last + V3::new(heading.cos(), heading.sin(), rng.random_range(-0.3..0.3)) * step,
+                last + V3::new(
+                    math::cos(heading),
+                    math::sin(heading),
+                    rng.random_range(-0.3..0.3),
+                ) * step,
             );
         }
         let axes: Vec<V3> = (0..=m)
@@ -625,11 +630,11 @@ mod tests {
         let tips = (0..n)
             .map(|j| {
                 let t = j as f64 * 0.05;
-                V3::new(30.0 * t.cos(), 30.0 * t.sin(), 0.5 * t)
+                V3::new(30.0 * math::cos(t), 30.0 * math::sin(t), 0.5 * t)
             })
             .collect();
         let axes = (0..n)
-            .map(|j| tilted(0.3 + 0.2 * (j as f64 * 0.01).sin(), j as f64 * 0.05))
+            .map(|j| tilted(0.3 + 0.2 * math::sin(j as f64 * 0.01), j as f64 * 0.05))
             .collect();
         (tips, axes)
     }
@@ -677,7 +682,7 @@ mod tests {
 
     /// Turns unit `o` by `angle` about the unit `d` ⟂ `o`.
     fn turn(o: &V3, d: &V3, angle: f64) -> V3 {
-        o * angle.cos() + d.cross(o) * angle.sin()
+        o * math::cos(angle) + d.cross(o) * math::sin(angle)
     }
 
     #[test]
@@ -690,7 +695,7 @@ mod tests {
             c_pivot: V3::new(3.0, -2.0, 0.0),
         };
         let lean = |x: f64| (10.0 + 3.0 * x).to_radians();
-        let axis = |x: f64| V3::new(lean(x).sin(), 0.0, lean(x).cos());
+        let axis = |x: f64| V3::new(math::sin(lean(x)), 0.0, math::cos(lean(x)));
         let reference: Vec<Pose> = (0..=100)
             .map(|i| {
                 let x = i as f64 * 0.1;
@@ -766,10 +771,10 @@ mod tests {
             c_pivot: V3::zeros(),
         };
         let helix = |t: f64, radial: f64, tilt: f64| {
-            let (s, c) = t.sin_cos();
+            let (s, c) = math::sincos(t);
             Pose {
                 tip: V3::new((20.0 + radial) * c, (20.0 + radial) * s, 0.8 * t),
-                axis: V3::new(-tilt.sin() * c, -tilt.sin() * s, tilt.cos()),
+                axis: V3::new(-math::sin(tilt) * c, -math::sin(tilt) * s, math::cos(tilt)),
             }
         };
         let step = 0.0025; // rad of helix angle per reference point, 0.05 mm
@@ -779,8 +784,8 @@ mod tests {
         let truth = |t: f64, c: f64| {
             let pose = helix(
                 t,
-                0.01 + 0.005 * (7.0 * t).sin(),
-                0.35 + 2e-4 * (5.0 * t).cos(),
+                0.01 + 0.005 * math::sin(7.0 * t),
+                0.35 + 2e-4 * math::cos(5.0 * t),
             );
             machine.inverse(&pose, c).unwrap()
         };

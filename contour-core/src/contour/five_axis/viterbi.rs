@@ -226,6 +226,7 @@ mod tests {
     use crate::contour::five_axis::hmm_online::OnlineMapper;
     use crate::contour::five_axis::run_evaluation::viterbi_windowed;
     use crate::geometry::{self, Vector};
+    use crate::math;
 
     use rand::rngs::StdRng;
     use rand::{RngExt, SeedableRng};
@@ -433,15 +434,15 @@ mod tests {
             let step = rng.random_range(0.3..2.0);
             let dz = rng.random_range(-0.3..0.3);
             let last = *tips.last().unwrap();
-            tips.push(last + V3::new(heading.cos(), heading.sin(), dz) * step);
+            tips.push(last + V3::new(math::cos(heading), math::sin(heading), dz) * step);
         }
         let tilted = |rng: &mut StdRng| {
             let (lean, azimuth): (f64, f64) =
                 (rng.random_range(0.1..0.6), rng.random_range(-3.0..3.0));
             let o = V3::new(
-                lean.sin() * azimuth.sin(),
-                lean.sin() * azimuth.cos(),
-                lean.cos(),
+                math::sin(lean) * math::sin(azimuth),
+                math::sin(lean) * math::cos(azimuth),
+                math::cos(lean),
             );
             geometry::unit(&o).unwrap()
         };

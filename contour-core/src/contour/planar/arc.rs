@@ -7,6 +7,7 @@
 //! arc distance is [`crate::contour::planar::true_error`]'s job). At the centre the error is −r
 //! (CCW) and the normal is taken toward the reference point, so it is never NaN.
 
+use crate::math;
 use serde::{Deserialize, Serialize};
 
 use super::local_circle;
@@ -65,7 +66,7 @@ pub fn arc_error(
 impl ArcEstimator {
     /// Exact error against the circle of `arc`.
     pub fn new(arc: &CircularArc) -> Self {
-        let (s, c) = arc.start_angle().sin_cos();
+        let (s, c) = math::sincos(arc.start_angle());
         ArcEstimator {
             mode: ArcMode::Fixed {
                 center: arc.center(),
@@ -181,12 +182,12 @@ mod tests {
     #[test]
     fn tracking_recovers_circle() {
         let mut e = ArcEstimator::tracking();
-        let c = |t: f64| Vector2::new(10.0 * t.cos(), 10.0 * t.sin());
+        let c = |t: f64| Vector2::new(10.0 * math::cos(t), 10.0 * math::sin(t));
         assert_eq!(e.estimate(c(0.0), Vector2::new(11.0, 0.0)).error, 0.0);
         e.estimate(c(0.01), Vector2::new(11.0, 0.0));
         let r = e.estimate(
             c(0.02),
-            Vector2::new(11.0 * 0.02f64.cos(), 11.0 * 0.02f64.sin()),
+            Vector2::new(11.0 * math::cos(0.02f64), 11.0 * math::sin(0.02f64)),
         );
         assert!((r.error - 1.0).abs() < 1e-9, "{}", r.error);
     }

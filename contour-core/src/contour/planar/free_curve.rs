@@ -198,20 +198,21 @@ impl ContourEstimator for FreeCurveEstimator {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math;
 
     #[test]
     fn circle_samples_give_exact_radial_error() {
         // On a circle the fitted circles are the circle itself: exact for any lag.
-        let c = |t: f64| Vector2::new(3.0 + 20.0 * t.cos(), 1.0 + 20.0 * t.sin());
+        let c = |t: f64| Vector2::new(3.0 + 20.0 * math::cos(t), 1.0 + 20.0 * math::sin(t));
         let mut e = FreeCurveEstimator::new(16);
         for i in 0..40 {
             let t = i as f64 * 0.005;
             let lag = t - 0.0123;
-            let p = Vector2::new(3.0 + 20.03 * lag.cos(), 1.0 + 20.03 * lag.sin());
+            let p = Vector2::new(3.0 + 20.03 * math::cos(lag), 1.0 + 20.03 * math::sin(lag));
             let r = e.estimate(c(t), p);
             if i >= 3 {
                 assert!((r.error - 0.03).abs() < 1e-12, "i={i}: {}", r.error);
-                let n = Vector2::new(-lag.cos(), -lag.sin());
+                let n = Vector2::new(-math::cos(lag), -math::sin(lag));
                 assert!((r.normal[0] - n[0]).abs() < 1e-9 && (r.normal[1] - n[1]).abs() < 1e-9);
             }
         }
@@ -223,16 +224,16 @@ mod tests {
     /// the estimate stays exact (the fallback branch of `estimate`).
     #[test]
     fn a_lag_beyond_the_buffer_uses_the_oldest_circle() {
-        let c = |t: f64| Vector2::new(20.0 * t.cos(), 20.0 * t.sin());
+        let c = |t: f64| Vector2::new(20.0 * math::cos(t), 20.0 * math::sin(t));
         let mut e = FreeCurveEstimator::new(MIN_CAPACITY);
         for i in 0..30 {
             let t = i as f64 * 0.01;
             let lag = t - 0.2; // 20 samples behind, the buffer holds 4
-            let p = Vector2::new(19.95 * lag.cos(), 19.95 * lag.sin());
+            let p = Vector2::new(19.95 * math::cos(lag), 19.95 * math::sin(lag));
             let r = e.estimate(c(t), p);
             if i >= 3 {
                 assert!((r.error + 0.05).abs() < 1e-12, "i={i}: {}", r.error);
-                let n = Vector2::new(-lag.cos(), -lag.sin()); // inward: the left normal of a CCW circle
+                let n = Vector2::new(-math::cos(lag), -math::sin(lag)); // inward: the left normal of a CCW circle
                 assert!((r.normal[0] - n[0]).abs() < 1e-9 && (r.normal[1] - n[1]).abs() < 1e-9);
             }
         }

@@ -6,6 +6,7 @@
 //! behind the segment start or overshoots its end still gets the perpendicular error the
 //! cross-coupled controller should correct.
 
+use crate::math;
 use serde::{Deserialize, Serialize};
 
 use crate::contour::{ContourEstimate, ContourEstimator};
@@ -52,7 +53,7 @@ impl LineEstimator {
 
     /// Exact error against the line through `point` at direction angle `theta` (rad).
     pub fn from_angle(point: Vector2, theta: f64) -> Self {
-        let (s, c) = theta.sin_cos();
+        let (s, c) = math::sincos(theta);
         LineEstimator {
             mode: LineMode::Fixed {
                 point,
@@ -123,10 +124,12 @@ mod tests {
         assert!((r.error + 1.0).abs() < 1e-14);
         // The formula of docs/design/two-axis.md §4.1 with following errors ex = xr − xp, ey = yr − yp.
         let (th, rr, p) = (0.3f64, Vector2::new(2.0, 1.0), Vector2::new(2.5, 0.2));
-        let mut f =
-            LineEstimator::from_angle(Vector2::new(2.0 - 3.0 * th.cos(), 1.0 - 3.0 * th.sin()), th);
+        let mut f = LineEstimator::from_angle(
+            Vector2::new(2.0 - 3.0 * math::cos(th), 1.0 - 3.0 * math::sin(th)),
+            th,
+        );
         let (ex, ey) = (rr[0] - p[0], rr[1] - p[1]);
-        let koren = -ex * th.sin() + ey * th.cos();
+        let koren = -ex * math::sin(th) + ey * math::cos(th);
         assert!((f.estimate(rr, p).error - koren).abs() < 1e-14);
     }
 

@@ -10,6 +10,7 @@
 
 use crate::contour::ContourEstimate;
 use crate::geometry::{self, Vector2};
+use crate::math;
 
 /// Signed error of `p` against the circle through `a` with tangent `t` and curvature `kappa`.
 pub(crate) fn circle_error(p: Vector2, a: Vector2, t: Vector2, kappa: f64) -> ContourEstimate {
@@ -49,9 +50,9 @@ pub(crate) fn chord_tangent(x: Vector2, y: Vector2, kappa: f64, at_end: bool) ->
         return Vector2::zeros();
     }
     let dir = c * (1.0 / len);
-    let half = (0.5 * kappa * len).clamp(-1.0, 1.0).asin();
+    let half = math::asin((0.5 * kappa * len).clamp(-1.0, 1.0));
     let ang = if at_end { half } else { -half };
-    let (s, co) = ang.sin_cos();
+    let (s, co) = math::sincos(ang);
     Vector2::new(dir[0] * co - dir[1] * s, dir[0] * s + dir[1] * co)
 }
 
@@ -116,11 +117,14 @@ mod tests {
 
     #[test]
     fn triple_recovers_circle() {
-        let pt = |t: f64| Vector2::new(3.0 + 2.0 * t.cos(), -1.0 + 2.0 * t.sin());
+        let pt = |t: f64| Vector2::new(3.0 + 2.0 * math::cos(t), -1.0 + 2.0 * math::sin(t));
         let pts = [pt(0.1), pt(0.15), pt(0.2)];
         assert!((curvature3(pts[0], pts[1], pts[2]) - 0.5).abs() < 1e-12);
         for anchor in 0..3 {
-            let p = Vector2::new(3.0 + 2.5 * 0.3f64.cos(), -1.0 + 2.5 * 0.3f64.sin());
+            let p = Vector2::new(
+                3.0 + 2.5 * math::cos(0.3f64),
+                -1.0 + 2.5 * math::sin(0.3f64),
+            );
             let e = triple_error(p, pts, anchor);
             assert!(
                 (e.error - 0.5).abs() < 1e-12,

@@ -16,6 +16,7 @@
 //! Lines and arcs are solved analytically (the finite segment/arc: beyond its ends the
 //! nearest end point is the foot).
 
+use crate::math;
 use std::ops::Range;
 
 use serde::{Deserialize, Serialize};
@@ -208,7 +209,7 @@ fn arc_box(a: &CircularArc) -> BBox {
     for k in 0..4 {
         let phi = k as f64 * std::f64::consts::FRAC_PI_2;
         if a.param_of_angle(phi).is_some() {
-            let (s, c) = phi.sin_cos();
+            let (s, c) = math::sincos(phi);
             b = union(&b, &point_box(a.center() + Vector2::new(c, s) * a.radius()));
         }
     }
@@ -465,7 +466,7 @@ fn arc_error_within(arc: &CircularArc, p: Vector2, (t0, t1): Span) -> TrueError 
     let d = p - o;
     let r = geometry::norm(&d);
     let radial = if r > 0.0 {
-        arc.param_of_angle(d[1].atan2(d[0]))
+        arc.param_of_angle(math::atan2(d[1], d[0]))
     } else {
         Some(t0)
     };
@@ -574,7 +575,7 @@ impl TrueErrorIndex {
                 for i in 0..=SCAN {
                     let d1 = path.eval(a + (b - a) * i as f64 / SCAN as f64).d1;
                     if let Some(t0) = prev_t {
-                        turn += geometry::cross(&t0, &d1).atan2(t0.dot(&d1)).abs();
+                        turn += math::atan2(geometry::cross(&t0, &d1), t0.dot(&d1)).abs();
                     }
                     prev_t = Some(d1);
                 }
@@ -1182,7 +1183,7 @@ mod tests {
             crate::path::program::parse_program("G1 X10 F600\nX0 Y5\n", "tip.ngc").unwrap(),
         );
         let p = Vector2::new(11.0, -0.8);
-        let want = 1.0f64.hypot(0.8);
+        let want = math::hypot(1.0f64, 0.8);
         for path in [&polygon, &program] {
             let index = TrueErrorIndex::new(path);
             for e in [
@@ -1255,9 +1256,9 @@ mod tests {
         for k in 0..50 {
             let ang = 0.123 + k as f64 * 0.1257;
             let rad = 0.2 + 0.05 * k as f64;
-            let r = true_error(&c, Vector2::new(rad * ang.cos(), rad * ang.sin()));
+            let r = true_error(&c, Vector2::new(rad * math::cos(ang), rad * math::sin(ang)));
             assert!((r.error - (rad - 1.0)).abs() < 1e-13, "k={k}: {}", r.error);
-            assert!((r.normal[0] + ang.cos()).abs() < 1e-9);
+            assert!((r.normal[0] + math::cos(ang)).abs() < 1e-9);
         }
     }
 

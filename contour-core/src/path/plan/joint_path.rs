@@ -18,6 +18,7 @@
 use crate::geometry::{self, slerp, Vector};
 use crate::kinematics::{axis_angles, unwrap_near, Joints, Pose, TableTiltingAc};
 use crate::limits::{JointLimits, PathLimits};
+use crate::math;
 use crate::path::PathError;
 
 use std::f64::consts::PI;
@@ -362,20 +363,20 @@ impl Planner<'_> {
         };
         let negative_ok = self.joints.min[3] < 0.0;
         let positive_ok = self.joints.max[3] > 0.0;
-        let sin_budget = self.budget.sin();
+        let sin_budget = math::sin(self.budget);
         let count = run.end - run.start + 1;
         // First the band nodes (None: free).
         let mut c: Vec<Option<f64>> = Vec::with_capacity(count);
         let mut centre: Option<(f64, bool)> = None;
         for node in &nodes[run.start..=run.end] {
-            let sin_tilt = node.tilt.sin();
+            let sin_tilt = math::sin(node.tilt);
             let target = linear(node.s);
             if sin_tilt <= sin_budget {
                 centre = None;
                 c.push(None);
                 continue;
             }
-            let half_width = (BAND_SHARE * sin_budget / sin_tilt).asin();
+            let half_width = math::asin(BAND_SHARE * sin_budget / sin_tilt);
             let (mid, flipped) = match centre {
                 Some((mid, flipped)) => {
                     let base = node.azimuth + if flipped { PI } else { 0.0 };
@@ -434,18 +435,21 @@ impl Planner<'_> {
         for (m, node) in nodes[run.start..=run.end].iter().enumerate() {
             let n = run.start + m;
             let c = c[m].unwrap_or(0.0);
-            let (sin_tilt, cos_tilt) = node.tilt.sin_cos();
-            let a = (sin_tilt * (node.azimuth - c).cos())
-                .atan2(cos_tilt)
+            let (sin_tilt, cos_tilt) = math::sincos(node.tilt);
+            let a = math::atan2(sin_tilt * math::cos(node.azimuth - c), cos_tilt)
                 .clamp(self.joints.min[3], self.joints.max[3]);
-            let planned = Vector::<3>::new(c.sin() * a.sin(), c.cos() * a.sin(), a.cos());
+            let planned = Vector::<3>::new(
+                math::sin(c) * math::sin(a),
+                math::cos(c) * math::sin(a),
+                math::cos(a),
+            );
             let deviation = geometry::angle_between(&planned, &node.pose.axis);
             if !(deviation <= self.budget * (1.0 + 1e-9) + 1e-12 && self.c_ok(c)) {
                 return Err(ConeFailure::Impossible);
             }
             if let Some((pa, pc)) = previous {
                 let step = (c - pc).abs();
-                if step * a.abs().max(pa.abs()).sin() > 0.25 * self.budget || step > 0.2 {
+                if step * math::sin(a.abs().max(pa.abs())) > 0.25 * self.budget || step > 0.2 {
                     if n == 0 || too_short(n) {
                         return Err(ConeFailure::Impossible);
                     }
@@ -459,7 +463,7 @@ impl Planner<'_> {
         if let (Some(n), Some(c), Some((_, pc))) = (after, c_out, previous) {
             let step = (c - pc).abs();
             let a = nodes[n].tilt;
-            if step > 0.2 || step * a.sin() > 0.25 * self.budget {
+            if step > 0.2 || step * math::sin(a) > 0.25 * self.budget {
                 // Leaving the band C holds for another: either this way is wrong, or
                 // the nodes are too sparse to tell.
                 if step > 1.0 || too_short(n) {
@@ -742,7 +746,11 @@ fn assemble(machine: &TableTiltingAc, nodes: &[Node], rotary: &[(f64, f64)]) -> 
         deviation: Vec::with_capacity(nodes.len()),
     };
     for (node, &(a, c)) in nodes.iter().zip(rotary) {
-        let planned = Vector::<3>::new(c.sin() * a.sin(), c.cos() * a.sin(), a.cos());
+        let planned = Vector::<3>::new(
+            math::sin(c) * math::sin(a),
+            math::cos(c) * math::sin(a),
+            math::cos(a),
+        );
         path.s.push(node.s);
         path.joints.push(machine.joints_at(&node.pose.tip, a, c));
         path.poses.push(node.pose);

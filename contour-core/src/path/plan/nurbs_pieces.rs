@@ -21,6 +21,7 @@
 //! tangential acceleration, so pieces are kept long where the curvature allows it.
 
 use crate::geometry::{self, Vector2};
+use crate::math;
 use crate::path::{gl5, Curve, CurvePoint, Nurbs, PathError};
 
 /// The largest gap (mm) between a cell's map and the integrated arc length.
@@ -342,7 +343,7 @@ fn group(nurbs: &Nurbs, knots: &[f64], probes: &[Probe]) -> Vec<NurbsPiece> {
             let (a, b) = (nurbs.eval_from_below(u), nurbs.eval(u));
             let (ka, kb) = (curvature(a.d1, a.d2), curvature(b.d1, b.d2));
             let (ta, tb) = (direction(&a, false), direction(&b, true));
-            let turn = geometry::cross(&ta, &tb).atan2(ta.dot(&tb)).abs();
+            let turn = math::atan2(geometry::cross(&ta, &tb), ta.dot(&tb)).abs();
             !(turn <= 1e-9 && (ka - kb).abs() <= 1e-9 * (ka.abs() + kb.abs()) + 1e-12)
         })
         .collect();

@@ -16,6 +16,7 @@
 //! is lowered by the excess and the plan made again, until every sample keeps every
 //! limit.
 
+use crate::math;
 use std::cell::Cell;
 use std::sync::{Arc, Mutex, Weak};
 
@@ -811,7 +812,7 @@ impl Plan {
                     let j = geometry::norm(&(tip - p1 * 3.0 + p2 * 3.0 - p3)) / ts.powi(3);
                     if j > limits.jerk * (1.0 + 1e-6) + 1.0 {
                         let r = limits.jerk / j;
-                        speed_factor = speed_factor.min(r.powf(2.0 / 3.0));
+                        speed_factor = speed_factor.min(math::pow(r, 2.0 / 3.0));
                         accel_factor = accel_factor.min(r);
                     }
                 }

@@ -19,6 +19,7 @@
 use super::nurbs_pieces::NurbsPieces;
 use super::piece_profile::{plan_piece, reachable, Phase, PieceLimits};
 use crate::geometry::{self, Vector2};
+use crate::math;
 use crate::path::program::{blended, Corner, Move, Program, Shape, Speed, MIN_BLEND_TURN};
 use crate::path::{Curve, Path, PathError};
 
@@ -250,9 +251,9 @@ fn piece_limits(piece: &PlanPiece, limits: &XyLimits) -> PieceLimits {
     let share = std::f64::consts::FRAC_1_SQRT_2;
     let term = 0.5 * share * jerk;
     let mut v = speed.min((share * limits.accel / kappa).sqrt());
-    v = v.min((term / (kappa * kappa)).cbrt());
+    v = v.min(math::cbrt(term / (kappa * kappa)));
     if rate > 0.0 {
-        v = v.min((term / rate).cbrt());
+        v = v.min(math::cbrt(term / rate));
     }
     PieceLimits {
         speed: v,
@@ -267,7 +268,7 @@ fn junction_cap(before: &PlanPiece, after: &PlanPiece, limits: &XyLimits) -> f64
         return 0.0;
     }
     let (t0, t1) = (before.tangent[1], after.tangent[0]);
-    let turn = geometry::cross(&t0, &t1).atan2(t0.dot(&t1)).abs();
+    let turn = math::atan2(geometry::cross(&t0, &t1), t0.dot(&t1)).abs();
     // A kink the geometry kept (an exact stop, a corner into an arc, a NURBS's kink) is
     // stopped at; one below the blends' least turn is passed at its cap.
     if turn >= MIN_BLEND_TURN || turn.is_nan() {

@@ -7,6 +7,7 @@
 //! circle whose end misses its start). LinuxCNC accepts more, max(0.028 mm, 0.1 % of r),
 //! and cuts a spiral; a reference path here is a true circle, so it must be closer.
 
+use crate::math;
 use std::f64::consts::PI;
 
 use crate::geometry::{self, Vector2};
@@ -47,7 +48,7 @@ pub fn arc(
         Circle::Radius(r) => radius_centre(start, end, r, clockwise)?,
     };
     let radius = geometry::dist(&start, &centre);
-    let angle = |p: Vector2| (p[1] - centre[1]).atan2(p[0] - centre[0]);
+    let angle = |p: Vector2| math::atan2(p[1] - centre[1], p[0] - centre[0]);
     let (a0, a1) = (angle(start), angle(end));
     let turn = if clockwise { a0 - a1 } else { a1 - a0 };
     let mut sweep = turn.rem_euclid(2.0 * PI);

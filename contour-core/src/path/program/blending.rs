@@ -5,6 +5,7 @@
 
 use super::{Corner, CornerBlend, Move, Program, Shape};
 use crate::geometry;
+use crate::math;
 use crate::path::{Curve, Line};
 
 /// Turns below this (rad) are not rounded: a reference passes them at speed within its
@@ -36,7 +37,7 @@ pub fn blended(program: &Program, tolerance: f64) -> Program {
                 return None;
             };
             let (t1, t2) = (a.direction(), b.direction());
-            let turn = geometry::cross(&t1, &t2).atan2(t1.dot(&t2)).abs();
+            let turn = math::atan2(geometry::cross(&t1, &t2), t1.dot(&t2)).abs();
             if !(within > 0.0 && turn >= MIN_BLEND_TURN) {
                 return None;
             }

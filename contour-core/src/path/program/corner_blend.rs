@@ -7,6 +7,7 @@
 //! length. Its points are Fresnel integrals, summed as power series (their argument is
 //! at most √(π/2) here).
 
+use crate::math;
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::{self, Vector2};
@@ -141,7 +142,7 @@ fn left(t: Vector2) -> Vector2 {
 impl CornerBlend {
     /// The blend of its parts, with the outgoing direction they give.
     fn from_parts(start: Vector2, incoming: Vector2, turn: f64, half: f64, trim: f64) -> Self {
-        let (sin, cos) = turn.sin_cos();
+        let (sin, cos) = math::sincos(turn);
         let outgoing = Vector2::new(
             incoming[0] * cos - incoming[1] * sin,
             incoming[0] * sin + incoming[1] * cos,
@@ -167,7 +168,10 @@ impl CornerBlend {
         tolerance: f64,
         reach: f64,
     ) -> Option<(CornerBlend, f64)> {
-        let turn = geometry::cross(&incoming, &outgoing).atan2(incoming.dot(&outgoing));
+        let turn = math::atan2(
+            geometry::cross(&incoming, &outgoing),
+            incoming.dot(&outgoing),
+        );
         if !(turn.abs() > 0.0 && turn.abs() < std::f64::consts::PI - 1e-6) {
             return None;
         }
@@ -178,7 +182,7 @@ impl CornerBlend {
         let across = across.abs();
         let beta = 0.5 * turn.abs();
         // The middle lies on the bisector: the trim before the vertex per unit half.
-        let trim = along + across * beta.tan();
+        let trim = along + across * math::tan(beta);
         let half = (tolerance / across).min(reach / trim);
         if !(half.is_finite() && half > 0.0) {
             return None;
@@ -250,7 +254,7 @@ impl CornerBlend {
     /// bisector.
     fn computed_trim(&self) -> f64 {
         let (along, across) = self.first_half(self.half);
-        along + across.abs() * (0.5 * self.turn.abs()).tan()
+        along + across.abs() * math::tan(0.5 * self.turn.abs())
     }
 
     /// The blend mirrored about the x axis (y → −y), travelled the mirrored way.
@@ -356,8 +360,8 @@ mod tests {
             let (mut c, mut s) = (0.0, 0.0);
             for k in 0..n {
                 let w: f64 = (k as f64 + 0.5) * h;
-                c += (w * w).cos() * h;
-                s += (w * w).sin() * h;
+                c += math::cos(w * w) * h;
+                s += math::sin(w * w) * h;
             }
             let (fc, fs) = fresnel(x);
             assert!((fc - c).abs() < 1e-10 && (fs - s).abs() < 1e-10, "{x}");
@@ -439,7 +443,7 @@ mod tests {
         assert!((trim - 0.2).abs() < 1e-15 && b.length() < 0.4);
         let back = Vector2::new(-1.0, 0.0);
         assert!(CornerBlend::at_corner(v, Vector2::new(1.0, 0.0), back, 0.1, 1.0).is_none());
-        let sharp = Vector2::new((PI - 0.1).cos(), (PI - 0.1).sin());
+        let sharp = Vector2::new(math::cos(PI - 0.1), math::sin(PI - 0.1));
         assert!(CornerBlend::at_corner(v, Vector2::new(1.0, 0.0), sharp, 0.1, 1.0).is_some());
     }
 }
