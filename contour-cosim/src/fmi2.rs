@@ -18,12 +18,18 @@ use contour_fmu::fmi2::bindings::*;
 
 use crate::Error;
 
-/// The platform folder of `binaries/` this build loads from (FMI 2.0, section 2.1).
-pub const PLATFORM: &str = if cfg!(all(target_os = "linux", target_pointer_width = "64")) {
+/// The platform folder of `binaries/` this build loads from: FMI 2.0's names (section
+/// 2.1) for x86-64, FMI 3.0's platform tuple for 64-bit ARM Linux (which FMI 2.0.4
+/// allows and 2.0 names none for).
+pub const PLATFORM: &str = if cfg!(all(target_os = "linux", target_arch = "x86_64")) {
     "linux64"
-} else if cfg!(all(target_os = "macos", target_pointer_width = "64")) {
+} else if cfg!(all(target_os = "linux", target_arch = "aarch64")) {
+    "aarch64-linux"
+} else if cfg!(all(target_os = "macos", target_arch = "x86_64")) {
     "darwin64"
-} else if cfg!(all(windows, target_pointer_width = "64")) {
+} else if cfg!(all(target_os = "macos", target_arch = "aarch64")) {
+    "aarch64-darwin"
+} else if cfg!(all(windows, target_arch = "x86_64")) {
     "win64"
 } else {
     "unsupported"
@@ -639,6 +645,7 @@ pub fn is_fatal(library: &Library) -> bool {
 /// what was file descriptor 1, which then points at standard error. What an FMU prints
 /// (a C printf, a pythonfmu print) goes to standard error and cannot corrupt results
 /// written to the returned file.
+#[cfg(unix)]
 pub fn private_stdout() -> std::io::Result<std::fs::File> {
     use std::os::fd::FromRawFd;
     // SAFETY: dup and dup2 on the process's own standard descriptors; the duplicate is
@@ -649,6 +656,28 @@ pub fn private_stdout() -> std::io::Result<std::fs::File> {
             return Err(std::io::Error::last_os_error());
         }
         Ok(std::fs::File::from_raw_fd(duplicate))
+    }
+}
+
+/// On Windows the C runtime's descriptor 1 is what an FMU's printf writes to: it is
+/// pointed at standard error as on Unix, and the results go to a duplicate of the original
+/// as a Windows handle.
+#[cfg(windows)]
+pub fn private_stdout() -> std::io::Result<std::fs::File> {
+    use std::os::windows::io::{FromRawHandle, RawHandle};
+    // SAFETY: _dup and _dup2 on the C runtime's own standard descriptors; the duplicate's
+    // handle is owned by the returned File alone (its descriptor is never closed, so the
+    // handle is not closed twice).
+    unsafe {
+        let duplicate = libc::dup(1);
+        if duplicate < 0 || libc::dup2(2, 1) < 0 {
+            return Err(std::io::Error::last_os_error());
+        }
+        let handle = libc::get_osfhandle(duplicate);
+        if handle == -1 {
+            return Err(std::io::Error::last_os_error());
+        }
+        Ok(std::fs::File::from_raw_handle(handle as RawHandle))
     }
 }
 
