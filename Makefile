@@ -4,15 +4,17 @@
 #   make test   lint, then every test (Rust unit/ABI tests, fmpy/libcosim/ecos and reference
 #               tests); installs libclang-dev, libtbb12 and valgrind through apt when they
 #               are missing (root), the venv gets the test set and the package
+#   make fmus-all  the FMUs with linux64, win64 and aarch64-linux binaries (the distribution
+#               build); installs its cross toolchain through apt (root) when missing
 # Other targets: check (the fast development loop), fmus, ccc-tune, bindings, lint, asan,
-# fuzz-smoke, fuzz-long, bench, leak-check, pso-claim, setup.
+# fuzz-smoke, fuzz-long, bench, leak-check, pso-claim, setup, cross-toolchain.
 
 VENV   := .venv
 PYTHON := $(VENV)/bin/python
 PIP    := $(PYTHON) -m pip install --quiet --disable-pip-version-check
 CARGO  ?= cargo
 
-.PHONY: demo test check fmus ccc-tune contour-eval bindings lint bench pso-claim setup libclang libtbb valgrind leak-check \
+.PHONY: demo test check fmus fmus-all cross-toolchain ccc-tune contour-eval bindings lint bench pso-claim setup libclang libtbb valgrind leak-check \
         asan fuzz-smoke fuzz-long cargo-fuzz
 
 # --- demo: cargo and python3 only ---------------------------------------------------------
@@ -26,6 +28,14 @@ fmus:
 
 ccc-tune:
 	$(CARGO) build --release -p contour-tune --bin ccc-tune
+
+# The distribution build (fmu-build/src/platform.rs): every FMU in target/fmu and
+# target/fmu-si with linux64 (glibc 2.28), win64 and aarch64-linux binaries of one build,
+# compiled by Debian's rustc-web with the standard library built from its sources, and each
+# platform's contour-cosim in target/cross/<triple>/release. About 7 minutes on 2 cores.
+fmus-all: cross-toolchain
+	$(CARGO) run --release -p fmu-build -- --platforms all
+	$(CARGO) build --release -p contour-cosim
 
 # The demo's ballbar test runs the circular test of ISO 230-4 with it.
 contour-eval:
@@ -78,8 +88,29 @@ cargo-fuzz:
 		$(CARGO) install --locked cargo-fuzz; \
 	fi
 
+# The distribution build's toolchain, pinned by path in fmu-build/src/platform.rs: Debian's
+# rustc-web (rustc 1.96 as /usr/bin/rustc) with its standard library's sources, mingw-w64
+# and aarch64 gcc, cargo-zigbuild and zig (ziglang, in the venv) for glibc 2.28; Wine and
+# QEMU run the win64 and aarch64 programs in the tests.
+CROSS_DEBS := rustc-web cargo-web rust-web-src gcc-mingw-w64-x86-64 gcc-aarch64-linux-gnu \
+              libc6-dev-arm64-cross wine64 qemu-user
+cross-toolchain: $(VENV)/.cross-installed
+	@missing=$$(for p in $(CROSS_DEBS); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+		echo "installing the cross toolchain:" $$missing; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
+	fi
+	@if ! cargo-zigbuild --version >/dev/null 2>&1; then \
+		echo "installing cargo-zigbuild (links the Linux binaries against glibc 2.28)"; \
+		$(CARGO) install --locked cargo-zigbuild@0.24.1; \
+	fi
+
+$(VENV)/.cross-installed: requirements/cross.txt | $(PYTHON)
+	$(PIP) -r requirements/cross.txt
+	touch $@
+
 # Everything `make test` installs.
-setup: libclang libtbb valgrind cargo-fuzz $(VENV)/.test-installed
+setup: libclang libtbb valgrind cargo-fuzz cross-toolchain $(VENV)/.test-installed
 
 # The fast development loop: format, lints, the libraries' unit tests and the Rust
 # integration and ABI tests; nothing installed, no Python, no sanitizer, no fuzzer.

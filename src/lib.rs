@@ -5,6 +5,7 @@
 //! sample clock, state codec and checks), [`models`] holds the six FMUs (and two test-only
 //! ones), and [`fmi2`] is the only place that speaks the FMI C ABI (the only `unsafe`).
 
+pub mod build_identity;
 pub mod fmi2;
 pub mod framework;
 pub mod models;

@@ -1,9 +1,12 @@
 //! The packager's pieces: each model's `modelDescription.xml` and documentation are
-//! rendered from its variable table, then zipped with the shared library into a `.fmu`.
+//! rendered from its variable table, then zipped with each platform's shared library
+//! (built and checked first) into a `.fmu`.
 
+pub mod binary_check;
 pub mod documentation;
 pub mod model_description;
 pub mod package;
+pub mod platform;
 
 /// Escapes text for XML/HTML attribute values and element content.
 pub fn escape(text: &str) -> String {

@@ -1,6 +1,8 @@
-//! `cargo run --release -p fmu-build [-- --bless] [--out DIR] [--resource MODEL=FILE]…`:
-//! builds the library in release mode and writes one `.fmu` per model and unit system:
-//! the mm build to `target/fmu/` (or DIR), the SI build to `target/fmu-si/` (or DIR-si).
+//! `cargo run --release -p fmu-build [-- --bless] [--platforms host|all|LIST] [--out DIR]
+//! [--resource MODEL=FILE]…`: builds the library in release mode, for this machine or for
+//! every platform (`platform.rs`), checks each binary (`binary_check.rs`) and writes one
+//! `.fmu` per model and unit system carrying them all: the mm build to `target/fmu/` (or
+//! DIR), the SI build to `target/fmu-si/` (or DIR-si).
 //! `--bless` rewrites the committed `modelDescription/<Model>.xml` (and
 //! `modelDescription/si/<Model>.xml`) files from the code; each `--resource` puts FILE
 //! into MODEL's `resources/` folder in both builds.
@@ -9,17 +11,23 @@
 //! `loops/si/` for the SI build) go beside the FMUs, where their components' sources are.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode};
+use std::process::ExitCode;
 
 use contour_fmu::framework::interface::{Interface, UnitSystem};
 use contour_fmu::models;
 use fmu_build::model_description;
-use fmu_build::package::{self, Resource};
+use fmu_build::package::{self, Binaries, Resource};
+use fmu_build::platform::{self, Platform, GLIBC_FLOOR};
 
-const USAGE: &str = "usage: fmu-build [--bless] [--out DIR] [--resource MODEL=FILE]...\n\
+const USAGE: &str = "usage: fmu-build [--bless] [--platforms host|all|LIST] [--out DIR] [--resource MODEL=FILE]...\n\
   builds the contour-fmu library (release) and packages target/fmu/<Model>.fmu (mm)\n\
   and target/fmu-si/<Model>.fmu (SI)\n\
   --bless                rewrite modelDescription/<Model>.xml from the variable tables\n\
+  --platforms host       (default) one binary, built for this machine by the workspace's cargo\n\
+  --platforms all        linux64, win64 and aarch64-linux, built by the pinned distribution\n\
+                         toolchain (make fmus-all installs it; docs/usage.md)\n\
+  --platforms LIST       some of them, comma-separated (e.g. linux64,win64); also the\n\
+                         untested darwin64 and aarch64-darwin (linked, never run here)\n\
   --out DIR              write the .fmu files to DIR and DIR-si instead of <target>/fmu\n\
                          and <target>/fmu-si\n\
   --resource MODEL=FILE  put FILE into MODEL's resources/ folder under its own name\n\
@@ -42,32 +50,95 @@ fn target_dir(root: &Path) -> PathBuf {
     std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from)
 }
 
-fn build_library(root: &Path) -> Result<PathBuf, String> {
-    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    let status = Command::new(cargo)
-        .args(["build", "--release", "--lib", "-p", "contour-fmu"])
-        .current_dir(root)
-        .status()
-        .map_err(|e| format!("cannot run cargo: {e}"))?;
-    if !status.success() {
-        return Err(format!("cargo build failed ({status})"));
+/// What `--platforms` asks for: the host build, or the distribution build of some platforms.
+#[derive(Debug, PartialEq, Eq)]
+enum Platforms {
+    Host,
+    Distribution(Vec<Platform>),
+}
+
+impl Platforms {
+    fn parse(text: &str) -> Result<Platforms, String> {
+        match text {
+            "host" => return Ok(Platforms::Host),
+            "all" => return Ok(Platforms::Distribution(Platform::ALL.to_vec())),
+            _ => {}
+        }
+        let mut chosen = Vec::new();
+        for name in text.split(',') {
+            let platform = Platform::from_folder(name.trim()).ok_or_else(|| {
+                format!(
+                    "--platforms: unknown platform '{name}' (host, all, or some of {}; \
+                     untested, only when named: {})",
+                    Platform::ALL.map(Platform::folder).join(", "),
+                    Platform::UNTESTED.map(Platform::folder).join(", ")
+                )
+            })?;
+            if !chosen.contains(&platform) {
+                chosen.push(platform);
+            }
+        }
+        Ok(Platforms::Distribution(chosen))
     }
-    let library = target_dir(root).join("release").join("libcontour_fmu.so");
-    if library.exists() {
-        Ok(library)
-    } else {
-        Err(format!("the build did not produce {}", library.display()))
+}
+
+/// Builds the libraries `platforms` asks for and checks them; a distribution build's Linux
+/// binaries must need no glibc newer than [`GLIBC_FLOOR`].
+fn build_binaries(root: &Path, platforms: &Platforms) -> Result<Binaries, String> {
+    let target = target_dir(root);
+    let built = match platforms {
+        Platforms::Host => vec![platform::build_host(root, &target)?],
+        Platforms::Distribution(list) => list
+            .iter()
+            .map(|p| platform::build_distribution(root, &target, *p))
+            .collect::<Result<Vec<_>, _>>()?,
+    };
+    let binaries = Binaries::load(&built)?;
+    let floor = GLIBC_FLOOR
+        .split_once('.')
+        .and_then(|(a, b)| Some((a.parse().ok()?, b.parse().ok()?)))
+        .expect("GLIBC_FLOOR is x.y");
+    for (platform, checked) in binaries.platforms() {
+        let glibc = checked
+            .glibc
+            .map(|(a, b)| format!(", needs glibc {a}.{b}"))
+            .unwrap_or_default();
+        let untested = if platform.tested() {
+            ""
+        } else {
+            " (UNTESTED: nothing here runs it)"
+        };
+        println!(
+            "binaries/{}: build {}, exports the 34 fmi2 functions{glibc}{untested}",
+            platform.folder(),
+            checked.build_id
+        );
+        if let (Platforms::Distribution(_), Some(needed)) = (platforms, checked.glibc) {
+            if needed > floor {
+                return Err(format!(
+                    "the {} binary needs glibc {}.{}, newer than {GLIBC_FLOOR}",
+                    platform.folder(),
+                    needed.0,
+                    needed.1
+                ));
+            }
+        }
     }
+    Ok(binaries)
 }
 
 fn run(args: &[String]) -> Result<(), String> {
     let mut bless = false;
+    let mut platforms = Platforms::Host;
     let mut out = None;
     let mut resources = Vec::new();
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
         match arg.as_str() {
             "--bless" => bless = true,
+            "--platforms" => {
+                platforms = Platforms::parse(rest.next().ok_or("--platforms needs a value")?)?
+            }
             "--out" => out = Some(PathBuf::from(rest.next().ok_or("--out needs a directory")?)),
             "--resource" => {
                 let spec = rest.next().ok_or("--resource needs MODEL=FILE")?;
@@ -115,13 +186,13 @@ fn run(args: &[String]) -> Result<(), String> {
         }
     }
 
-    let library = build_library(&root)?;
+    let binaries = build_binaries(&root, &platforms)?;
     for interface in packaged() {
         let out = match interface.units {
             UnitSystem::Millimetre => out.clone(),
             UnitSystem::Si => si_folder(&out),
         };
-        let fmu = package::write_fmu_with_resources(interface, &library, &out, &resources)?;
+        let fmu = package::write_fmu_with_resources(interface, &binaries, &out, &resources)?;
         println!("wrote {}", fmu.display());
         for r in resources
             .iter()

@@ -1,5 +1,6 @@
-//! Zips one FMU: `modelDescription.xml`, `binaries/linux64/<id>.so`,
-//! `documentation/index.html` and, on request, files under `resources/`.
+//! Zips one FMU: `modelDescription.xml`, one library per platform
+//! (`binaries/<platform>/<id>.<so|dll>`), `documentation/index.html` and, on request, files
+//! under `resources/`.
 
 use std::fs::File;
 use std::io::Write;
@@ -11,7 +12,47 @@ use zip::CompressionMethod;
 use contour_fmu::framework::interface::Interface;
 use contour_fmu::models;
 
+use crate::binary_check::{self, Checked};
+use crate::platform::{Binary, Platform};
 use crate::{documentation, model_description};
+
+/// The libraries one FMU carries, read and checked ([`binary_check`]): each exports exactly
+/// the fmi2 Co-Simulation functions, all come from one source tree, one per platform.
+#[derive(Debug)]
+pub struct Binaries {
+    libraries: Vec<(Platform, Vec<u8>, Checked)>,
+}
+
+impl Binaries {
+    /// Reads and checks the built libraries; refused, naming the file, when one fails a
+    /// check, when two are for the same platform or when they come from different builds.
+    pub fn load(built: &[Binary]) -> Result<Binaries, String> {
+        let mut libraries: Vec<(Platform, Vec<u8>, Checked)> = Vec::new();
+        for binary in built {
+            if libraries.iter().any(|(p, _, _)| *p == binary.platform) {
+                return Err(format!(
+                    "two binaries for binaries/{}",
+                    binary.platform.folder()
+                ));
+            }
+            let bytes = std::fs::read(&binary.file)
+                .map_err(|e| format!("cannot read {}: {e}", binary.file.display()))?;
+            let checked =
+                binary_check::check(binary.platform, &bytes, &binary.file.display().to_string())?;
+            libraries.push((binary.platform, bytes, checked));
+        }
+        if libraries.is_empty() {
+            return Err("no binary to package".into());
+        }
+        binary_check::same_build(libraries.iter().map(|(p, _, c)| (*p, c)))?;
+        Ok(Binaries { libraries })
+    }
+
+    /// The platforms, in the order given.
+    pub fn platforms(&self) -> impl Iterator<Item = (Platform, &Checked)> {
+        self.libraries.iter().map(|(p, _, c)| (*p, c))
+    }
+}
 
 /// The model that reads path files from its `resources/` folder (its `path` parameter
 /// takes a file name relative to it).
@@ -117,24 +158,26 @@ pub fn check_unique(resources: &[Resource]) -> Result<(), String> {
     Ok(())
 }
 
-/// Writes `<out_dir>/<id>.fmu` holding `library` (the built cdylib) under the name FMI
-/// requires: `binaries/linux64/<modelIdentifier>.so`. No resources.
-pub fn write_fmu(interface: &Interface, library: &Path, out_dir: &Path) -> Result<PathBuf, String> {
-    write_fmu_with_resources(interface, library, out_dir, &[])
+/// Writes `<out_dir>/<id>.fmu` holding each of `binaries` under the name FMI requires:
+/// `binaries/<platform>/<modelIdentifier>.<so|dll>`. No resources.
+pub fn write_fmu(
+    interface: &Interface,
+    binaries: &Binaries,
+    out_dir: &Path,
+) -> Result<PathBuf, String> {
+    write_fmu_with_resources(interface, binaries, out_dir, &[])
 }
 
 /// As [`write_fmu`], plus every entry of `resources` whose `model` is this model's
 /// identifier as `resources/<name>` (entries for other models are skipped).
 pub fn write_fmu_with_resources(
     interface: &Interface,
-    library: &Path,
+    binaries: &Binaries,
     out_dir: &Path,
     resources: &[Resource],
 ) -> Result<PathBuf, String> {
     let model = interface.model;
     check_unique(resources)?;
-    let binary =
-        std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
     let mut files = Vec::new();
     for r in resources.iter().filter(|r| r.model == model.identifier) {
         let bytes = std::fs::read(&r.source)
@@ -153,11 +196,17 @@ pub fn write_fmu_with_resources(
     let options = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated);
     let xml = model_description::render(interface);
     let html = documentation::render(interface);
-    let mut entries: Vec<(String, &[u8])> = vec![
-        ("modelDescription.xml".into(), xml.as_bytes()),
-        (format!("binaries/linux64/{}.so", model.identifier), &binary),
-        ("documentation/index.html".into(), html.as_bytes()),
-    ];
+    let mut entries: Vec<(String, &[u8])> = vec![("modelDescription.xml".into(), xml.as_bytes())];
+    for (platform, bytes, _) in &binaries.libraries {
+        let name = format!(
+            "binaries/{}/{}.{}",
+            platform.folder(),
+            model.identifier,
+            platform.library_extension()
+        );
+        entries.push((name, bytes));
+    }
+    entries.push(("documentation/index.html".into(), html.as_bytes()));
     entries.extend(files.iter().map(|(n, b)| (n.clone(), b.as_slice())));
     let write_err = |e: &dyn std::fmt::Display| format!("cannot write {}: {e}", partial.display());
     for (name, bytes) in entries {

@@ -6,7 +6,8 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use contour_fmu::models;
-use fmu_build::package::{self, Resource};
+use fmu_build::package::{self, Binaries, Resource};
+use fmu_build::platform::{Binary, Platform};
 
 /// The documented example of the README (a rational cubic NURBS).
 const NURBS: &str = r#"{"degree": 3, "knots": [0, 0, 0, 0, 0.5, 1, 1, 1, 1],
@@ -32,6 +33,23 @@ fn model(identifier: &str) -> &'static contour_fmu::framework::interface::Interf
     )
 }
 
+/// The host's library as cargo built it for this test run (the cdylib of the contour-fmu
+/// dependency lies beside the test executable, in target/<profile>/deps/).
+fn host_binaries() -> Binaries {
+    let deps = std::env::current_exe()
+        .unwrap()
+        .parent()
+        .unwrap()
+        .to_path_buf();
+    let file = deps.join(format!(
+        "{}contour_fmu{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ));
+    let platform = Platform::host().expect("tests run on a platform FMUs carry");
+    Binaries::load(&[Binary { platform, file }]).unwrap()
+}
+
 /// Name → bytes of every file in the zip.
 fn entries(fmu: &Path) -> Vec<(String, Vec<u8>)> {
     let mut zip = zip::ZipArchive::new(std::fs::File::open(fmu).unwrap()).unwrap();
@@ -50,9 +68,7 @@ fn a_nurbs_file_lands_in_the_interpolators_resources_folder() {
     let dir = scratch("lands");
     let json = dir.join("part.json");
     std::fs::write(&json, NURBS).unwrap();
-    // The packager only copies the library; any bytes do for this test.
-    let library = dir.join("libcontour_fmu.so");
-    std::fs::write(&library, b"\x7fELF not really").unwrap();
+    let library = host_binaries();
     let resources =
         vec![Resource::parse(&format!("PathInterpolator2D={}", json.display())).unwrap()];
     assert_eq!(resources[0].name, "part.json");
@@ -144,8 +160,7 @@ fn bad_resource_requests_are_refused_with_a_clear_message() {
     ];
     let e = package::check_unique(&twice).unwrap_err();
     assert!(e.contains("resources/part.json"), "{e}");
-    let library = dir.join("lib.so");
-    std::fs::write(&library, b"x").unwrap();
+    let library = host_binaries();
     assert!(package::write_fmu_with_resources(
         model("PathInterpolator2D"),
         &library,

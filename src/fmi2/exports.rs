@@ -295,9 +295,10 @@ pub unsafe extern "C" fn fmi2Instantiate(
         }
         let instance = Instance::with_interface(interface, environment, logger, name);
         instance.log_event(&format!(
-            "instantiated {} with the {} interface (GUID {guid})",
+            "instantiated {} with the {} interface (GUID {guid}, {})",
             interface.model.identifier,
-            interface.units.name()
+            interface.units.name(),
+            crate::build_identity::described()
         ));
         instance.logger.flush();
         match registry::add_instance(instance) {

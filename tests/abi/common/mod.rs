@@ -2,6 +2,7 @@
 //! it dlopens `libcontour_fmu.so` and calls the exported `fmi2*` symbols.
 #![allow(dead_code)]
 
+use contour_core::math;
 use std::ffi::{c_char, c_void, CStr, CString};
 use std::path::PathBuf;
 use std::sync::{Mutex, OnceLock};
@@ -25,7 +26,7 @@ pub fn run_plant(i: &Instance, from: usize, to: usize) -> Vec<[f64; 3]> {
     (from..to)
         .map(|k| {
             let t = k as f64 * h;
-            let u = [20.0 * (5.0 * t).sin(), 15.0 * (3.0 * t).cos()];
+            let u = [20.0 * math::sin(5.0 * t), 15.0 * math::cos(3.0 * t)];
             assert_eq!(i.set_reals(&[plant_vr::U_X, plant_vr::U_Y], &u), OK);
             assert_eq!(i.step(t, h), OK);
             let (_, v) = i.get_reals(&[plant_vr::POS_X, plant_vr::POS_Y, plant_vr::VEL_X]);
@@ -55,45 +56,7 @@ pub const DISCARD: fmi2Status = fmi2Status_fmi2Discard;
 pub const ERROR: fmi2Status = fmi2Status_fmi2Error;
 pub const FATAL: fmi2Status = fmi2Status_fmi2Fatal;
 
-/// FMI 2.0 for Co-Simulation, in the order of fmi2Functions.h.
-pub const FMI2_CO_SIMULATION: [&str; 34] = [
-    // Common functions.
-    "fmi2GetTypesPlatform",
-    "fmi2GetVersion",
-    "fmi2SetDebugLogging",
-    "fmi2Instantiate",
-    "fmi2FreeInstance",
-    "fmi2SetupExperiment",
-    "fmi2EnterInitializationMode",
-    "fmi2ExitInitializationMode",
-    "fmi2Terminate",
-    "fmi2Reset",
-    "fmi2GetReal",
-    "fmi2GetInteger",
-    "fmi2GetBoolean",
-    "fmi2GetString",
-    "fmi2SetReal",
-    "fmi2SetInteger",
-    "fmi2SetBoolean",
-    "fmi2SetString",
-    "fmi2GetFMUstate",
-    "fmi2SetFMUstate",
-    "fmi2FreeFMUstate",
-    "fmi2SerializedFMUstateSize",
-    "fmi2SerializeFMUstate",
-    "fmi2DeSerializeFMUstate",
-    "fmi2GetDirectionalDerivative",
-    // Co-Simulation functions.
-    "fmi2SetRealInputDerivatives",
-    "fmi2GetRealOutputDerivatives",
-    "fmi2DoStep",
-    "fmi2CancelStep",
-    "fmi2GetStatus",
-    "fmi2GetRealStatus",
-    "fmi2GetIntegerStatus",
-    "fmi2GetBooleanStatus",
-    "fmi2GetStringStatus",
-];
+pub use contour_fmu::fmi2::FMI2_CO_SIMULATION;
 
 /// The cdylib cargo built with this test binary: `cargo test` leaves it beside the test
 /// in target/<profile>/deps/, `cargo build` in target/<profile>/.
