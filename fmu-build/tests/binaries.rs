@@ -2,25 +2,12 @@
 //! claimed for another platform, a library that is not an FMU's, and binaries of two
 //! source trees are refused, each with a message naming the file or the platforms.
 
-use std::path::PathBuf;
+mod common;
 
+use common::host_library;
 use contour_fmu::build_identity;
 use fmu_build::binary_check::{check, same_build};
 use fmu_build::platform::Platform;
-
-/// The contour-fmu cdylib cargo built beside this test (target/<profile>/deps/).
-fn host_library() -> PathBuf {
-    let deps = std::env::current_exe()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .to_path_buf();
-    deps.join(format!(
-        "{}contour_fmu{}",
-        std::env::consts::DLL_PREFIX,
-        std::env::consts::DLL_SUFFIX
-    ))
-}
 
 #[test]
 fn the_host_library_passes_and_carries_this_trees_build() {

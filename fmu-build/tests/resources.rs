@@ -5,6 +5,8 @@
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+mod common;
+
 use contour_fmu::models;
 use fmu_build::package::{self, Binaries, Resource};
 use fmu_build::platform::{Binary, Platform};
@@ -33,19 +35,9 @@ fn model(identifier: &str) -> &'static contour_fmu::framework::interface::Interf
     )
 }
 
-/// The host's library as cargo built it for this test run (the cdylib of the contour-fmu
-/// dependency lies beside the test executable, in target/<profile>/deps/).
+/// The host's library as cargo built it for this test run.
 fn host_binaries() -> Binaries {
-    let deps = std::env::current_exe()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .to_path_buf();
-    let file = deps.join(format!(
-        "{}contour_fmu{}",
-        std::env::consts::DLL_PREFIX,
-        std::env::consts::DLL_SUFFIX
-    ));
+    let file = common::host_library();
     let platform = Platform::host().expect("tests run on a platform FMUs carry");
     Binaries::load(&[Binary { platform, file }]).unwrap()
 }
