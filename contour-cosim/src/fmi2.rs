@@ -644,40 +644,31 @@ pub fn is_fatal(library: &Library) -> bool {
 /// Gives this process's standard output to its caller alone: returns a file writing to
 /// what was file descriptor 1, which then points at standard error. What an FMU prints
 /// (a C printf, a pythonfmu print) goes to standard error and cannot corrupt results
-/// written to the returned file.
-#[cfg(unix)]
+/// written to the returned file. On Windows descriptor 1 is the C runtime's, which an
+/// FMU's printf writes to; the results go to its duplicate's Windows handle.
 pub fn private_stdout() -> std::io::Result<std::fs::File> {
-    use std::os::fd::FromRawFd;
-    // SAFETY: dup and dup2 on the process's own standard descriptors; the duplicate is
-    // owned by the returned File alone.
+    // SAFETY: dup and dup2 (the C runtime's _dup and _dup2 on Windows) on the process's
+    // own standard descriptors; the duplicate is owned by the returned File alone (on
+    // Windows its descriptor is never closed, so the handle is not closed twice).
     unsafe {
         let duplicate = libc::dup(1);
         if duplicate < 0 || libc::dup2(2, 1) < 0 {
             return Err(std::io::Error::last_os_error());
         }
-        Ok(std::fs::File::from_raw_fd(duplicate))
-    }
-}
-
-/// On Windows the C runtime's descriptor 1 is what an FMU's printf writes to: it is
-/// pointed at standard error as on Unix, and the results go to a duplicate of the original
-/// as a Windows handle.
-#[cfg(windows)]
-pub fn private_stdout() -> std::io::Result<std::fs::File> {
-    use std::os::windows::io::{FromRawHandle, RawHandle};
-    // SAFETY: _dup and _dup2 on the C runtime's own standard descriptors; the duplicate's
-    // handle is owned by the returned File alone (its descriptor is never closed, so the
-    // handle is not closed twice).
-    unsafe {
-        let duplicate = libc::dup(1);
-        if duplicate < 0 || libc::dup2(2, 1) < 0 {
-            return Err(std::io::Error::last_os_error());
+        #[cfg(unix)]
+        {
+            use std::os::fd::FromRawFd;
+            Ok(std::fs::File::from_raw_fd(duplicate))
         }
-        let handle = libc::get_osfhandle(duplicate);
-        if handle == -1 {
-            return Err(std::io::Error::last_os_error());
+        #[cfg(windows)]
+        {
+            use std::os::windows::io::{FromRawHandle, RawHandle};
+            let handle = libc::get_osfhandle(duplicate);
+            if handle == -1 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(std::fs::File::from_raw_handle(handle as RawHandle))
         }
-        Ok(std::fs::File::from_raw_handle(handle as RawHandle))
     }
 }
 
