@@ -94,10 +94,6 @@ fn build_binaries(root: &Path, platforms: &Platforms) -> Result<Binaries, String
             .collect::<Result<Vec<_>, _>>()?,
     };
     let binaries = Binaries::load(&built)?;
-    let floor = GLIBC_FLOOR
-        .split_once('.')
-        .and_then(|(a, b)| Some((a.parse().ok()?, b.parse().ok()?)))
-        .expect("GLIBC_FLOOR is x.y");
     for (platform, checked) in binaries.platforms() {
         let glibc = checked
             .glibc
@@ -114,12 +110,14 @@ fn build_binaries(root: &Path, platforms: &Platforms) -> Result<Binaries, String
             checked.build_id
         );
         if let (Platforms::Distribution(_), Some(needed)) = (platforms, checked.glibc) {
-            if needed > floor {
+            if needed > GLIBC_FLOOR {
                 return Err(format!(
-                    "the {} binary needs glibc {}.{}, newer than {GLIBC_FLOOR}",
+                    "the {} binary needs glibc {}.{}, newer than {}.{}",
                     platform.folder(),
                     needed.0,
-                    needed.1
+                    needed.1,
+                    GLIBC_FLOOR.0,
+                    GLIBC_FLOOR.1
                 ));
             }
         }

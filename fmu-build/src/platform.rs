@@ -29,8 +29,8 @@ pub enum Platform {
     Aarch64Darwin,
 }
 
-/// The lowest glibc the Linux binaries of the distribution build need.
-pub const GLIBC_FLOOR: &str = "2.28";
+/// The lowest glibc the Linux binaries of the distribution build need: (major, minor).
+pub const GLIBC_FLOOR: (u32, u32) = (2, 28);
 
 impl Platform {
     /// The platforms of the distribution build (`--platforms all`).
@@ -225,7 +225,8 @@ pub fn build_distribution(
                 .env("CARGO_ZIGBUILD_PYTHON_PATH", python);
             match platform.macos_floor() {
                 None => {
-                    command.arg(format!("--target={triple}.{GLIBC_FLOOR}"));
+                    let (major, minor) = GLIBC_FLOOR;
+                    command.arg(format!("--target={triple}.{major}.{minor}"));
                 }
                 Some(floor) => {
                     // zig ignores the linker's export list: hidden visibility leaves the
