@@ -102,8 +102,8 @@ fn bench_path_length(c: &mut Criterion) {
 fn bench_planning(c: &mut Criterion) {
     use contour_core::kinematics::TableTiltingAc;
     use contour_core::limits::{JointLimits, PathLimits};
-    use contour_core::path::cam_examples::dome_raster;
-    use contour_core::path::plan::Plan;
+    use contour_core::path::five_axis::cam_examples::dome_raster;
+    use contour_core::path::five_axis::FiveAxisPlan;
     let mut group = c.benchmark_group("five_axis");
     group.sample_size(10);
     for (name, stepover, passes) in [("plan_1k", 5.0, 2), ("plan_100k", 0.1, 282)] {
@@ -112,7 +112,7 @@ fn bench_planning(c: &mut Criterion) {
         group.throughput(Throughput::Elements(poses.len() as u64));
         group.bench_function(name, |b| {
             b.iter(|| {
-                Plan::new(
+                FiveAxisPlan::new(
                     black_box(&poses),
                     TableTiltingAc::default(),
                     &JointLimits::default(),

@@ -522,7 +522,7 @@ fn spiral_program(n: usize) -> String {
 /// The interpolator on the paper's circle, then planned on the 1k and 100k spirals; the
 /// controller's program estimator on the spirals' planned samples.
 fn two_axis_programs() -> Vec<Round> {
-    use contour_core::path::plan::{XyLimits, XyReference};
+    use contour_core::path::planar::{XyLimits, XyReference};
     use linked::Start;
     const TIMED: usize = 4_000;
     let interpolator = |parameters: &[(&str, Start)]| {
@@ -564,10 +564,10 @@ fn two_axis_programs() -> Vec<Round> {
             vec![[0.0f64; 0]; TIMED],
         ));
         // The same plan in process: the reference rows, the tool trailing it.
-        let program = contour_core::path::program::load_program(std::path::Path::new(&file))
+        let program = contour_core::path::planar::Program::load(std::path::Path::new(&file))
             .expect("the spiral reads");
         let mut reference = XyReference::new(
-            contour_core::path::Path::Program(program),
+            contour_core::path::planar::Path::Program(program),
             XyLimits {
                 feed: 50.0,
                 rapid: 100.0,
@@ -609,8 +609,8 @@ fn two_axis_programs() -> Vec<Round> {
 /// through vertical at constant feed (C flips by π at the pole: the correction stands
 /// aside and the mapping restarts every sample while the machine catches up).
 fn cam_paths() -> Vec<Round> {
-    use contour_core::path::cam_examples::{dome_raster, tilting_pass};
-    use contour_core::path::ToolPath;
+    use contour_core::path::five_axis::cam_examples::{dome_raster, tilting_pass};
+    use contour_core::path::five_axis::ToolPath;
     let replay = |name: &'static str, poses: Vec<contour_core::kinematics::Pose>, planned: bool| {
         let mut config = FiveAxisSimConfig::new(ToolPath::from_poses(&poses).unwrap(), 50.0);
         if !planned {

@@ -8,7 +8,8 @@
 
 use contour_core::contour::planar::{true_error, TrueErrorIndex};
 use contour_core::math;
-use contour_core::path::{builtin, Curve};
+use contour_core::path::planar::builtin;
+use contour_core::path::Curve;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 use serde_json::json;

@@ -7,7 +7,8 @@ use std::time::Instant;
 
 use contour_core::contour::planar::{true_error, FreeCurveEstimator, TrueErrorIndex};
 use contour_core::contour::ContourEstimator;
-use contour_core::path::{builtin, Curve, Interpolator};
+use contour_core::path::planar::builtin;
+use contour_core::path::{Curve, Interpolator};
 
 fn main() {
     let name = std::env::args().nth(1).unwrap_or_else(|| "trident".into());

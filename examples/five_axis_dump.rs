@@ -30,7 +30,7 @@ use contour_core::control::CccMode;
 use contour_core::geometry::Vector;
 use contour_core::kinematics::{Joints, Pose, TableTiltingAc};
 use contour_core::math;
-use contour_core::path::ToolPath;
+use contour_core::path::five_axis::ToolPath;
 use contour_core::plant::{ServoAxes, ServoAxesParams};
 use contour_core::sim::{simulate_five_axis, FiveAxisSimConfig};
 use rand::rngs::StdRng;

@@ -9,7 +9,7 @@
 use std::io::Write;
 
 use contour_core::control::CccMode;
-use contour_core::path::ToolPath;
+use contour_core::path::five_axis::ToolPath;
 use contour_core::sim::{simulate_five_axis, FiveAxisSimConfig};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

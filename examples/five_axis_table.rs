@@ -8,7 +8,7 @@
 
 use contour_core::control::CccMode;
 use contour_core::limits::JointLimits;
-use contour_core::path::BUILTIN_TOOL_PATHS;
+use contour_core::path::five_axis::BUILTIN_TOOL_PATHS;
 use contour_core::sim::{simulate_five_axis, FiveAxisSimConfig};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

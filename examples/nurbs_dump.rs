@@ -3,7 +3,8 @@
 //!
 //! Usage: `nurbs_dump <infinity|trident|unit_circle|FILE.json> [COUNT]` (COUNT = 1000).
 
-use contour_core::path::{builtin, file, Curve, Nurbs};
+use contour_core::path::planar::builtin;
+use contour_core::path::{nurbs_file, Curve, Nurbs};
 use serde_json::json;
 
 fn main() {
@@ -21,7 +22,7 @@ fn main() {
         "infinity" => builtin::infinity(),
         "trident" => builtin::trident(),
         "unit_circle" => builtin::rational_unit_circle(),
-        f => match file::load_nurbs(f) {
+        f => match nurbs_file::load_nurbs(f) {
             Ok(n) => n,
             Err(e) => {
                 eprintln!("{e}");

@@ -2,8 +2,10 @@
 //! `contour-fmu` compute, and the in-process loops and offline evaluation that the tools
 //! (`contour-eval`, `contour-tune`), tests and benchmarks run.
 //!
-//! The floors, each using only those above it: [`geometry`], [`kinematics`] and [`limits`]; [`path`]
-//! (reference paths and the feed-rate interpolator); [`contour`] (contour errors, split by
+//! The floors, each using only those above it: [`geometry`], [`kinematics`] and [`limits`];
+//! [`path`] (the curves both machines' references are made of, the feed-rate interpolator)
+//! with [`part_program`] (what CAM systems write, read into one model) and each machine's
+//! paths (`path::planar`, `path::five_axis`); [`contour`] (contour errors, split by
 //! paper into `planar` and `five_axis`); [`control`] (PID, fuzzy gain scheduling, the
 //! cross-coupled controllers); [`plant`] (the test plants); [`sim`] (the closed loops in
 //! process). Units: mm, rad, s.
@@ -17,6 +19,7 @@ pub mod geometry;
 pub mod kinematics;
 pub mod limits;
 pub mod math;
+pub mod part_program;
 pub mod path;
 pub mod plant;
 pub mod sim;

@@ -56,7 +56,8 @@ use contour_core::contour::planar::{
 use contour_core::contour::ContourEstimator;
 use contour_core::geometry::Vector2;
 use contour_core::math;
-use contour_core::path::{builtin, Curve, Interpolator, Path};
+use contour_core::path::planar::{builtin, Path};
+use contour_core::path::{Curve, Interpolator};
 
 const TS: f64 = 1e-3;
 const LAGS: [f64; 7] = [0.0, 0.3, 1.0, 1.5, 2.0, 3.7, 5.0];

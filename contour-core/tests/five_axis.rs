@@ -9,8 +9,7 @@ use contour_core::contour::five_axis::hmm::{
 use contour_core::control::{CccMode, FiveAxisConfig, FiveAxisController, SampleError};
 use contour_core::geometry::{self, Vector};
 use contour_core::kinematics::{damped_least_squares, Joints};
-use contour_core::path::JointReference;
-use contour_core::path::{ToolPath, BUILTIN_TOOL_PATHS};
+use contour_core::path::five_axis::{JointReference, ToolPath, BUILTIN_TOOL_PATHS};
 use contour_core::sim::{
     nearest_on_branch, simulate_five_axis, FiveAxisMetrics, FiveAxisRecord, FiveAxisSimConfig,
 };

@@ -9,8 +9,8 @@
 use contour_core::control::CccMode;
 use contour_core::geometry::{self, Vector};
 use contour_core::kinematics::Pose;
-use contour_core::path::cam_examples::{dome_raster, tilting_pass};
-use contour_core::path::ToolPath;
+use contour_core::path::five_axis::cam_examples::{dome_raster, tilting_pass};
+use contour_core::path::five_axis::ToolPath;
 use contour_core::plant::AxisEffects;
 use contour_core::sim::{simulate_five_axis, FiveAxisMetrics, FiveAxisSimConfig};
 

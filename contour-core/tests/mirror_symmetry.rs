@@ -10,8 +10,8 @@
 //! `Path::mirrored`, which is checked against them.
 
 use contour_core::control::{CccMode, FuzzyFactors};
-use contour_core::path::program::{self, Move, Shape};
-use contour_core::path::{builtin, CircularArc, Line, Nurbs, Path, Program};
+use contour_core::path::planar::{builtin, Move, Path, Program, Shape};
+use contour_core::path::{CircularArc, Line, Nurbs};
 use contour_core::plant::XyTableParams;
 use contour_core::sim::{simulate, SimConfig};
 
@@ -120,7 +120,7 @@ fn mirrored_paths_give_mirrored_runs() {
 
 #[test]
 fn a_part_program_and_its_mirror_give_mirrored_runs() {
-    let part = Path::Program(program::parse_program(PART, "part.ngc").unwrap());
+    let part = Path::Program(Program::parse_gcode(PART, "part.ngc").unwrap());
     assert_eq!(part.mirrored(), mirror_by_definition(&part));
     assert_eq!(part.mirrored().mirrored(), part);
     for (mode_name, mode) in [("off", CccMode::Off), ("fuzzy", CccMode::Fuzzy)] {

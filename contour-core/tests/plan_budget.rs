@@ -6,11 +6,10 @@ use std::sync::Arc;
 
 use contour_core::kinematics::TableTiltingAc;
 use contour_core::limits::{JointLimits, PathLimits};
-use contour_core::path::plan::{plan_for, set_sample_budget, PlanInputs};
-use contour_core::path::ToolPath;
+use contour_core::path::five_axis::{FiveAxisInputs, Planner, ToolPath};
 
-fn figure_eight(limits: PathLimits) -> PlanInputs {
-    PlanInputs {
+fn figure_eight(limits: PathLimits) -> FiveAxisInputs {
+    FiveAxisInputs {
         path: ToolPath::builtin("figure_eight").expect("a built-in"),
         builtin: Some("figure_eight".into()),
         machine: TableTiltingAc::default(),
@@ -25,14 +24,18 @@ fn planning_work_is_bounded_by_the_sample_budget() {
     // The fuzzers' budget: the figure-eight's own plan (930 samples, about 55 000
     // evaluations of the limits) fits; 30 times the acceleration at the same jerk asks a
     // jerk filter 600 samples long and about a million evaluations, refused at 320 000.
-    set_sample_budget(20_000);
+    let planner = Planner::new();
+    planner.set_sample_budget(20_000);
     let base = PathLimits::at_feed(50.0);
-    assert!(plan_for(&figure_eight(base), &|i| format!("{i}")).is_ok());
+    assert!(planner
+        .plan(&figure_eight(base), &|i| format!("{i}"))
+        .is_ok());
     let heavy = PathLimits {
         accel: 30.0 * base.accel,
         ..base
     };
-    let error = plan_for(&figure_eight(heavy), &|i| format!("{i}"))
+    let error = planner
+        .plan(&figure_eight(heavy), &|i| format!("{i}"))
         .expect_err("beyond the work budget")
         .to_string();
     assert!(
@@ -49,10 +52,16 @@ fn a_plan_dropped_by_its_last_instance_is_found_again() {
         tolerance: 0.004,
         ..PathLimits::at_feed(40.0)
     });
-    let first = plan_for(&inputs, &|i| format!("{i}")).expect("plans");
+    let planner = Planner::new();
+    let first = planner.plan(&inputs, &|i| format!("{i}")).expect("plans");
     let kept = Arc::downgrade(&first);
     drop(first);
     let alive = kept.upgrade().expect("the plan outlives its last instance");
-    let again = plan_for(&inputs, &|i| format!("{i}")).expect("plans");
+    let again = planner.plan(&inputs, &|i| format!("{i}")).expect("plans");
     assert!(Arc::ptr_eq(&alive, &again));
+    // Another planner keeps its own plans: no state is shared through the core.
+    let other = Planner::new()
+        .plan(&inputs, &|i| format!("{i}"))
+        .expect("plans");
+    assert!(!Arc::ptr_eq(&alive, &other));
 }

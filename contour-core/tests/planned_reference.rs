@@ -6,7 +6,7 @@ use contour_core::geometry::{self, Vector};
 use contour_core::kinematics::{Pose, TableTiltingAc};
 use contour_core::limits::{JointLimits, PathLimits};
 use contour_core::math;
-use contour_core::path::plan::{Plan, PlannedSample};
+use contour_core::path::five_axis::{FiveAxisPlan, PlannedSample};
 
 type V3 = Vector<3>;
 
@@ -60,7 +60,7 @@ fn name(i: usize) -> String {
 }
 
 /// Every sample of `plan` from its start to rest at the end.
-fn samples(plan: Plan) -> (Vec<PlannedSample>, std::sync::Arc<Plan>) {
+fn samples(plan: FiveAxisPlan) -> (Vec<PlannedSample>, std::sync::Arc<FiveAxisPlan>) {
     let mut cursor = plan.start();
     let mut out = vec![plan.sample(&mut cursor)];
     while !out[out.len() - 1].done {
@@ -147,8 +147,8 @@ fn plan(
     cl: &[Pose],
     joints: &JointLimits,
     limits: &PathLimits,
-) -> (Vec<PlannedSample>, std::sync::Arc<Plan>) {
-    samples(Plan::new(cl, TableTiltingAc::default(), joints, limits, TS, &name).unwrap())
+) -> (Vec<PlannedSample>, std::sync::Arc<FiveAxisPlan>) {
+    samples(FiveAxisPlan::new(cl, TableTiltingAc::default(), joints, limits, TS, &name).unwrap())
 }
 
 fn check_all(
@@ -258,7 +258,7 @@ fn a_path_beyond_the_a_travel_is_refused_naming_the_pose() {
     let mut joints = JointLimits::default();
     joints.max[3] = 20f64.to_radians();
     joints.min[3] = -20f64.to_radians();
-    let e = Plan::new(
+    let e = FiveAxisPlan::new(
         &tilting_pass(0.0),
         TableTiltingAc::default(),
         &joints,
@@ -312,7 +312,7 @@ fn a_path_too_long_for_the_sample_budget_is_refused_before_any_planning() {
             axis: V3::z(),
         },
     ];
-    let e = Plan::new(
+    let e = FiveAxisPlan::new(
         &far,
         TableTiltingAc::default(),
         &JointLimits::default(),

@@ -8,8 +8,9 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use contour_core::contour::planar::TrueErrorIndex;
 use contour_core::geometry::Vector2;
-use contour_core::path::program::{parse_program, Corner, Speed};
-use contour_core::path::{Curve, Interpolator, Path};
+use contour_core::part_program::{Corner, Speed};
+use contour_core::path::planar::{Path, Program};
+use contour_core::path::{Curve, Interpolator};
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
 
@@ -100,7 +101,7 @@ fn part() -> (String, Vec<Piece>) {
 #[test]
 fn the_reader_gives_the_parts_pieces_and_their_modes() {
     let (text, pieces) = part();
-    let program = parse_program(&text, "part.ngc").unwrap();
+    let program = Program::parse_gcode(&text, "part.ngc").unwrap();
     assert!(
         program.warnings.iter().any(|w| w.contains("G94")),
         "{:?}",
@@ -131,7 +132,7 @@ fn the_reader_gives_the_parts_pieces_and_their_modes() {
 #[test]
 fn the_exact_distance_is_the_nearest_piece_whatever_the_hint() {
     let (text, pieces) = part();
-    let program = parse_program(&text, "part.ngc").unwrap();
+    let program = Program::parse_gcode(&text, "part.ngc").unwrap();
     for (path, mirrored) in [
         (Path::Program(program.clone()), false),
         (Path::Program(program.mirrored()), true),
@@ -198,7 +199,7 @@ fn the_exact_distance_is_the_nearest_piece_whatever_the_hint() {
 #[test]
 fn at_constant_feed_every_sample_is_on_the_part_one_feed_step_apart() {
     let (text, pieces) = part();
-    let program = parse_program(&text, "part.ngc").unwrap();
+    let program = Program::parse_gcode(&text, "part.ngc").unwrap();
     let path = Path::Program(program);
     let index = TrueErrorIndex::new(&path);
     let (feed, ts) = (20.0, 1e-3);
@@ -235,7 +236,8 @@ fn beyond_a_sharp_corner_the_sign_says_outside() {
     // points all round each vertex are positive outside and negative inside, by the
     // test's own half-plane test, whichever move's end is the foot.
     let h = 5.0 * 3f64.sqrt();
-    let program = parse_program("G1 X10 F600\nG1 X5 Y8.660254037844386\nG1 X0 Y0\n", "t.ngc");
+    let program =
+        Program::parse_gcode("G1 X10 F600\nG1 X5 Y8.660254037844386\nG1 X0 Y0\n", "t.ngc");
     let path = Path::Program(program.unwrap());
     let index = TrueErrorIndex::new(&path);
     let corners = [
@@ -285,7 +287,7 @@ fn the_program_estimate_is_the_exact_distance_on_every_sample_of_closed_loop_run
     use contour_core::contour::planar::EstimatorKind;
     use contour_core::sim::{SimConfig, Simulator};
     let (text, pieces) = part();
-    let program = parse_program(&text, "part.ngc").unwrap();
+    let program = Program::parse_gcode(&text, "part.ngc").unwrap();
     let mirrored_pieces: Vec<Piece> = pieces
         .iter()
         .map(|p| match *p {
@@ -295,7 +297,8 @@ fn the_program_estimate_is_the_exact_distance_on_every_sample_of_closed_loop_run
         .collect();
     // 120° turns: past each corner the reference pulls the tool back along the side it
     // has left.
-    let triangle = parse_program("G1 X10 F600\nG1 X5 Y8.660254037844386\nG1 X0 Y0\n", "t.ngc");
+    let triangle =
+        Program::parse_gcode("G1 X10 F600\nG1 X5 Y8.660254037844386\nG1 X0 Y0\n", "t.ngc");
     let h = 8.660254037844386;
     let triangle_pieces = vec![
         Piece::Line([0.0, 0.0], [10.0, 0.0]),
@@ -304,7 +307,7 @@ fn the_program_estimate_is_the_exact_distance_on_every_sample_of_closed_loop_run
     ];
     // A slot's end: a half circle of 0.5 mm between two passes 1 mm apart, all joins
     // tangent; at speed the reference comes back behind the tool round it.
-    let slot = parse_program("G1 X20 F600\nG3 X20 Y1 R0.5\nG1 X0\n", "slot.ngc");
+    let slot = Program::parse_gcode("G1 X20 F600\nG3 X20 Y1 R0.5\nG1 X0\n", "slot.ngc");
     let slot_pieces = vec![
         Piece::Line([0.0, 0.0], [20.0, 0.0]),
         Piece::Arc([20.0, 0.5], 0.5, -FRAC_PI_2, PI),

@@ -15,7 +15,7 @@ use contour_core::contour::five_axis::run_evaluation::{
 use contour_core::geometry::{norm, Vector};
 use contour_core::kinematics::{Joints, Pose, TableTiltingAc};
 use contour_core::math;
-use contour_core::path::load_poses;
+use contour_core::path::five_axis::load_poses;
 
 type V3 = Vector<3>;
 

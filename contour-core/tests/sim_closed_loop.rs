@@ -5,7 +5,8 @@
 use contour_core::contour::planar::{true_error, Estimator, EstimatorKind};
 use contour_core::control::{CccMode, ControllerConfig, CrossCoupledController, PidGains};
 use contour_core::math;
-use contour_core::path::{builtin, Interpolator};
+use contour_core::path::planar::builtin;
+use contour_core::path::Interpolator;
 use contour_core::plant::{XyTable, XyTableParams};
 use contour_core::sim::{
     DivergenceKind, Metrics, SimConfig, SimResult, Simulator, FREE_CURVE_FEED, PAPER_CIRCLE_FEED,

@@ -7,9 +7,7 @@
 use contour_core::contour::planar::{true_error, TrueErrorIndex};
 use contour_core::geometry::Vector2;
 use contour_core::math;
-use contour_core::path::plan::{XyLimits, XyReference};
-use contour_core::path::program::parse_program;
-use contour_core::path::Path;
+use contour_core::path::planar::{Path, Program, XyLimits, XyReference};
 
 const LIMITS: XyLimits = XyLimits {
     feed: 50.0,
@@ -21,7 +19,7 @@ const LIMITS: XyLimits = XyLimits {
 };
 
 fn program(text: &str) -> Path {
-    Path::Program(parse_program(text, "test.ngc").unwrap())
+    Path::Program(Program::parse_gcode(text, "test.ngc").unwrap())
 }
 
 /// All samples of a planned reference, from the start to the end.
@@ -257,8 +255,8 @@ fn the_exact_distance_to_a_blended_program_is_the_dense_samples_nearest() {
     // the search samples more sparsely): every blend against its own 200 000 samples
     // (chords under 40 nm), the lines by their closed form, for points around every
     // corner.
-    use contour_core::path::program::{blended, Shape};
-    let program = parse_program(
+    use contour_core::path::planar::{blended, Shape};
+    let program = Program::parse_gcode(
         "G64 P0.05\nG1 X20 F600\nY20\nX0\nY0\nX-3 Y0.8\nX-13 Y1\nX-23 Y1.2\nX-33 Y1.9\n",
         "b.ngc",
     )
@@ -330,7 +328,7 @@ fn the_exact_distance_to_a_blended_program_is_the_dense_samples_nearest() {
 
 #[test]
 fn a_nurbs_is_planned_on_itself_within_the_limits() {
-    use contour_core::path::builtin;
+    use contour_core::path::planar::builtin;
     use contour_core::path::{clamped_uniform_knots, Curve, Nurbs};
     let knots_inside = |n: &Nurbs| -> Vec<Vector2> {
         let (a, b) = n.param_range();

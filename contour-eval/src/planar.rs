@@ -27,8 +27,7 @@
 
 use contour_core::contour::planar::{TrueError, TrueErrorIndex};
 use contour_core::geometry::{self, Vector2};
-use contour_core::path::program::{blended, Shape};
-use contour_core::path::Path;
+use contour_core::path::planar::{blended, Path, Shape};
 
 /// Path length (mm) every stretch reaches beyond what the tool's move and its distance
 /// from the path call for: 1 µm.
@@ -248,10 +247,10 @@ impl Statistics {
 mod tests {
     use super::*;
     use contour_core::math;
-    use contour_core::path::program::parse_program;
+    use contour_core::path::planar::Program;
 
     fn program(text: &str) -> Path {
-        Path::Program(parse_program(text, "t.ngc").unwrap())
+        Path::Program(Program::parse_gcode(text, "t.ngc").unwrap())
     }
 
     #[test]

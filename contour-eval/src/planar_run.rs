@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use contour_core::geometry::Vector2;
-use contour_core::path::Path;
+use contour_core::path::planar::Path;
 
 use crate::planar::{evaluate, Geometry, PlanarSample, Statistics};
 use crate::staged::{commit, Staged};

@@ -5,8 +5,9 @@
 //! columns say; a path of the other kind is refused, naming both.
 
 use contour_core::kinematics::Pose;
-use contour_core::path::program::is_program_file;
-use contour_core::path::{builtin, load_poses, Path, ToolPath, BUILTIN_TOOL_PATHS};
+use contour_core::part_program::{self, FileKind};
+use contour_core::path::five_axis::{load_poses, ToolPath, BUILTIN_TOOL_PATHS};
+use contour_core::path::planar::{builtin, Path};
 
 use crate::measured::Kind;
 
@@ -33,15 +34,12 @@ fn builtin_kind(spec: &str, columns: Kind, planar: &[&str], five_axis: &[&str]) 
     }
 }
 
-/// The kind a file name says by its ending alone (a `.json` file can be either).
+/// The machine a file is for by its kind alone (a `.json` file can be either).
 fn file_kind(spec: &str) -> Option<Kind> {
-    let lower = spec.to_ascii_lowercase();
-    if lower.ends_with(".cl") || lower.ends_with(".apt") {
-        Some(Kind::FiveAxis)
-    } else if is_program_file(std::path::Path::new(spec)) {
-        Some(Kind::Planar)
-    } else {
-        None
+    match part_program::file_kind(std::path::Path::new(spec))? {
+        FileKind::ClData => Some(Kind::FiveAxis),
+        FileKind::GCode => Some(Kind::Planar),
+        FileKind::Json => None,
     }
 }
 
@@ -84,7 +82,7 @@ pub fn load(spec: &str, columns: Kind, measured: &str) -> Result<Reference, Stri
         }
     }
     // A JSON file the run's kind cannot read may be one of the other kind.
-    let json = spec.to_ascii_lowercase().ends_with(".json");
+    let json = part_program::file_kind(std::path::Path::new(spec)) == Some(FileKind::Json);
     match columns {
         Kind::Planar => planar(spec).map(Reference::Planar).map_err(|e| {
             if json && ToolPath::load(spec).is_ok() {

@@ -10,8 +10,7 @@ use common::{contour_eval, entries, s};
 
 use contour_core::geometry::{self, Vector};
 use contour_core::kinematics::{Pose, TableTiltingAc};
-use contour_core::path::JointReference;
-use contour_core::path::ToolPath;
+use contour_core::path::five_axis::{JointReference, ToolPath};
 
 type V3 = Vector<3>;
 

@@ -12,8 +12,7 @@ mod common;
 use common::{contour_eval, entries, s};
 
 use contour_core::contour::planar::true_error;
-use contour_core::path::plan::planned_geometry;
-use contour_core::path::Path as CorePath;
+use contour_core::path::planar::{planned_geometry, Path as CorePath};
 
 type P2 = [f64; 2];
 

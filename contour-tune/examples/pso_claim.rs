@@ -6,7 +6,7 @@
 //! Usage: `cargo run --release -p contour-tune --example pso_claim [SEEDS] [SWARM] [ITERATIONS] [json]`;
 //! with `json` the final fitness of every run is printed as JSON instead of the table.
 
-use contour_core::path::builtin;
+use contour_core::path::planar::builtin;
 use contour_core::sim::{FREE_CURVE_FEED, PAPER_CIRCLE_FEED};
 use contour_tune::objective::{ContourObjective, Fitness, LOWER, UPPER};
 use contour_tune::{minimize, Algorithm, PsoSettings};

@@ -6,7 +6,7 @@
 use serde::{Deserialize, Serialize};
 
 use contour_core::control::{ControllerConfig, FuzzyFactors};
-use contour_core::path::Path;
+use contour_core::path::planar::Path;
 use contour_core::plant::XyTableParams;
 use contour_core::sim::{Metrics, SimConfig, Simulator};
 
@@ -136,7 +136,7 @@ impl ContourObjective {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use contour_core::path::builtin;
+    use contour_core::path::planar::builtin;
 
     #[test]
     fn paper_factors_score_the_simulators_metrics_and_divergence_is_penalised() {

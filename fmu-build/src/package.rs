@@ -109,14 +109,14 @@ impl Resource {
                 )
             })?
             .to_string();
-        let checked = if model != PATH_MODEL {
-            Ok(())
-        } else if name.to_ascii_lowercase().ends_with(".json") {
-            contour_core::path::file::load_nurbs::<2>(&source).map(drop)
-        } else if contour_core::path::program::is_program_file(&source) {
-            contour_core::path::program::load_program(&source).map(drop)
-        } else {
-            Ok(())
+        use contour_core::part_program::{file_kind, FileKind};
+        let checked = match file_kind(&source) {
+            _ if model != PATH_MODEL => Ok(()),
+            Some(FileKind::Json) => {
+                contour_core::path::nurbs_file::load_nurbs::<2>(&source).map(drop)
+            }
+            Some(FileKind::GCode) => contour_core::path::planar::Program::load(&source).map(drop),
+            _ => Ok(()),
         };
         checked.map_err(|e| format!("--resource {model}={}: {e}", source.display()))?;
         Ok(Resource {

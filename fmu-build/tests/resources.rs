@@ -89,7 +89,7 @@ fn a_nurbs_file_lands_in_the_interpolators_resources_folder() {
     assert_eq!(bytes.as_slice(), NURBS.as_bytes());
     // What the FMU will read is a valid path.
     let text = std::str::from_utf8(bytes).unwrap();
-    assert!(contour_core::path::file::parse_nurbs::<2>(text, "part.json").is_ok());
+    assert!(contour_core::path::nurbs_file::parse_nurbs::<2>(text, "part.json").is_ok());
 
     // The other models' FMUs carry no resources.
     let controller =

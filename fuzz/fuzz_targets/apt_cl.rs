@@ -6,10 +6,9 @@
 #![no_main]
 
 use contour_core::kinematics::TableTiltingAc;
-use contour_core::path::cl_data::parse_cl;
+use contour_core::part_program::cl_data::parse_cl;
 use contour_core::path::Curve;
-use contour_core::path::JointReference;
-use contour_core::path::ToolPath;
+use contour_core::path::five_axis::{JointReference, ToolPath};
 use contour_fmu_fuzz::install_panic_hook;
 use libfuzzer_sys::fuzz_target;
 
@@ -20,8 +19,8 @@ fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
     let Ok(cl) = parse_cl(&text, "fuzz.cl") else {
         return;
     };
-    assert!(cl.poses.len() >= 2, "parse_cl accepted fewer than two poses");
-    let Ok(path) = ToolPath::from_poses(&cl.poses) else {
+    assert!(cl.poses().len() >= 2, "parse_cl accepted fewer than two poses");
+    let Ok(path) = ToolPath::from_poses(&cl.poses()) else {
         return;
     };
     let ToolPath::Poses { tips, .. } = &path else {
@@ -32,7 +31,7 @@ fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
         let _ = path.pose_at(u);
     }
     // The vertices themselves: no sampling for a pose path.
-    assert_eq!(path.poses(0.01).map(|p| p.len()), Ok(cl.poses.len()));
+    assert_eq!(path.poses(0.01).map(|p| p.len()), Ok(cl.poses().len()));
     let feed = (tips.length() / (SAMPLES as f64 * 1e-3)).clamp(1e-3, 1e6);
     if let Ok(mut reference) = JointReference::new(path, TableTiltingAc::default(), feed, 1e-3) {
         for _ in 0..SAMPLES {

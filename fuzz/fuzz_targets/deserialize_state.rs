@@ -221,7 +221,7 @@ fuzz_target!(
         install_panic_hook();
         // A restored five-axis state plans again: within the 10 s a fuzz input may take
         // (FUZZ_SAMPLE_BUDGET), a longer plan refused.
-        contour_core::path::plan::set_sample_budget(FUZZ_SAMPLE_BUDGET);
+        contour_fmu::fmi2::set_plan_sample_budget(FUZZ_SAMPLE_BUDGET);
         check_envelope();
         if let Some(dir) = std::env::var_os("CONTOUR_FUZZ_SEEDS") {
             write_seeds(std::path::Path::new(&dir));

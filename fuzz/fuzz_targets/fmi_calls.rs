@@ -1377,7 +1377,7 @@ fuzz_target!(
         install_panic_hook();
         // Plans within the 10 s a fuzz input may take (FUZZ_SAMPLE_BUDGET): a longer
         // one is refused like any other.
-        contour_core::path::plan::set_sample_budget(FUZZ_SAMPLE_BUDGET);
+        contour_fmu::fmi2::set_plan_sample_budget(FUZZ_SAMPLE_BUDGET);
     },
     |input: Input| {
         let mut session = Session::new();

@@ -8,8 +8,8 @@
 
 use contour_core::contour::planar::TrueErrorIndex;
 use contour_core::geometry::Vector2;
-use contour_core::path::program::{parse_program, Program};
-use contour_core::path::{Curve, Interpolator, Path};
+use contour_core::path::planar::{Path, Program};
+use contour_core::path::{Curve, Interpolator};
 use contour_fmu_fuzz::install_panic_hook;
 use libfuzzer_sys::fuzz_target;
 
@@ -17,7 +17,7 @@ const SAMPLES: usize = 32;
 
 fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
     let text = String::from_utf8_lossy(data);
-    let Ok(program) = parse_program(&text, "fuzz.ngc") else {
+    let Ok(program) = Program::parse_gcode(&text, "fuzz.ngc") else {
         return;
     };
     let length = program.length();

@@ -11,9 +11,9 @@
 #![no_main]
 
 use contour_core::kinematics::TableTiltingAc;
-use contour_core::path::JointReference;
-use contour_core::path::ToolPath;
-use contour_core::path::{file, Curve, Interpolator, Nurbs, Path};
+use contour_core::path::five_axis::{JointReference, ToolPath};
+use contour_core::path::{nurbs_file, Curve, Interpolator, Nurbs};
+use contour_core::path::planar::Path;
 use contour_fmu_fuzz::install_panic_hook;
 use libfuzzer_sys::fuzz_target;
 
@@ -61,7 +61,7 @@ fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
     let text = String::from_utf8_lossy(body);
     match selector % 3 {
         0 => {
-            if let Ok(curve) = file::parse_nurbs::<2>(&text, "fuzz.json") {
+            if let Ok(curve) = nurbs_file::parse_nurbs::<2>(&text, "fuzz.json") {
                 exercise(&curve);
                 // As PathInterpolator2D holds it.
                 let path = Path::Nurbs(curve);
@@ -69,7 +69,7 @@ fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
             }
         }
         1 => {
-            if let Ok(curve) = file::parse_nurbs::<3>(&text, "fuzz.json") {
+            if let Ok(curve) = nurbs_file::parse_nurbs::<3>(&text, "fuzz.json") {
                 exercise(&curve);
             }
         }

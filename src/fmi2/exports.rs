@@ -279,7 +279,10 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 known.join(", ")
             ));
         };
-        let mut environment = Environment::default();
+        let mut environment = Environment {
+            resource_dir: None,
+            planner: super::plans::planner(),
+        };
         if !fmuResourceLocation.is_null() {
             match c_str(fmuResourceLocation)
                 .ok_or_else(|| "resource location is not UTF-8".to_string())

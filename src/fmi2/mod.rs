@@ -11,12 +11,15 @@ mod exports;
 mod fmu_state;
 mod instance;
 mod logger;
+mod plans;
 mod registry;
 mod resource_uri;
 mod state_machine;
 mod status;
 
 pub use logger::Category as LogCategory;
+#[cfg(feature = "test-hooks")]
+pub use plans::set_plan_sample_budget;
 
 /// The functions of FMI 2.0 for Co-Simulation, in the order of fmi2Functions.h: what the
 /// library exports, and nothing else (the packager checks every platform's binary).

@@ -3,7 +3,9 @@
 //! initial dependencies and the GUID hashed from them).
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
+use contour_core::path::five_axis::Planner;
 use sha2::{Digest, Sha256};
 
 use super::units;
@@ -14,6 +16,10 @@ use super::variables::{Start, Values, Variable, Vr};
 pub struct Environment {
     /// The unpacked FMU's `resources/` folder, when the importer gave one.
     pub resource_dir: Option<PathBuf>,
+    /// Makes and keeps the five-axis plans: the library's instances share one (see
+    /// `fmi2::plans`), so instances on one path plan once and a restored state finds its
+    /// plan.
+    pub planner: Arc<Planner>,
 }
 
 /// A model's answer when it cannot do what was asked; the text goes to the log.

@@ -1,7 +1,7 @@
 //! The line and arc geometry parameters shared by `PathInterpolator2D` (the path to
 //! follow) and `ContourCCC2D` (the exact line/arc estimators): the same names and
 //! defaults in both FMUs, so one set of values describes one path. The defaults are the
-//! built-in `line` and `arc` paths (contour_core::path::builtin).
+//! built-in `line` and `arc` paths (contour_core::path::planar::builtin).
 
 use std::f64::consts::PI;
 

@@ -8,16 +8,15 @@
 use std::f64::consts::PI;
 
 use super::axis_variables::{REFERENCE_ACCELERATION_OUT, REFERENCE_OUT, REFERENCE_VELOCITY_OUT};
-use super::line_arc_parameters;
-use super::path_parameter;
+use super::{line_arc_parameters, path_parameter};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
 use crate::framework::state_check;
 use crate::framework::state_codec::{SavedState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, Real, XY};
 use crate::framework::variables::{Start, Values, Variable};
-use contour_core::path::plan::{XyLimits, XyReference};
-use contour_core::path::{CircularArc, Curve, Interpolator, Line, Path};
+use contour_core::path::planar::{Path, XyLimits, XyReference};
+use contour_core::path::{CircularArc, Curve, Interpolator, Line};
 
 variable_table! {
     static VARIABLES;
@@ -366,7 +365,7 @@ impl Model for PathInterpolator2D {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use contour_core::path::builtin;
+    use contour_core::path::planar::builtin;
 
     #[test]
     fn start_values_give_the_papers_circle_and_geometry_defaults_the_built_ins() {

@@ -13,12 +13,14 @@ use super::axis_variables::{REFERENCE_ACCELERATION_OUT, REFERENCE_OUT, REFERENCE
 use super::{joint_limits_parameters, kinematics_parameters};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
-use crate::framework::state_codec::{SavedState, StateLayout};
+use crate::framework::state_codec::{decode_state, encode_state, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, XYZAC};
 use crate::framework::variables::{Start, Values, Variable};
 use contour_core::limits::PathLimits;
-use contour_core::path::cl_data;
-use contour_core::path::{FiveAxisReference, ToolPath, BUILTIN_TOOL_PATHS};
+use contour_core::part_program::{cl_data, file_kind, FileKind};
+use contour_core::path::five_axis::{
+    FiveAxisInputs, FiveAxisReference, SavedFiveAxisReference, ToolPath, BUILTIN_TOOL_PATHS,
+};
 
 variable_table! {
     static VARIABLES;
@@ -211,13 +213,22 @@ const LAYOUT: StateLayout = StateLayout {
     version: 4,
 };
 
-#[derive(Clone, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, serde::Serialize)]
 struct State {
     reference: FiveAxisReference,
     clock: SampleClock,
 }
 
-impl SavedState for State {
+/// A saved [`State`] as read back (the same layout), before its reference is planned
+/// again through the instance's planner.
+#[derive(serde::Deserialize)]
+struct SavedStateData {
+    reference: SavedFiveAxisReference,
+    clock: SampleClock,
+}
+
+impl State {
+    /// The check every restored state passes (as a `SavedState`'s).
     fn validate(&self, time: f64) -> Result<(), String> {
         self.clock.validate_at(time)?;
         // Not `state_check::all_finite`: it names every float of the path, megabytes of
@@ -268,16 +279,15 @@ fn programmed(spec: &str, environment: &Environment) -> Result<Programmed, Strin
         let h = super::path_parameter::resource_hint(spec, environment, &e);
         e + h
     };
-    let lower = spec.to_ascii_lowercase();
-    if lower.ends_with(".cl") || lower.ends_with(".apt") {
+    if file_kind(file) == Some(FileKind::ClData) {
         // Read here rather than through ToolPath::load: the plan names CL lines.
-        let data = cl_data::load_cl(&full).map_err(|e| hint(message(e)))?;
-        let path = ToolPath::from_poses(&data.poses).map_err(message)?;
+        let program = cl_data::load_cl(&full).map_err(|e| hint(message(e)))?;
+        let path = ToolPath::from_poses(&program.poses()).map_err(message)?;
         return Ok(Programmed {
             path,
             builtin: None,
-            lines: Some((spec.to_owned(), data.lines)),
-            warnings: data.warnings,
+            lines: Some((spec.to_owned(), program.lines())),
+            warnings: program.warning_lines(),
         });
     }
     let (path, warnings) = ToolPath::load(&full.to_string_lossy()).map_err(|e| hint(message(e)))?;
@@ -317,22 +327,22 @@ impl Model for PathInterpolator5X {
             },
             None => format!("pose {i} of the path"),
         };
-        let reference = FiveAxisReference::new(
-            programmed.path,
-            programmed.builtin,
+        let inputs = FiveAxisInputs {
+            path: programmed.path,
+            builtin: programmed.builtin,
             machine,
             joints,
             limits,
             ts,
-            &name,
-        )
-        // The file read, but its path cannot be followed: say which file.
-        .map_err(|e| match e {
-            contour_core::path::PathError::Invalid(m) => {
-                format!("parameter 'path': {}: {m}", PATH.get(values).trim())
-            }
-            other => format!("parameter 'path': {other}"),
-        })?;
+        };
+        let reference = FiveAxisReference::new(inputs, &self.environment.planner, &name)
+            // The file read, but its path cannot be followed: say which file.
+            .map_err(|e| match e {
+                contour_core::path::PathError::Invalid(m) => {
+                    format!("parameter 'path': {}: {m}", PATH.get(values).trim())
+                }
+                other => format!("parameter 'path': {other}"),
+            })?;
         self.warnings = programmed
             .warnings
             .into_iter()
@@ -364,10 +374,47 @@ impl Model for PathInterpolator5X {
         Ok(())
     }
 
-    crate::framework::state_codec::sampled_state_methods!(State, LAYOUT);
+    fn save_state(&self) -> Result<Vec<u8>, String> {
+        encode_state(LAYOUT, &self.state)
+    }
+
+    fn check_state(&self, bytes: &[u8], time: f64) -> ModelResult {
+        self.decode_state(bytes, time).map(drop)
+    }
+
+    fn restore_state(&mut self, bytes: &[u8], time: f64) -> ModelResult {
+        self.state = self.decode_state(bytes, time)?;
+        Ok(())
+    }
+
+    fn check_step(&self, time: f64, step: f64) -> ModelResult {
+        match &self.state {
+            Some(state) => state.clock.check_step(time + step),
+            None => Ok(()),
+        }
+    }
 }
 
 impl PathInterpolator5X {
+    /// The state saved in `bytes` at `time`, its plan found or made again by the
+    /// instance's planner, checked like any other model's.
+    fn decode_state(&self, bytes: &[u8], time: f64) -> Result<Option<State>, String> {
+        let saved: Option<SavedStateData> = decode_state(LAYOUT, bytes)?;
+        let Some(saved) = saved else {
+            return Ok(None);
+        };
+        saved.clock.validate_at(time)?;
+        let state = State {
+            reference: saved
+                .reference
+                .resume(&self.environment.planner)
+                .map_err(|e| format!("reference: {e}"))?,
+            clock: saved.clock,
+        };
+        state.validate(time)?;
+        Ok(Some(state))
+    }
+
     fn write_outputs(&mut self, values: &mut Values) {
         if let Some(state) = &mut self.state {
             let out = state.reference.current();

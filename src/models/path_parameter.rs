@@ -5,8 +5,7 @@
 use super::line_arc_parameters;
 use crate::framework::model::Environment;
 use crate::framework::variables::{Start, Values, Variable};
-use contour_core::path::program::blended;
-use contour_core::path::Path;
+use contour_core::path::planar::{blended, Path};
 
 /// The parameter's start value: the paper's circle.
 pub const DEFAULT: &str = "circle";

@@ -19,7 +19,8 @@ use contour_core::control::{
 };
 use contour_core::geometry::Vector2;
 use contour_core::kinematics::Joints;
-use contour_core::path::{builtin, Curve, Interpolator, Path};
+use contour_core::path::planar::{builtin, Path};
+use contour_core::path::{Curve, Interpolator};
 use contour_core::sim::{SimConfig, Simulator};
 
 thread_local! {
@@ -285,7 +286,8 @@ fn sample_and_fuzzy_evaluation_do_not_allocate() {
 #[test]
 fn path_estimator_and_true_error_do_not_allocate() {
     let part = "G1 X30 F600\nG3 X35 Y5 R5\nG1 Y20\nX0\nY0\n";
-    let part = Path::Program(contour_core::path::program::parse_program(part, "p.ngc").unwrap());
+    let part =
+        Path::Program(contour_core::path::planar::Program::parse_gcode(part, "p.ngc").unwrap());
     let paths = ["circle", "infinity", "trident"].map(|n| (n, builtin::by_name(n).unwrap()));
     for (name, path) in paths.into_iter().chain([("program", part)]) {
         let mut interp = Interpolator::new(path.clone(), 50.0, 1e-3).unwrap();
@@ -328,9 +330,10 @@ fn path_estimator_and_true_error_do_not_allocate() {
 
 #[test]
 fn a_planned_xy_reference_samples_without_allocating() {
-    use contour_core::path::plan::{XyLimits, XyReference};
+    use contour_core::path::planar::{XyLimits, XyReference};
     let part = "G64 P0.02\nG1 X30 F1200\nG3 X35 Y5 R5\nG1 Y20\nX0\nY0\n";
-    let part = Path::Program(contour_core::path::program::parse_program(part, "p.ngc").unwrap());
+    let part =
+        Path::Program(contour_core::path::planar::Program::parse_gcode(part, "p.ngc").unwrap());
     let limits = XyLimits {
         feed: 20.0,
         rapid: 100.0,
@@ -358,7 +361,7 @@ fn a_planned_xy_reference_samples_without_allocating() {
 fn a_five_axis_reference_and_its_derivatives_sample_without_allocating() {
     use contour_core::kinematics::TableTiltingAc;
     use contour_core::limits::{JointLimits, PathLimits};
-    use contour_core::path::{FiveAxisReference, ToolPath};
+    use contour_core::path::five_axis::{FiveAxisInputs, FiveAxisReference, Planner, ToolPath};
     // At constant feed (the interpolator's look-ahead and the inverse kinematics) and
     // planned (the jerk filter's look-ahead), to the end of the path.
     for accel in [0.0, 2000.0] {
@@ -366,16 +369,16 @@ fn a_five_axis_reference_and_its_derivatives_sample_without_allocating() {
             accel,
             ..PathLimits::at_feed(50.0)
         };
-        let mut reference = FiveAxisReference::new(
-            ToolPath::builtin("tilted_helix").unwrap(),
-            Some("tilted_helix".into()),
-            TableTiltingAc::ORIGIN,
-            JointLimits::DEFAULT,
+        let inputs = FiveAxisInputs {
+            path: ToolPath::builtin("tilted_helix").unwrap(),
+            builtin: Some("tilted_helix".into()),
+            machine: TableTiltingAc::ORIGIN,
+            joints: JointLimits::DEFAULT,
             limits,
-            1e-3,
-            &|i| format!("pose {i}"),
-        )
-        .unwrap();
+            ts: 1e-3,
+        };
+        let mut reference =
+            FiveAxisReference::new(inputs, &Planner::new(), &|i| format!("pose {i}")).unwrap();
         let mut acc = 0.0;
         let count = allocations_during(|| {
             while !reference.current().done {

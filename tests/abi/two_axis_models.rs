@@ -10,7 +10,8 @@ use crate::common::*;
 use contour_core::contour::planar::{Estimator, FreeCurveEstimator};
 use contour_core::control::{ControllerConfig, CrossCoupledController};
 use contour_core::geometry::Vector2;
-use contour_core::path::{builtin, Interpolator};
+use contour_core::path::planar::builtin;
+use contour_core::path::Interpolator;
 use contour_fmu::framework::model::ModelInfo;
 use contour_fmu::framework::variables::Start;
 use contour_fmu::models::{

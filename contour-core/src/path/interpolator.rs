@@ -11,7 +11,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Curve, CurvePoint, Path, PathError};
+use super::planar::Path;
+use super::{Curve, CurvePoint, PathError};
 use crate::geometry::{self, Vector};
 
 /// One emitted reference sample.
@@ -312,7 +313,8 @@ mod tests {
     use super::*;
     use crate::geometry::Vector2;
     use crate::math;
-    use crate::path::{builtin, Nurbs};
+    use crate::path::planar::builtin;
+    use crate::path::Nurbs;
 
     /// Worst relative chord deviation over the whole run (last clamped sample excluded)
     /// and the sample count.

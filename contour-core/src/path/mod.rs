@@ -1,41 +1,36 @@
-//! Reference paths (lines and NURBS in any dimension, planar arcs), the built-in shapes
-//! and the feed-rate interpolator that samples them every `Ts` (docs/design/two-axis.md §4.6).
-//! Units: mm, s.
+//! What both machines' references are made of: curves in any dimension ([`Curve`]:
+//! lines, planar arcs, NURBS, polylines), the feed-rate interpolator that samples a curve
+//! every `Ts` (docs/design/two-axis.md §4.6), the time-optimal feed along a path and the
+//! jerk-limited motion of one piece. Units: mm, s.
 //!
-//! Every geometric type implements [`Curve`] in its dimension, and [`Path`] is the closed
-//! set of planar paths the two-axis FMUs choose from by name ([`builtin::by_name`]) or by
-//! file ([`file::load_nurbs`]).
+//! Each machine's own paths are apart: [`planar`] (the XY table: the closed set of paths
+//! its FMUs follow, its programs with blended corners, its plan) and [`five_axis`] (the
+//! tool path with its axis, the joint references, the plan within the joints' limits).
+//! Part programs are read in [`crate::part_program`].
 
 mod arc;
-pub mod builtin;
-pub mod cam_examples;
-pub mod cl_data;
-pub mod file;
-mod five_axis_reference;
+mod feed;
+pub mod five_axis;
 mod interpolator;
-mod joint_reference;
 mod line;
 mod nurbs;
-pub mod plan;
+pub mod nurbs_file;
+pub(crate) mod piece_profile;
+pub mod planar;
 mod polyline;
-pub mod program;
-mod tool_path;
 
 pub use arc::CircularArc;
-pub use five_axis_reference::{FiveAxisReference, ReferenceSample};
+pub use feed::{FeedConstraints, FeedPoint, FeedProfile};
 pub use interpolator::{Interpolator, Progress, Sample};
-pub use joint_reference::{JointReference, JointSample};
 pub use line::Line;
 pub use nurbs::{clamped_uniform_knots, Nurbs, NurbsData, MAX_DEGREE};
 pub use polyline::Polyline;
-pub use program::Program;
-pub use tool_path::{load_poses, ToolPath, ToolPathData, BUILTIN_TOOL_PATHS};
 
 use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{self, Vector, Vector2};
+use crate::geometry::{self, Vector};
 
 /// Why a path could not be built, loaded or sampled.
 #[derive(Clone, Debug, PartialEq)]
@@ -90,18 +85,24 @@ impl fmt::Display for PathError {
                 line,
                 column,
                 message,
-            } => {
-                // A CL record has a line but no column: "file:line:0:" would read as a
-                // position that does not exist.
-                if *line > 0 && *column > 0 {
-                    write!(f, "{file}:{line}:{column}: {message}")
-                } else if *line > 0 {
-                    write!(f, "{file}:{line}: {message}")
-                } else {
-                    write!(f, "{file}: {message}")
-                }
-            }
+            } => write_placed(f, file, *line, *column, message),
         }
+    }
+}
+
+/// `file:line:column: message`, leaving out what is not known (a CL record has a line but
+/// no column: `file:line:0:` would read as a place that does not exist).
+pub(crate) fn write_placed(
+    f: &mut fmt::Formatter<'_>,
+    file: &str,
+    line: usize,
+    column: usize,
+    message: &str,
+) -> fmt::Result {
+    match (line, column) {
+        (0, _) => write!(f, "{file}: {message}"),
+        (line, 0) => write!(f, "{file}:{line}: {message}"),
+        (line, column) => write!(f, "{file}:{line}:{column}: {message}"),
     }
 }
 
@@ -177,143 +178,6 @@ pub(crate) fn clamp_param(u: f64, a: f64, b: f64) -> f64 {
         a
     } else {
         u.clamp(a, b)
-    }
-}
-
-/// Any path the interpolator and the FMUs can follow.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum Path {
-    /// Straight segment.
-    Line(Line),
-    /// Circular arc or full circle.
-    Arc(CircularArc),
-    /// NURBS curve of any degree up to [`MAX_DEGREE`].
-    Nurbs(Nurbs),
-    /// A G-code part program: line and arc moves end to end.
-    Program(Program),
-}
-
-impl Path {
-    /// Builds a path from a built-in name (`circle`, `line`, `arc`, `infinity`, `trident`)
-    /// or, failing that, from a G-code program (by its name's ending) or a NURBS JSON file
-    /// (relative names resolved against `base_dir`).
-    pub fn from_spec(spec: &str, base_dir: Option<&std::path::Path>) -> Result<Path, PathError> {
-        match builtin::by_name(spec) {
-            Ok(p) => Ok(p),
-            Err(PathError::UnknownName(_)) => {
-                let fs = std::path::Path::new(spec);
-                let full = match base_dir {
-                    Some(dir) if fs.is_relative() => dir.join(fs),
-                    _ => fs.to_path_buf(),
-                };
-                // Something that looks like a file gets the file's own error (naming it).
-                let looks_like_file = spec.ends_with(".json") || spec.contains(['/', '\\']);
-                if program::is_program_file(fs) {
-                    program::load_program(&full).map(Path::Program)
-                } else if full.is_file() || looks_like_file {
-                    file::load_nurbs(&full).map(Path::Nurbs)
-                } else {
-                    Err(PathError::UnknownName(spec.to_string()))
-                }
-            }
-            Err(e) => Err(e),
-        }
-    }
-
-    /// First point of the path.
-    pub fn start_point(&self) -> Vector2 {
-        self.point(self.param_range().0)
-    }
-
-    /// Last point of the path.
-    pub fn end_point(&self) -> Vector2 {
-        self.point(self.param_range().1)
-    }
-
-    /// The mirror image about the x axis (y → −y), travelled in the mirrored sense: a
-    /// counter-clockwise circle becomes a clockwise one. The controller must give the
-    /// mirrored run exactly (the contour error negated sample by sample), which is how the
-    /// tests and the demo check that it does not depend on the direction of travel.
-    pub fn mirrored(&self) -> Path {
-        let flip = |p: Vector2| Vector2::new(p[0], -p[1]);
-        let rebuilt = match self {
-            Path::Line(l) => Ok(Path::Line(l.mirrored())),
-            Path::Arc(a) => Ok(Path::Arc(a.mirrored())),
-            Path::Nurbs(n) => Nurbs::new(
-                n.degree(),
-                n.knots().to_vec(),
-                n.control_points().iter().map(|&p| flip(p)).collect(),
-                Some(n.weights().to_vec()),
-            )
-            .map(Path::Nurbs),
-            Path::Program(p) => Ok(Path::Program(p.mirrored())),
-        };
-        // Mirroring keeps every property the constructors check.
-        rebuilt.expect("the mirror image of a valid path is valid")
-    }
-}
-
-impl Curve for Path {
-    fn param_range(&self) -> (f64, f64) {
-        match self {
-            Path::Line(c) => c.param_range(),
-            Path::Arc(c) => c.param_range(),
-            Path::Nurbs(c) => c.param_range(),
-            Path::Program(c) => c.param_range(),
-        }
-    }
-    fn eval(&self, u: f64) -> CurvePoint {
-        match self {
-            Path::Line(c) => c.eval(u),
-            Path::Arc(c) => c.eval(u),
-            Path::Nurbs(c) => c.eval(u),
-            Path::Program(c) => c.eval(u),
-        }
-    }
-    fn point(&self, u: f64) -> Vector2 {
-        match self {
-            Path::Line(c) => c.point(u),
-            Path::Arc(c) => c.point(u),
-            Path::Nurbs(c) => c.point(u),
-            Path::Program(c) => c.point(u),
-        }
-    }
-    fn length_between(&self, u0: f64, u1: f64) -> f64 {
-        match self {
-            Path::Line(c) => c.length_between(u0, u1),
-            Path::Arc(c) => c.length_between(u0, u1),
-            Path::Nurbs(c) => c.length_between(u0, u1),
-            Path::Program(c) => c.length_between(u0, u1),
-        }
-    }
-    fn breakpoints(&self) -> Vec<f64> {
-        match self {
-            Path::Line(c) => c.breakpoints(),
-            Path::Arc(c) => c.breakpoints(),
-            Path::Nurbs(c) => c.breakpoints(),
-            Path::Program(c) => c.breakpoints(),
-        }
-    }
-}
-
-impl From<Line> for Path {
-    fn from(c: Line) -> Self {
-        Path::Line(c)
-    }
-}
-impl From<CircularArc> for Path {
-    fn from(c: CircularArc) -> Self {
-        Path::Arc(c)
-    }
-}
-impl From<Program> for Path {
-    fn from(c: Program) -> Self {
-        Path::Program(c)
-    }
-}
-impl From<Nurbs> for Path {
-    fn from(c: Nurbs) -> Self {
-        Path::Nurbs(c)
     }
 }
 

@@ -398,7 +398,7 @@ mod tests {
 
     /// docs/design/two-axis.md §4.6: exact unit circle, degree 2, 9 control points on a square.
     fn unit_circle() -> Nurbs {
-        crate::path::builtin::rational_unit_circle()
+        crate::path::planar::builtin::rational_unit_circle()
     }
 
     #[test]
@@ -428,7 +428,7 @@ mod tests {
 
     #[test]
     fn derivatives_match_central_differences() {
-        use crate::path::builtin;
+        use crate::path::planar::builtin;
         for c in [builtin::infinity(), builtin::trident(), unit_circle()] {
             let h = 1e-6;
             let (a, b) = c.param_range();

@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::contour::planar::EstimatorKind;
 use crate::control::{CccMode, ConfigError, ControllerConfig};
-use crate::path::{builtin, Path, PathError};
+use crate::path::planar::{builtin, Path};
+use crate::path::PathError;
 use crate::plant::{AxisParams, ServoAxesParams};
 
 /// The paper's circle feed, mm/s: at 10π the built-in `circle` is x = 10 cos πt − 10,

@@ -16,6 +16,8 @@
 //! other branch through the crossing is never taken. The orientation error is the angle
 //! between the actual tool axis and the reference axis at that nearest point.
 
+use std::sync::Arc;
+
 use serde::{Deserialize, Serialize};
 
 use super::config::SimError;
@@ -23,12 +25,11 @@ use super::metrics::{Divergence, DivergenceKind};
 use crate::contour::five_axis::evaluation_online::PointEvaluation;
 use crate::contour::five_axis::hmm::segment_fraction;
 use crate::control::{CccMode, FiveAxisConfig, FiveAxisController, Hold};
-use crate::geometry::angle_between;
-use crate::geometry::{self, Vector};
+use crate::geometry::{self, angle_between, Vector};
 use crate::kinematics::Joints;
 use crate::limits::{JointLimits, PathLimits};
+use crate::path::five_axis::{FiveAxisInputs, FiveAxisReference, Planner, ToolPath};
 use crate::path::{Curve, PathError};
-use crate::path::{FiveAxisReference, ToolPath};
 use crate::plant::{ServoAxes, ServoAxesParams};
 
 /// Reference samples the truth search looks back over: the default loops trail by about
@@ -56,6 +57,9 @@ pub struct FiveAxisSimConfig {
     pub settle: f64,
     /// The run stops when the true tip error exceeds this, mm. Default 10 mm.
     pub abort_tip_error: f64,
+    /// Makes and keeps the plans: configs cloned from one share it, so their runs on one
+    /// path and limits plan once.
+    pub planner: Arc<Planner>,
 }
 
 impl FiveAxisSimConfig {
@@ -71,6 +75,7 @@ impl FiveAxisSimConfig {
             plant: ServoAxesParams::<5>::TRUNNION,
             settle: 0.1,
             abort_tip_error: 10.0,
+            planner: Arc::new(Planner::new()),
         }
     }
 
@@ -209,15 +214,15 @@ pub fn simulate_five_axis(
     record: bool,
 ) -> Result<(FiveAxisMetrics, Vec<FiveAxisRecord>), SimError> {
     let ts = config.controller.ts;
-    let mut reference = FiveAxisReference::new(
-        config.path.clone(),
-        config.builtin.clone(),
-        config.controller.machine,
-        config.joint_limits,
-        config.path_limits,
+    let inputs = FiveAxisInputs {
+        path: config.path.clone(),
+        builtin: config.builtin.clone(),
+        machine: config.controller.machine,
+        joints: config.joint_limits,
+        limits: config.path_limits,
         ts,
-        &|i| format!("pose {i}"),
-    )?;
+    };
+    let mut reference = FiveAxisReference::new(inputs, &config.planner, &|i| format!("pose {i}"))?;
     let mut controller = FiveAxisController::new(config.controller)?;
     config.plant.validate().map_err(SimError::Plant)?;
     let start = reference.current();

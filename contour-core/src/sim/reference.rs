@@ -8,7 +8,8 @@ use std::fmt::Debug;
 use crate::contour::planar::{Estimator, EstimatorKind, TrueError, TrueErrorIndex};
 use crate::contour::{ContourEstimator, SpatialLineEstimator};
 use crate::geometry::Vector;
-use crate::path::{Curve, Line, Path};
+use crate::path::planar::Path;
+use crate::path::{Curve, Line};
 
 /// A path the in-process closed loop can follow.
 pub trait ReferencePath<const D: usize>: Curve<D> + Clone + Debug {

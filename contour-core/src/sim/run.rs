@@ -8,7 +8,8 @@ use super::reference::ReferencePath;
 use super::trace::{Record, SimResult, Trace};
 use crate::control::{ConfigError, ControllerConfig, CrossCoupledController};
 use crate::geometry::Vector;
-use crate::path::{Interpolator, Path, Sample};
+use crate::path::planar::Path;
+use crate::path::{Interpolator, Sample};
 use crate::plant::ServoAxes;
 
 /// A validated configuration with its reference samples and true-error index prepared,

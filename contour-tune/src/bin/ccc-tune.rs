@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use contour_core::path::Path;
+use contour_core::path::planar::Path;
 use contour_core::sim::preset_feed;
 use contour_cosim::fmi2::Activity;
 use contour_cosim::{System, SystemStructure};

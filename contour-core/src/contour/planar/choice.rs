@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::{ArcEstimator, FreeCurveEstimator, LineEstimator, ProgramEstimator};
 use crate::contour::{ContourEstimate, ContourEstimator};
 use crate::geometry::Vector2;
-use crate::path::Path;
+use crate::path::planar::Path;
 
 /// Which estimator to use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -146,7 +146,7 @@ impl ContourEstimator for Estimator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::path::builtin;
+    use crate::path::planar::builtin;
 
     #[test]
     fn names_parse() {

@@ -35,7 +35,7 @@ use super::free_curve::DEFAULT_CAPACITY;
 use super::true_error::{TrueError, TrueErrorIndex};
 use crate::contour::{ContourEstimate, ContourEstimator};
 use crate::geometry::{self, Vector2};
-use crate::path::Path;
+use crate::path::planar::Path;
 
 /// How near the path (mm) the reference must be to be on it: 1 µm. A reference farther
 /// off comes from another path (another file or tolerance) and is reported.
@@ -273,14 +273,14 @@ impl<'de> Deserialize<'de> for ProgramEstimator {
 mod tests {
     use super::*;
     use crate::contour::planar::true_error;
-    use crate::path::program::parse_program;
-    use crate::path::{builtin, Curve, Interpolator};
+    use crate::path::planar::{builtin, Program};
+    use crate::path::{Curve, Interpolator};
 
     /// Two passes 0.6 mm apart, both to +x: 30 mm along y = 0, round a loop on the
     /// left, then 30 mm along y = 0.6 (a pocket's passes, 37 mm of path apart).
     fn passes() -> Path {
         let text = "G1 X30 F600\nY3\nX-2\nY0.6\nX30\n";
-        Path::Program(parse_program(text, "passes.ngc").unwrap())
+        Path::Program(Program::parse_gcode(text, "passes.ngc").unwrap())
     }
 
     #[test]
@@ -321,7 +321,7 @@ mod tests {
         // end the reference is at its start point again, and the track must go on, not
         // back. The actual sits 0.1 mm outside the circle all round, then on the line.
         let text = "G1 X10 F600\nG3 X10 Y0 I0 J5\nG1 X20\n";
-        let path = Path::Program(parse_program(text, "c.ngc").unwrap());
+        let path = Path::Program(Program::parse_gcode(text, "c.ngc").unwrap());
         let mut it = Interpolator::new(path.clone(), 10.0, 1e-3).unwrap();
         let mut e = ProgramEstimator::new(&path);
         let mut s_before = 0.0;
@@ -412,12 +412,12 @@ mod tests {
     fn a_blended_program_continues_bit_for_bit_after_a_restore() {
         // Every corner a blend: the tool's search starts from its guessed foot, which
         // must come back with the state.
-        let program = crate::path::program::parse_program(
+        let program = crate::path::planar::Program::parse_gcode(
             "G64 P0.01\nG1 X2 F600\nX4 Y0.2\nX6 Y0.6\nX8 Y1.2\nX10 Y2\nX11 Y3.5\n",
             "fan.ngc",
         )
         .unwrap();
-        let path = Path::Program(crate::path::program::blended(&program, 0.0));
+        let path = Path::Program(crate::path::planar::blended(&program, 0.0));
         let mut e = ProgramEstimator::new(&path);
         let mut it = Interpolator::new(path.clone(), 20.0, 1e-3).unwrap();
         let sample = |it: &Interpolator| {

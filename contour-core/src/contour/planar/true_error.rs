@@ -23,8 +23,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::contour::ContourEstimate;
 use crate::geometry::{self, Vector, Vector2};
-use crate::path::program::{CornerBlend, Shape};
-use crate::path::{CircularArc, Curve, CurvePoint, Line, Nurbs, Path, Program};
+use crate::path::planar::{CornerBlend, Path, Program, Shape};
+use crate::path::{CircularArc, Curve, CurvePoint, Line, Nurbs};
 
 /// Exact contour error of one point.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -1121,7 +1121,7 @@ fn chunk_box(c: &Path, u0: f64, u1: f64) -> BBox {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::path::builtin;
+    use crate::path::planar::builtin;
     use std::f64::consts::PI;
 
     #[test]
@@ -1180,7 +1180,7 @@ mod tests {
             .unwrap(),
         );
         let program = Path::Program(
-            crate::path::program::parse_program("G1 X10 F600\nX0 Y5\n", "tip.ngc").unwrap(),
+            crate::path::planar::Program::parse_gcode("G1 X10 F600\nX0 Y5\n", "tip.ngc").unwrap(),
         );
         let p = Vector2::new(11.0, -0.8);
         let want = math::hypot(1.0f64, 0.8);
@@ -1207,7 +1207,7 @@ mod tests {
     #[test]
     fn a_chunk_is_found_from_any_hint() {
         let program = Path::Program(
-            crate::path::program::parse_program(
+            crate::path::planar::Program::parse_gcode(
                 "G1 X1 F600\nX3\nX3.5\nX7\nX7.25\nX9\nX10\n",
                 "steps.ngc",
             )

@@ -1,24 +1,21 @@
-//! A part program on the XY table: the line and arc moves a G-code program describes, in
-//! mm, each with the speed it was programmed at and the corner mode at its end
-//! (docs/design/two-axis.md §4.7). Read from G-code by [`reader`].
+//! A part program on the XY table: the line and arc moves of a [`PartProgram`] in the XY
+//! plane, in mm, each with the speed it was programmed at and the corner mode at its end
+//! (docs/design/two-axis.md §4.7). The table has no third axis: Z is followed only where
+//! the table stands still while it moves.
 //!
 //! As a [`Curve`] a program is parameterised by arc length s ∈ [0, L]: move i covers
 //! [sᵢ, sᵢ₊₁], and its own parameter is (s − sᵢ)/ℓᵢ. A query finds its move by binary
 //! search over the starts (O(log n), no allocation).
 
-mod arc_words;
-mod blending;
-mod corner_blend;
-pub mod reader;
+use std::collections::BTreeSet;
 
 use serde::{Deserialize, Serialize};
 
-use super::{clamp_param, CircularArc, Curve, CurvePoint, Line, PathError};
+use super::CornerBlend;
 use crate::geometry::{self, Vector2};
-
-pub use blending::{blended, MIN_BLEND_TURN};
-pub use corner_blend::CornerBlend;
-pub use reader::{is_program_file, load_program, parse_program, PROGRAM_EXTENSIONS};
+use crate::part_program::gcode::{load_gcode, parse_gcode};
+use crate::part_program::{Corner, Motion, PartProgram, Place, Speed, Warning};
+use crate::path::{clamp_param, CircularArc, Curve, CurvePoint, Line, PathError};
 
 /// The geometry of one move.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -62,28 +59,6 @@ impl Shape {
             Shape::Blend(b) => Shape::Blend(b.mirrored()),
         }
     }
-}
-
-/// The speed a move was programmed at.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub enum Speed {
-    /// G0: the machine's rapid.
-    Rapid,
-    /// G1–G3 before the program's first F word: the interpolator's `feed` parameter.
-    Default,
-    /// G1–G3 after an F word, mm/s.
-    Feed(f64),
-}
-
-/// What the machine does at the end of a move, where the next one begins.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub enum Corner {
-    /// G61 (or G61.1), or the end of XY motion for a Z-only move: stop exactly.
-    ExactStop,
-    /// G64 P…: blend within this many mm of the programmed corner.
-    Blend(f64),
-    /// Bare G64: blend within the interpolator's `tolerance` parameter.
-    BlendDefault,
 }
 
 /// One move of a program.
@@ -148,6 +123,109 @@ impl Program {
             starts,
             warnings: Vec::new(),
         })
+    }
+
+    /// The XY program of the G-code file `file`.
+    pub fn load(file: impl AsRef<std::path::Path>) -> Result<Self, PathError> {
+        Program::from_part_program(&load_gcode(file)?)
+    }
+
+    /// The XY program of the G-code text `text`; `name` is used in messages.
+    pub fn parse_gcode(text: &str, name: &str) -> Result<Self, PathError> {
+        Program::from_part_program(&parse_gcode(text, name)?)
+    }
+
+    /// The XY part of `part`, with its reader's warnings and what the table leaves out:
+    /// rapids before the first cut only position the tool (the path starts at the cut); a
+    /// rapid's Z is left to the rapid; a Z-only move is an exact stop of the table. A
+    /// move of X or Y together with Z at a feed (a ramp or a helix) is refused at its Z
+    /// word: its feed is along the 3D path, which the table cannot follow.
+    pub fn from_part_program(part: &PartProgram) -> Result<Self, PathError> {
+        let mut skipped = BTreeSet::new();
+        let mut warnings = part.warning_lines();
+        let mut skip = |kind: &'static str, line: usize| {
+            if skipped.insert(kind) {
+                let message = format!(
+                    "{kind} skipped (not part of the XY contour); further ones are skipped \
+                     silently"
+                );
+                let place = Place { line, column: 0 };
+                let file = part.file.clone();
+                warnings.push(
+                    Warning {
+                        file,
+                        place,
+                        message,
+                    }
+                    .to_string(),
+                );
+            }
+        };
+        let mut position = Vector2::new(part.start[0], part.start[1]);
+        let mut z = part.start[2];
+        let mut moves: Vec<Move> = Vec::new();
+        let mut cutting = false;
+        for m in &part.moves {
+            let line = m.place.line;
+            let end = Vector2::new(m.end[0], m.end[1]);
+            let arc = matches!(m.motion, Motion::Arc(_));
+            if m.end[2] != z {
+                if m.speed != Speed::Rapid && (end != position || arc) {
+                    let at = m.z_place.unwrap_or(m.place);
+                    return Err(PathError::File {
+                        file: part.file.clone(),
+                        line: at.line,
+                        column: at.column.max(1),
+                        message: "a move of X or Y together with Z (a ramp or a helix): its \
+                                  feed is along the 3D path, which the XY table cannot \
+                                  follow; move Z in a block of its own"
+                            .into(),
+                    });
+                }
+                if end != position {
+                    // A rapid goes there at the machine's rapid whatever Z does.
+                    skip("Z in rapids (their XY part is followed)", line);
+                } else {
+                    // The table stands still while Z moves: an exact stop in XY.
+                    skip("Z-only moves (the table stops while Z moves)", line);
+                    if let Some(last) = moves.last_mut() {
+                        last.corner = Corner::ExactStop;
+                    }
+                }
+                z = m.end[2];
+            }
+            let shape = match &m.motion {
+                Motion::Line if end == position => continue,
+                // Finite ends that differ make a line (the readers' values are decimals).
+                Motion::Line => {
+                    Shape::Line(Line::new(position, end).map_err(|e| PathError::File {
+                        file: part.file.clone(),
+                        line,
+                        column: m.place.column.max(1),
+                        message: e.to_string(),
+                    })?)
+                }
+                Motion::Arc(a) => Shape::Arc(a.clone()),
+            };
+            if m.speed != Speed::Rapid {
+                cutting = true;
+            } else if !cutting {
+                // Rapids before the first cut only position the tool: the path starts
+                // at the cut.
+                position = end;
+                continue;
+            }
+            moves.push(Move {
+                shape,
+                speed: m.speed,
+                corner: m.corner,
+                line,
+            });
+            position = end;
+        }
+        let mut program = Program::new(moves).map_err(|e| e.in_file(&part.file))?;
+        program.warnings = warnings;
+        Ok(program)
     }
 
     /// The moves, in program order.

@@ -17,11 +17,12 @@
 //! [`NurbsPieces`], whose curvature bounds are sampled.
 
 use super::nurbs_pieces::NurbsPieces;
-use super::piece_profile::{plan_piece, reachable, Phase, PieceLimits};
 use crate::geometry::{self, Vector2};
 use crate::math;
-use crate::path::program::{blended, Corner, Move, Program, Shape, Speed, MIN_BLEND_TURN};
-use crate::path::{Curve, Path, PathError};
+use crate::part_program::{Corner, Speed};
+use crate::path::piece_profile::{plan_piece, reachable, Phase, PieceLimits};
+use crate::path::planar::{blended, Move, Path, Program, Shape, MIN_BLEND_TURN};
+use crate::path::{Curve, PathError};
 
 /// What the plan obeys.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

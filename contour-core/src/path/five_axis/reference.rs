@@ -5,13 +5,15 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::plan::{PlanInputs, PlannedReference};
-use super::{JointReference, PathError, ToolPath};
-use crate::kinematics::{Joints, TableTiltingAc};
-use crate::limits::{JointLimits, PathLimits};
+use super::planned_reference::{PlannedFiveAxisReference, SavedPlannedReference};
+use super::planner::{FiveAxisInputs, Planner};
+use super::JointReference;
+use crate::kinematics::Joints;
+use crate::path::PathError;
 
-/// A five-axis reference. The whole value is the state an FMU saves.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// A five-axis reference. The whole value is the state an FMU saves; it is restored as a
+/// [`SavedFiveAxisReference`], which plans again through a [`Planner`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FiveAxisReference {
     kind: Kind,
     /// The joints one sample before the current one (the current ones at the start):
@@ -19,13 +21,43 @@ pub struct FiveAxisReference {
     previous: Joints,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[allow(clippy::large_enum_variant)] // one per instance
 enum Kind {
     /// The tip at constant feed, the joints on the A ≥ 0 branch.
     ConstantFeed(JointReference),
     /// Planned within the limits.
-    Planned(PlannedReference),
+    Planned(PlannedFiveAxisReference),
+}
+
+/// A saved [`FiveAxisReference`] as read back (the same layout), before it is planned
+/// again by [`SavedFiveAxisReference::resume`].
+#[derive(Deserialize)]
+pub struct SavedFiveAxisReference {
+    kind: SavedKind,
+    previous: Joints,
+}
+
+#[derive(Deserialize)]
+#[allow(clippy::large_enum_variant)] // one per restore
+enum SavedKind {
+    ConstantFeed(JointReference),
+    Planned(SavedPlannedReference),
+}
+
+impl SavedFiveAxisReference {
+    /// The reference, its plan found or made again by `planner` and the saved place
+    /// checked against it.
+    pub fn resume(self, planner: &Planner) -> Result<FiveAxisReference, String> {
+        let kind = match self.kind {
+            SavedKind::ConstantFeed(r) => Kind::ConstantFeed(r),
+            SavedKind::Planned(r) => Kind::Planned(r.resume(planner)?),
+        };
+        Ok(FiveAxisReference {
+            kind,
+            previous: self.previous,
+        })
+    }
 }
 
 /// One sample of a [`FiveAxisReference`].
@@ -45,32 +77,28 @@ pub struct ReferenceSample {
 }
 
 impl FiveAxisReference {
-    /// The reference on `path` (`builtin` its name when it is one) for `machine`: planned
-    /// within `joints` and `limits` when `limits.accel` > 0, else at the constant feed
-    /// `limits.feed`. `name` names a programmed pose in a planner's refusal.
+    /// The reference of `inputs`: planned by `planner` within the joints' and the path's
+    /// limits when `limits.accel` > 0, else at the constant feed `limits.feed`. `name`
+    /// names a programmed pose in a planner's refusal.
     pub fn new(
-        path: ToolPath,
-        builtin: Option<String>,
-        machine: TableTiltingAc,
-        joints: JointLimits,
-        limits: PathLimits,
-        ts: f64,
+        inputs: FiveAxisInputs,
+        planner: &Planner,
         name: &dyn Fn(usize) -> String,
     ) -> Result<Self, PathError> {
-        super::joint_reference::check_length(&path)?;
-        if limits.accel > 0.0 {
-            let inputs = PlanInputs {
-                path,
-                builtin,
-                machine,
-                joints,
-                limits,
-                ts,
-            };
-            return Ok(Self::starting(Kind::Planned(PlannedReference::new(
-                inputs, name,
-            )?)));
+        super::joint_reference::check_length(&inputs.path)?;
+        if inputs.limits.accel > 0.0 {
+            return Ok(Self::starting(Kind::Planned(
+                PlannedFiveAxisReference::new(inputs, planner, name)?,
+            )));
         }
+        let FiveAxisInputs {
+            path,
+            builtin,
+            machine,
+            limits,
+            ts,
+            ..
+        } = inputs;
         Ok(Self::starting(Kind::ConstantFeed(match builtin {
             Some(name) => JointReference::builtin(&name, machine, limits.feed, ts)?,
             None => JointReference::new(path, machine, limits.feed, ts)?,
@@ -210,22 +238,53 @@ impl Kind {
 mod tests {
     use super::*;
     use crate::geometry::{self, Vector};
+    use crate::kinematics::TableTiltingAc;
+    use crate::limits::{JointLimits, PathLimits};
+    use crate::path::five_axis::ToolPath;
+
+    fn helix(limits: PathLimits) -> FiveAxisInputs {
+        FiveAxisInputs {
+            path: ToolPath::builtin("tilted_helix").unwrap(),
+            builtin: Some("tilted_helix".into()),
+            machine: TableTiltingAc::ORIGIN,
+            joints: JointLimits::DEFAULT,
+            limits,
+            ts: 1e-3,
+        }
+    }
 
     fn reference(accel: f64) -> FiveAxisReference {
         let limits = PathLimits {
             accel,
             ..PathLimits::at_feed(50.0)
         };
-        FiveAxisReference::new(
-            ToolPath::builtin("tilted_helix").unwrap(),
-            Some("tilted_helix".into()),
-            TableTiltingAc::ORIGIN,
-            JointLimits::DEFAULT,
-            limits,
-            1e-3,
-            &|i| format!("pose {i}"),
-        )
-        .unwrap()
+        FiveAxisReference::new(helix(limits), &Planner::new(), &|i| format!("pose {i}")).unwrap()
+    }
+
+    #[test]
+    fn a_saved_reference_resumes_on_the_kept_plan_and_continues_alike() {
+        let planner = Planner::new();
+        for accel in [0.0, 2000.0] {
+            let limits = PathLimits {
+                accel,
+                ..PathLimits::at_feed(50.0)
+            };
+            let mut r =
+                FiveAxisReference::new(helix(limits), &planner, &|i| format!("pose {i}")).unwrap();
+            for _ in 0..500 {
+                r.step().unwrap();
+            }
+            let bytes = postcard::to_stdvec(&r).unwrap();
+            let saved: SavedFiveAxisReference = postcard::from_bytes(&bytes).unwrap();
+            let mut restored = saved.resume(&planner).unwrap();
+            assert_eq!(restored, r);
+            if let (Kind::Planned(a), Kind::Planned(b)) = (&r.kind, &restored.kind) {
+                assert!(std::sync::Arc::ptr_eq(a.plan(), b.plan()), "planned again");
+            }
+            for _ in 0..300 {
+                assert_eq!(r.step().unwrap(), restored.step().unwrap());
+            }
+        }
     }
 
     /// The tip's speed in the workpiece frame when the joints move at `qdot`.

@@ -5,8 +5,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::xy_plan::{XyCursor, XyLimits, XyPlan, XyPoint};
-use crate::path::{Path, PathError};
+use super::plan::{XyCursor, XyLimits, XyPlan, XyPoint};
+use crate::path::planar::Path;
+use crate::path::PathError;
 
 /// A planned XY reference at its latest sample.
 #[derive(Clone, Debug, PartialEq)]

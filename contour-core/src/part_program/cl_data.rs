@@ -9,41 +9,32 @@
 //! `GOTO` (wrong count, not a number, non-finite, a zero axis) is refused with the file
 //! and line.
 
-use super::PathError;
+use super::{Corner, Motion, PartMove, PartProgram, Place, Speed, Warning};
 use crate::geometry::{self, Vector};
-use crate::kinematics::Pose;
+use crate::path::nurbs_file::read_path_file;
+use crate::path::PathError;
 
 /// How far an axis vector's length may be off 1 before it is worth a warning.
 const UNIT_TOLERANCE: f64 = 1e-6;
 
-/// The poses of a CL file, in order, and what was corrected on the way.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ClData {
-    /// One per GOTO record.
-    pub poses: Vec<Pose>,
-    /// The line each GOTO record starts on (1-based), one per pose.
-    pub lines: Vec<usize>,
-    /// One line per normalised axis (`file:line: …`).
-    pub warnings: Vec<String>,
-}
-
 /// Reads a CL file.
-pub fn load_cl(file: impl AsRef<std::path::Path>) -> Result<ClData, PathError> {
-    let (name, text) = super::file::read_path_file(file.as_ref())?;
+pub fn load_cl(file: impl AsRef<std::path::Path>) -> Result<PartProgram, PathError> {
+    let (name, text) = read_path_file(file.as_ref())?;
     parse_cl(&text, &name)
 }
 
 /// Parses the text of a CL file; `name` is used in messages.
-pub fn parse_cl(text: &str, name: &str) -> Result<ClData, PathError> {
+pub fn parse_cl(text: &str, name: &str) -> Result<PartProgram, PathError> {
     let fail = |line: usize, message: String| PathError::File {
         file: name.to_string(),
         line,
         column: 0,
         message,
     };
-    let mut data = ClData {
-        poses: Vec::new(),
-        lines: Vec::new(),
+    let mut data = PartProgram {
+        file: name.to_string(),
+        start: Vector::<3>::zeros(),
+        moves: Vec::new(),
         warnings: Vec::new(),
     };
     let mut axis = Vector::<3>::z();
@@ -99,9 +90,14 @@ pub fn parse_cl(text: &str, name: &str) -> Result<ClData, PathError> {
                 return Err(fail(first_line, "GOTO: the tool axis i,j,k is zero".into()));
             }
             if (length - 1.0).abs() > UNIT_TOLERANCE {
-                data.warnings.push(format!(
-                    "{name}:{first_line}: tool axis of length {length} normalised"
-                ));
+                data.warnings.push(Warning {
+                    file: name.to_string(),
+                    place: Place {
+                        line: first_line,
+                        column: 0,
+                    },
+                    message: format!("tool axis of length {length} normalised"),
+                });
             }
             // A length within a few ulps of 1 is unit already: dividing would only
             // round (and a written unit axis would not read back as written).
@@ -111,8 +107,22 @@ pub fn parse_cl(text: &str, name: &str) -> Result<ClData, PathError> {
                 given / length
             };
         }
-        data.poses.push(Pose { tip, axis });
-        data.lines.push(first_line);
+        // The first GOTO is where the tool path starts.
+        if data.moves.is_empty() {
+            data.start = tip;
+        }
+        data.moves.push(PartMove {
+            motion: Motion::Line,
+            speed: Speed::Default,
+            end: tip,
+            tool_axis: Some(axis),
+            corner: Corner::BlendDefault,
+            place: Place {
+                line: first_line,
+                column: 0,
+            },
+            z_place: None,
+        });
     }
     if !record.is_empty() {
         return Err(fail(
@@ -120,12 +130,12 @@ pub fn parse_cl(text: &str, name: &str) -> Result<ClData, PathError> {
             "the last record ends in a continuation '$'".into(),
         ));
     }
-    if data.poses.len() < 2 {
+    if data.moves.len() < 2 {
         return Err(fail(
             0,
             format!(
                 "a path needs at least two GOTO points, found {}",
-                data.poses.len()
+                data.moves.len()
             ),
         ));
     }
@@ -135,6 +145,7 @@ pub fn parse_cl(text: &str, name: &str) -> Result<ClData, PathError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kinematics::Pose;
     use crate::math;
 
     const EXAMPLE: &str = "PARTNO/BLADE 7\n\
@@ -152,7 +163,7 @@ mod tests {
     #[test]
     fn reads_goto_records_and_skips_the_rest() {
         let data = parse_cl(EXAMPLE, "blade.cl").unwrap();
-        let tips: Vec<[f64; 3]> = data.poses.iter().map(|p| p.tip.into()).collect();
+        let tips: Vec<[f64; 3]> = data.poses().iter().map(|p| p.tip.into()).collect();
         assert_eq!(
             tips,
             [
@@ -162,7 +173,7 @@ mod tests {
                 [13.0, 21.0, 6.0]
             ]
         );
-        let axes: Vec<[f64; 3]> = data.poses.iter().map(|p| p.axis.into()).collect();
+        let axes: Vec<[f64; 3]> = data.poses().iter().map(|p| p.axis.into()).collect();
         assert_eq!(
             axes,
             [
@@ -174,7 +185,7 @@ mod tests {
         );
         // (0, 0, 2) was normalised, with a warning naming file and line.
         assert_eq!(
-            data.warnings,
+            data.warning_lines(),
             ["blade.cl:7: tool axis of length 2 normalised"]
         );
     }
@@ -205,7 +216,7 @@ mod tests {
         }
         text += "FINI\n";
         let data = parse_cl(&text, "trip.cl").unwrap();
-        assert_eq!(data.poses, poses);
+        assert_eq!(data.poses(), poses);
         assert!(data.warnings.is_empty(), "{:?}", data.warnings);
     }
 

@@ -391,7 +391,7 @@ fn group(nurbs: &Nurbs, knots: &[f64], probes: &[Probe]) -> Vec<NurbsPiece> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::path::builtin;
+    use crate::path::planar::builtin;
 
     #[test]
     fn the_map_follows_the_arc_length_of_the_builtin_curves() {
@@ -432,8 +432,7 @@ mod tests {
 #[cfg(test)]
 mod pathological {
     use super::*;
-    use crate::path::plan::{XyCursor, XyLimits, XyPlan};
-    use crate::path::Path;
+    use crate::path::planar::{Path, XyCursor, XyLimits, XyPlan};
 
     #[test]
     fn a_cusp_is_a_stop_and_wild_control_points_are_refused_in_bounded_work() {

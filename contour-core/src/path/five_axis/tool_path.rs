@@ -8,12 +8,12 @@ use std::sync::{Arc, OnceLock};
 
 use serde::{Deserialize, Serialize};
 
-use super::nurbs::NurbsData;
-use super::polyline::Polyline;
-use super::{Curve, Nurbs, PathError};
-use crate::geometry::slerp;
-use crate::geometry::{self, Vector};
+use crate::geometry::{self, slerp, Vector};
 use crate::kinematics::Pose;
+use crate::part_program::cl_data::load_cl;
+use crate::part_program::{file_kind, FileKind};
+use crate::path::nurbs_file::read_path_file;
+use crate::path::{Curve, Nurbs, NurbsData, PathError, Polyline};
 
 /// Samples per turn of the sampled built-ins: chords of at most 3.2 µm, deviating from the
 /// curves they sample by < 0.3 nm; a nearest point on them lies within 0.1 µm of the one on
@@ -176,13 +176,10 @@ enum Source<'a> {
 }
 
 fn source(spec: &str) -> Source<'_> {
-    let lower = spec.to_ascii_lowercase();
-    if lower.ends_with(".cl") || lower.ends_with(".apt") {
-        Source::Cl(spec)
-    } else if lower.ends_with(".json") {
-        Source::Json(spec)
-    } else {
-        Source::Builtin(spec)
+    match file_kind(std::path::Path::new(spec)) {
+        Some(FileKind::ClData) => Source::Cl(spec),
+        Some(FileKind::Json) => Source::Json(spec),
+        _ => Source::Builtin(spec),
     }
 }
 
@@ -192,8 +189,8 @@ fn source(spec: &str) -> Source<'_> {
 pub fn load_poses(spec: &str, chord: f64) -> Result<(Vec<Pose>, Vec<String>), PathError> {
     match source(spec) {
         Source::Cl(file) => {
-            let data = super::cl_data::load_cl(file)?;
-            Ok((data.poses, data.warnings))
+            let program = load_cl(file)?;
+            Ok((program.poses(), program.warning_lines()))
         }
         Source::Json(file) => {
             let (path, _) = ToolPath::load(spec)?;
@@ -251,11 +248,14 @@ impl ToolPath {
     pub fn load(spec: &str) -> Result<(ToolPath, Vec<String>), PathError> {
         match source(spec) {
             Source::Cl(file) => {
-                let data = super::cl_data::load_cl(file)?;
-                Ok((ToolPath::from_poses(&data.poses)?, data.warnings))
+                let program = load_cl(file)?;
+                Ok((
+                    ToolPath::from_poses(&program.poses())?,
+                    program.warning_lines(),
+                ))
             }
             Source::Json(file) => {
-                let (name, text) = super::file::read_path_file(file.as_ref())?;
+                let (name, text) = read_path_file(file.as_ref())?;
                 Ok((ToolPath::parse_json(&text, &name)?, Vec::new()))
             }
             Source::Builtin(name) => Ok((ToolPath::builtin(name)?, Vec::new())),

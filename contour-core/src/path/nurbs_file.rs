@@ -110,7 +110,7 @@ mod tests {
 
     #[test]
     fn spec_resolves_builtins_then_files() {
-        use crate::path::Path;
+        use crate::path::planar::Path;
         assert!(matches!(Path::from_spec("circle", None), Ok(Path::Arc(_))));
         let dir = std::env::temp_dir().join(format!("contour_fmu_path_{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();

@@ -3,10 +3,10 @@
 //! depends only on the program and the `tolerance` parameter, so the interpolator and
 //! the controller's `program` estimator build the same path.
 
-use super::{Corner, CornerBlend, Move, Program, Shape};
-use crate::geometry;
-use crate::math;
+use super::{CornerBlend, Move, Program, Shape};
+use crate::part_program::Corner;
 use crate::path::{Curve, Line};
+use crate::{geometry, math};
 
 /// Turns below this (rad) are not rounded: a reference passes them at speed within its
 /// limits (v·θ within the acceleration and jerk of one sample), and rounding them would

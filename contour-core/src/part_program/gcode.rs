@@ -1,5 +1,5 @@
-//! Reading a G-code program for the XY table (docs/design/two-axis.md §4.7): the
-//! RS-274/NGC subset LinuxCNC reads for the XY plane. The `g-code` crate reads the syntax
+//! Reading a G-code program into a [`PartProgram`] (docs/design/two-axis.md §4.7): the
+//! RS-274/NGC subset LinuxCNC reads, arcs in the XY plane. The `g-code` crate reads the syntax
 //! (words with exact decimals, comments, line by line); the modal state, the units and the
 //! arc geometry are this file's. Every refusal names the file, line and column.
 
@@ -10,31 +10,19 @@ use g_code::parse::ast::Spanned;
 use g_code::parse::snippet_parser;
 
 use super::arc_words::{self, Circle};
-use super::{Corner, Move, Program, Shape, Speed};
-use crate::geometry::Vector2;
-use crate::path::file::read_path_file;
-use crate::path::{Line, PathError};
-
-/// The file name endings read as G-code (case-insensitive).
-pub const PROGRAM_EXTENSIONS: [&str; 4] = ["ngc", "nc", "gcode", "tap"];
-
-/// Whether `file` is named as a G-code program (by [`PROGRAM_EXTENSIONS`]).
-pub fn is_program_file(file: &std::path::Path) -> bool {
-    let extension = file.extension().and_then(|e| e.to_str()).unwrap_or("");
-    PROGRAM_EXTENSIONS
-        .iter()
-        .any(|x| x.eq_ignore_ascii_case(extension))
-}
+use super::{Corner, Motion, PartMove, PartProgram, Place, Speed, Warning};
+use crate::geometry::{Vector, Vector2};
+use crate::path::nurbs_file::read_path_file;
+use crate::path::PathError;
 
 /// Reads a G-code file (see the module docs).
-pub fn load_program(file: impl AsRef<std::path::Path>) -> Result<Program, PathError> {
+pub fn load_gcode(file: impl AsRef<std::path::Path>) -> Result<PartProgram, PathError> {
     let (name, text) = read_path_file(file.as_ref())?;
-    parse_program(&text, &name)
+    parse_gcode(&text, &name)
 }
 
-/// Reads the text of a G-code program; `name` is used in messages. The warnings (one per
-/// kind of word skipped) are in [`Program::warnings`].
-pub fn parse_program(text: &str, name: &str) -> Result<Program, PathError> {
+/// Reads the text of a G-code program; `name` is used in messages.
+pub fn parse_gcode(text: &str, name: &str) -> Result<PartProgram, PathError> {
     let mut reader = Reader::new(name);
     let mut percents = 0;
     for (index, line) in text.lines().enumerate() {
@@ -50,17 +38,17 @@ pub fn parse_program(text: &str, name: &str) -> Result<Program, PathError> {
             break;
         }
     }
-    let Reader {
-        moves, warnings, ..
-    } = reader;
-    let mut program = Program::new(moves).map_err(|e| e.in_file(name))?;
-    program.warnings = warnings;
-    Ok(program)
+    Ok(PartProgram {
+        file: name.to_string(),
+        start: Vector::<3>::zeros(),
+        moves: reader.moves,
+        warnings: reader.warnings,
+    })
 }
 
 /// The motion modes (modal group 1).
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Motion {
+enum Mode {
     Rapid,
     Linear,
     Clockwise,
@@ -81,16 +69,15 @@ struct Reader<'a> {
     scale: f64,
     absolute: bool,
     arc_absolute: bool,
-    motion: Option<Motion>,
+    motion: Option<Mode>,
     feed: Option<f64>,
     corner: Corner,
     position: Vector2,
-    z: Option<f64>,
-    moves: Vec<Move>,
-    /// Whether a G1–G3 move has been made (rapids before it only position the tool).
-    cutting: bool,
+    /// The tip's z, mm: 0 until programmed (the program's origin).
+    z: f64,
+    moves: Vec<PartMove>,
     skipped: BTreeSet<&'static str>,
-    warnings: Vec<String>,
+    warnings: Vec<Warning>,
 }
 
 impl<'a> Reader<'a> {
@@ -104,9 +91,8 @@ impl<'a> Reader<'a> {
             feed: None,
             corner: Corner::BlendDefault,
             position: Vector2::zeros(),
-            z: None,
+            z: 0.0,
             moves: Vec::new(),
-            cutting: false,
             skipped: BTreeSet::new(),
             warnings: Vec::new(),
         }
@@ -124,10 +110,13 @@ impl<'a> Reader<'a> {
     /// Notes a skipped kind of word, with one warning per kind.
     fn skip(&mut self, kind: &'static str, line: usize) {
         if self.skipped.insert(kind) {
-            self.warnings.push(format!(
-                "{}:{line}: {kind} skipped (not part of the XY contour); further ones are skipped silently",
-                self.name
-            ));
+            self.warnings.push(Warning {
+                file: self.name.to_string(),
+                place: Place { line, column: 0 },
+                message: format!(
+                    "{kind} skipped (not part of the XY contour); further ones are skipped silently"
+                ),
+            });
         }
     }
 
@@ -171,7 +160,7 @@ impl<'a> Reader<'a> {
     /// Reads one block; `false` at the program's end (M2, M30).
     fn block(&mut self, text: &str, line: usize) -> Result<bool, PathError> {
         let words = self.words(text, line)?;
-        let mut motion: Option<(Motion, usize)> = None;
+        let mut motion: Option<(Mode, usize)> = None;
         let mut end = false;
         let (mut axes, mut z, mut centre, mut radius) = ([None; 2], None, [None; 2], None);
         let (mut p, mut feed) = (None, None);
@@ -197,10 +186,10 @@ impl<'a> Reader<'a> {
                             return Err(self.error(line, column, "two motion codes in one block"));
                         }
                         let m = [
-                            Motion::Rapid,
-                            Motion::Linear,
-                            Motion::Clockwise,
-                            Motion::CounterClockwise,
+                            Mode::Rapid,
+                            Mode::Linear,
+                            Mode::Clockwise,
+                            Mode::CounterClockwise,
                         ][c as usize / 10];
                         motion = Some((m, column));
                     }
@@ -327,54 +316,27 @@ impl<'a> Reader<'a> {
                 end_point[k] = if self.absolute { v } else { end_point[k] + v };
             }
         }
-        if let Some((v, column)) = z {
+        let mut end_z = self.z;
+        let z_place = z.map(|(v, column)| {
             let v = v * self.scale;
-            let new_z = match (self.absolute, self.z) {
-                (true, _) => v,
-                (false, Some(z0)) => z0 + v,
-                (false, None) => v,
-            };
-            let moves_z = self.z.is_some_and(|z0| z0 != new_z) || self.z.is_none() && v != 0.0;
-            self.z = Some(new_z);
-            let arc = matches!(mode, Motion::Clockwise | Motion::CounterClockwise);
-            if moves_z && mode != Motion::Rapid && (end_point != self.position || arc) {
-                return Err(self.error(
-                    line,
-                    column,
-                    "a move of X or Y together with Z (a ramp or a helix): its feed is along \
-                     the 3D path, which the XY table cannot follow; move Z in a block of its own",
-                ));
-            }
-            if moves_z && end_point != self.position {
-                // A rapid goes there at the machine's rapid whatever Z does.
-                self.skip("Z in rapids (their XY part is followed)", line);
-            } else if moves_z {
-                // The table stands still while Z moves: an exact stop in XY.
-                self.skip("Z-only moves (the table stops while Z moves)", line);
-                if let Some(last) = self.moves.last_mut() {
-                    last.corner = Corner::ExactStop;
-                }
-            }
-        }
+            end_z = if self.absolute { v } else { self.z + v };
+            Place { line, column }
+        });
         let speed = match mode {
-            Motion::Rapid => Speed::Rapid,
+            Mode::Rapid => Speed::Rapid,
             _ => self.feed.map_or(Speed::Default, Speed::Feed),
         };
         let shape = match mode {
-            Motion::Rapid | Motion::Linear => {
+            Mode::Rapid | Mode::Linear => {
                 if let Some((_, column)) = arc_words.or(p.filter(|_| !p_used)) {
                     return Err(self.error(line, column, "I, J, R and P belong to arcs"));
                 }
-                if end_point == self.position {
+                if end_point == self.position && end_z == self.z {
                     return Ok(!end);
                 }
-                // Finite ends that differ make a line (the reader's values are decimals).
-                Shape::Line(
-                    Line::new(self.position, end_point)
-                        .map_err(|e| self.error(line, 1, e.to_string()))?,
-                )
+                Motion::Line
             }
-            Motion::Clockwise | Motion::CounterClockwise => {
+            Mode::Clockwise | Mode::CounterClockwise => {
                 let motion_column = motion.map_or(1, |(_, c)| c);
                 if let Some((turns, column)) = p.filter(|_| !p_used) {
                     if turns != 1.0 {
@@ -414,28 +376,23 @@ impl<'a> Reader<'a> {
                         Circle::Centre(Vector2::new(offset(i, 0)?, offset(j, 1)?))
                     }
                 };
-                let clockwise = mode == Motion::Clockwise;
+                let clockwise = mode == Mode::Clockwise;
                 let arc = arc_words::arc(self.position, end_point, circle, clockwise)
                     .map_err(|m| self.error(line, motion_column, m))?;
-                Shape::Arc(arc)
+                Motion::Arc(arc)
             }
         };
-        if mode != Motion::Rapid && !self.cutting {
-            // Rapids before the first cut only position the tool: the path starts here.
-            self.cutting = true;
-            self.moves.clear();
-        }
-        if mode == Motion::Rapid && !self.cutting {
-            self.position = end_point;
-            return Ok(!end);
-        }
-        self.moves.push(Move {
-            shape,
+        self.moves.push(PartMove {
+            motion: shape,
             speed,
+            end: Vector::<3>::new(end_point[0], end_point[1], end_z),
+            tool_axis: None,
             corner: self.corner,
-            line,
+            place: Place { line, column: 1 },
+            z_place,
         });
         self.position = end_point;
+        self.z = end_z;
         Ok(!end)
     }
 }
@@ -443,15 +400,16 @@ impl<'a> Reader<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::path::planar::{Program, Shape};
     use crate::path::Curve;
     use std::f64::consts::PI;
 
     fn read(text: &str) -> Program {
-        parse_program(text, "t.ngc").unwrap_or_else(|e| panic!("{e}"))
+        Program::parse_gcode(text, "t.ngc").unwrap_or_else(|e| panic!("{e}"))
     }
 
     fn refused(text: &str) -> String {
-        parse_program(text, "t.ngc").unwrap_err().to_string()
+        Program::parse_gcode(text, "t.ngc").unwrap_err().to_string()
     }
 
     #[test]

@@ -5,11 +5,9 @@
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use super::interpolator::{Interpolator, Progress};
-use super::polyline::Polyline;
 use super::tool_path::ToolPath;
-use super::{Curve, Nurbs, PathError};
 use crate::kinematics::{Joints, Pose, TableTiltingAc};
+use crate::path::{Curve, Interpolator, Nurbs, PathError, Polyline, Progress};
 
 /// The tip curve the interpolator runs on.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -351,7 +349,9 @@ mod tests {
             "length": 100
         }"#;
         let cl = "GOTO/0,0,0,0,0,1\nGOTO/5,0,0,0,0.1,1\nGOTO/5,5,1,0.1,0.1,1\nGOTO/0,5,1,0,0,1\n";
-        let poses = crate::path::cl_data::parse_cl(cl, "part.cl").unwrap().poses;
+        let poses = crate::part_program::cl_data::parse_cl(cl, "part.cl")
+            .unwrap()
+            .poses();
         let cases = [
             (
                 "helix",

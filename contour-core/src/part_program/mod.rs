@@ -1,0 +1,193 @@
+//! Part programs as CAM systems write them, read in one place: G-code ([`gcode`]) and APT
+//! cutter-location data ([`cl_data`]) become one model, a [`PartProgram`]: the tool's moves
+//! in the workpiece frame with their feeds, corner modes and, where the format gives it,
+//! the tool axis; each with the line it was read from, and the reader's warnings with
+//! file, line and column. The XY table turns a part program into its
+//! [`Program`](crate::path::planar::Program), the five-axis machine into its
+//! [`ToolPath`](crate::path::five_axis::ToolPath); [`file_kind`] decides what a file is.
+//! Units: mm, rad, s.
+
+mod arc_words;
+pub mod cl_data;
+pub mod gcode;
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::Vector;
+use crate::kinematics::Pose;
+use crate::path::CircularArc;
+
+/// The speed a move was programmed at.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Speed {
+    /// G0 (a CL `RAPID`): the machine's rapid.
+    Rapid,
+    /// Before the program's first feed word: the interpolator's `feed` parameter.
+    Default,
+    /// After a feed word (G-code F, CL `FEDRAT`), mm/s.
+    Feed(f64),
+}
+
+/// What the machine does at the end of a move, where the next one begins.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Corner {
+    /// G61 (or G61.1), or the end of XY motion for a Z-only move: stop exactly.
+    ExactStop,
+    /// G64 P…: blend within this many mm of the programmed corner.
+    Blend(f64),
+    /// Bare G64: blend within the interpolator's `tolerance` parameter.
+    BlendDefault,
+}
+
+/// The path of one move from the previous move's end to its own.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Motion {
+    /// A straight move of the tip (G0, G1, a CL `GOTO`).
+    Line,
+    /// A circular arc in the XY plane (G2, G3 under G17), its z unchanged.
+    Arc(CircularArc),
+}
+
+/// Where in its file something was read: 1-based line and column, 0 when not known.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Place {
+    /// 1-based line, 0 when not known.
+    pub line: usize,
+    /// 1-based column, 0 when not known.
+    pub column: usize,
+}
+
+/// One move of a part program.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartMove {
+    /// How the tip gets to `end`.
+    pub motion: Motion,
+    /// Whether it is a rapid, or at which feed.
+    pub speed: Speed,
+    /// The tool tip at the move's end, mm, in the workpiece frame.
+    pub end: Vector<3>,
+    /// The tool axis at the move's end (a unit vector from the tip toward the spindle),
+    /// where the format gives one (CL data); `None` for G-code, whose tool stays vertical.
+    pub tool_axis: Option<Vector<3>>,
+    /// The corner mode in force at the move's end.
+    pub corner: Corner,
+    /// The block or record the move was read from.
+    pub place: Place,
+    /// Where the Z word of the block was, when it had one (a third-axis move is refused
+    /// there by a machine that has no third axis).
+    pub z_place: Option<Place>,
+}
+
+/// Something a reader read past or corrected, with where.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Warning {
+    /// The file as given by the caller.
+    pub file: String,
+    /// Where in it.
+    pub place: Place,
+    /// What was done.
+    pub message: String,
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        crate::path::write_placed(
+            f,
+            &self.file,
+            self.place.line,
+            self.place.column,
+            &self.message,
+        )
+    }
+}
+
+/// A part program: the tool's moves in order from `start`, as the file programmed them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartProgram {
+    /// The file as given by the caller, for messages.
+    pub file: String,
+    /// The tip before the first move, mm (the program's origin: a G-code program starts
+    /// where its first move starts from; CL data starts at its first `GOTO`, a move from
+    /// here too).
+    pub start: Vector<3>,
+    /// The moves in order.
+    pub moves: Vec<PartMove>,
+    /// What the reader read past or corrected, in the order it met them.
+    pub warnings: Vec<Warning>,
+}
+
+impl PartProgram {
+    /// The tool's pose at the end of every move: the tip, and the tool axis where the
+    /// program gave one (+Z until it does, the vertical tool of a G-code program).
+    pub fn poses(&self) -> Vec<Pose> {
+        let mut axis = Vector::<3>::z();
+        self.moves
+            .iter()
+            .map(|m| {
+                axis = m.tool_axis.unwrap_or(axis);
+                Pose { tip: m.end, axis }
+            })
+            .collect()
+    }
+
+    /// The line every move was read from, in order.
+    pub fn lines(&self) -> Vec<usize> {
+        self.moves.iter().map(|m| m.place.line).collect()
+    }
+
+    /// The warnings as text, `file:line[:column]: message` each.
+    pub fn warning_lines(&self) -> Vec<String> {
+        self.warnings.iter().map(ToString::to_string).collect()
+    }
+}
+
+/// What a part or path file holds, by its name's ending (case-insensitive).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileKind {
+    /// G-code (`.ngc`, `.nc`, `.gcode`, `.tap`).
+    GCode,
+    /// APT cutter-location data (`.cl`, `.apt`).
+    ClData,
+    /// A JSON path: a planar NURBS curve or a five-axis curve pair.
+    Json,
+}
+
+/// The endings read as G-code.
+pub const GCODE_EXTENSIONS: [&str; 4] = ["ngc", "nc", "gcode", "tap"];
+/// The endings read as CL data.
+pub const CL_EXTENSIONS: [&str; 2] = ["cl", "apt"];
+
+/// What the file named `file` holds by its ending, `None` for another ending or none.
+/// The one place that decides it: the FMUs, the simulator and the tools all ask here.
+pub fn file_kind(file: &std::path::Path) -> Option<FileKind> {
+    let extension = file.extension().and_then(|e| e.to_str())?;
+    let is = |list: &[&str]| list.iter().any(|x| x.eq_ignore_ascii_case(extension));
+    if is(&GCODE_EXTENSIONS) {
+        Some(FileKind::GCode)
+    } else if is(&CL_EXTENSIONS) {
+        Some(FileKind::ClData)
+    } else if extension.eq_ignore_ascii_case("json") {
+        Some(FileKind::Json)
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn file_kinds_by_ending_in_any_case() {
+        let kind = |name: &str| file_kind(std::path::Path::new(name));
+        assert_eq!(kind("dir.v2/part.NGC"), Some(FileKind::GCode));
+        assert_eq!(kind("p.tap"), Some(FileKind::GCode));
+        assert_eq!(kind("blade.cl"), Some(FileKind::ClData));
+        assert_eq!(kind("C:\\cam\\blade.APT"), Some(FileKind::ClData));
+        assert_eq!(kind("curve.Json"), Some(FileKind::Json));
+        assert_eq!(kind("trident"), None);
+        assert_eq!(kind("notes.txt"), None);
+    }
+}

@@ -1,0 +1,152 @@
+//! Planning five-axis references, and the plans alive: instances on the same path and
+//! limits share one plan, and a restored state finds it instead of planning again. The
+//! [`Planner`] belongs to whoever owns the instances' lifetimes (the FMU library keeps one
+//! per process, an in-process loop its own), so the core holds no state of its own.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, Weak};
+
+use super::plan::{FiveAxisPlan, SAMPLE_BUDGET};
+use super::ToolPath;
+use crate::kinematics::TableTiltingAc;
+use crate::limits::{JointLimits, PathLimits};
+use crate::path::PathError;
+
+/// What a plan is made from: the programmed path (a built-in by name), the machine, its
+/// limits and the sample period. Saved with the place on the plan; restoring plans again
+/// (or finds the plan kept by the [`Planner`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FiveAxisInputs {
+    /// The programmed path (saved by name when it is the built-in `builtin`, see
+    /// `SavedInputs`).
+    pub path: ToolPath,
+    /// The built-in's name when the path is one.
+    pub builtin: Option<String>,
+    /// The machine's geometry.
+    pub machine: TableTiltingAc,
+    /// The joints' limits.
+    pub joints: JointLimits,
+    /// The path's limits and tolerances.
+    pub limits: PathLimits,
+    /// The sample period, s.
+    pub ts: f64,
+}
+
+/// Plans five-axis references within a sample budget, and keeps the plans alive by a
+/// fingerprint of their inputs: instances on the same path and limits share one, and a
+/// restored state finds it instead of planning again.
+#[derive(Debug)]
+pub struct Planner {
+    /// The most samples a plan may have (at least 1).
+    sample_budget: AtomicU64,
+    plans: Mutex<Vec<(u64, Weak<FiveAxisPlan>)>>,
+    /// The plans used last, kept alive after their instances let go of them: restoring a
+    /// state checks it (a plan made and dropped) and then takes it (the same plan again),
+    /// and an importer that rolls back between states of two plans would plan each time.
+    recent: Mutex<[Option<Arc<FiveAxisPlan>>; RECENT_PLANS]>,
+}
+
+const RECENT_PLANS: usize = 2;
+/// Larger plans are not kept beyond their instances (about 120 bytes a node).
+const RECENT_NODES: usize = 200_000;
+
+impl Default for Planner {
+    fn default() -> Self {
+        Planner::new()
+    }
+}
+
+impl Planner {
+    /// A planner with no plans and the default budget, [`SAMPLE_BUDGET`].
+    pub const fn new() -> Self {
+        Planner {
+            sample_budget: AtomicU64::new(SAMPLE_BUDGET),
+            plans: Mutex::new(Vec::new()),
+            recent: Mutex::new([None, None]),
+        }
+    }
+
+    /// Sets the most samples a plan may have (at least 1): a host that must answer within a
+    /// time (a fuzzer's timeout) lowers it, and a longer plan is refused like any other.
+    pub fn set_sample_budget(&self, samples: u64) {
+        self.sample_budget.store(samples.max(1), Ordering::Relaxed);
+    }
+
+    /// The most samples a plan may have.
+    pub fn sample_budget(&self) -> u64 {
+        self.sample_budget.load(Ordering::Relaxed)
+    }
+
+    /// The plan for `inputs`, kept or made now; `name` names a programmed pose in
+    /// messages.
+    pub fn plan(
+        &self,
+        inputs: &FiveAxisInputs,
+        name: &dyn Fn(usize) -> String,
+    ) -> Result<Arc<FiveAxisPlan>, PathError> {
+        let key = fingerprint(inputs);
+        {
+            let mut plans = self.plans.lock().unwrap_or_else(|e| e.into_inner());
+            plans.retain(|(_, plan)| plan.strong_count() > 0);
+            if let Some(plan) = plans
+                .iter()
+                .find(|(k, _)| *k == key)
+                .and_then(|(_, p)| p.upgrade())
+            {
+                drop(plans);
+                self.remember(&plan);
+                return Ok(plan);
+            }
+        }
+        let poses = inputs.path.poses(PLAN_CHORD)?;
+        let plan = Arc::new(FiveAxisPlan::within_budget(
+            &poses,
+            inputs.machine,
+            &inputs.joints,
+            &inputs.limits,
+            inputs.ts,
+            name,
+            self.sample_budget(),
+        )?);
+        self.plans
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push((key, Arc::downgrade(&plan)));
+        self.remember(&plan);
+        Ok(plan)
+    }
+
+    /// Puts `plan` first among the recent plans.
+    fn remember(&self, plan: &Arc<FiveAxisPlan>) {
+        if plan.nodes() > RECENT_NODES {
+            return;
+        }
+        let mut recent = self.recent.lock().unwrap_or_else(|e| e.into_inner());
+        let at = recent
+            .iter()
+            .position(|p| p.as_ref().is_some_and(|p| Arc::ptr_eq(p, plan)))
+            .unwrap_or(RECENT_PLANS - 1);
+        recent[..=at].rotate_right(1);
+        recent[0] = Some(Arc::clone(plan));
+    }
+}
+
+fn fingerprint(inputs: &FiveAxisInputs) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::hash::DefaultHasher::new();
+    match &inputs.builtin {
+        Some(name) => name.hash(&mut hasher),
+        None => postcard::to_stdvec(&inputs.path)
+            .unwrap_or_default()
+            .hash(&mut hasher),
+    }
+    let rest = (&inputs.machine, &inputs.joints, &inputs.limits, inputs.ts);
+    postcard::to_stdvec(&rest)
+        .unwrap_or_default()
+        .hash(&mut hasher);
+    hasher.finish()
+}
+
+/// The chord a curve pair is sampled at for planning, mm: the planned tip leaves the
+/// curve by at most chord²·κ/8 (2.5 nm at a 5 mm radius).
+const PLAN_CHORD: f64 = 0.01;

@@ -1,0 +1,21 @@
+//! The five-axis plans of this library's instances: one [`Planner`] for the process, which
+//! owns the instances, so instances on one path and limits share a plan and a restored
+//! state finds its plan instead of planning again (contour-core keeps no state of its own).
+
+use std::sync::{Arc, OnceLock};
+
+use contour_core::path::five_axis::Planner;
+
+/// The planner every instance of this library is given.
+pub fn planner() -> Arc<Planner> {
+    static PLANNER: OnceLock<Arc<Planner>> = OnceLock::new();
+    Arc::clone(PLANNER.get_or_init(|| Arc::new(Planner::new())))
+}
+
+/// Sets the most samples a plan may have (a fuzzer's time limit; see
+/// [`Planner::set_sample_budget`]). Only in test builds: a packaged FMU plans within the
+/// default budget.
+#[cfg(feature = "test-hooks")]
+pub fn set_plan_sample_budget(samples: u64) {
+    planner().set_sample_budget(samples);
+}
