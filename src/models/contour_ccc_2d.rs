@@ -16,10 +16,7 @@ use crate::framework::state_check;
 use crate::framework::state_codec::{SavedState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, AxisUnit, XY};
 use crate::framework::variables::{EnumItem, EnumType, Start, Values, Variable};
-use contour_core::contour::planar::{
-    ArcEstimator, Estimator, EstimatorKind, FreeCurveEstimator, LineEstimator, ProgramEstimator,
-    ON_PATH,
-};
+use contour_core::contour::planar::{Estimator, EstimatorKind, FreeCurveEstimator, ON_PATH};
 use contour_core::control::{
     CccConfig, ConfigError, ControllerConfig, CrossCoupledController, FuzzyFactor, FuzzyFactors,
     Parameter, PidGains,
@@ -304,29 +301,30 @@ fn estimator_kind(values: &Values) -> Result<EstimatorKind, String> {
         })
 }
 
-/// The estimator the parameters choose, with the path reader's warnings.
+/// The estimator the parameters choose ([`Estimator::for_path`]), with the path reader's
+/// warnings. The exact line and arc estimators measure against the paths named `line` and
+/// `arc` (the `line.*` and `arc.*` parameters, whatever `path` says), the program
+/// estimator against `path`, both as followed (blended); the free-curve one needs none.
 fn estimator(
     values: &Values,
     environment: &Environment,
 ) -> Result<(Estimator, Vec<String>), String> {
     let kind = estimator_kind(values)?;
-    let mut warnings = Vec::new();
-    let estimator = match kind {
-        EstimatorKind::FreeCurve => Estimator::FreeCurve(FreeCurveEstimator::default()),
-        EstimatorKind::Line => Estimator::Line(LineEstimator::new(&line_arc_parameters::line(
-            values, GEOMETRY,
-        )?)),
-        EstimatorKind::Arc => Estimator::Arc(ArcEstimator::new(&line_arc_parameters::arc(
-            values, GEOMETRY,
-        )?)),
-        EstimatorKind::Program => {
-            let mut path = path_parameter::path(PATH.get(values), values, GEOMETRY, environment)?;
-            warnings = path_parameter::reader_warnings(&mut path);
-            let path = path_parameter::with_blends(path, TOLERANCE.get(values));
-            Estimator::Program(ProgramEstimator::new(&path))
+    let spec = match kind {
+        EstimatorKind::FreeCurve => {
+            return Ok((
+                Estimator::FreeCurve(FreeCurveEstimator::default()),
+                Vec::new(),
+            ))
         }
+        EstimatorKind::Line => "line",
+        EstimatorKind::Arc => "arc",
+        EstimatorKind::Program => PATH.get(values),
     };
-    Ok((estimator, warnings))
+    let mut path = path_parameter::path(spec, values, GEOMETRY, environment)?;
+    let warnings = path_parameter::reader_warnings(&mut path);
+    let path = path.blended(TOLERANCE.get(values));
+    Ok((Estimator::for_path(kind, &path), warnings))
 }
 
 impl Model for ContourCCC2D {

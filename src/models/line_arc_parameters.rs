@@ -1,12 +1,12 @@
 //! The line and arc geometry parameters shared by `PathInterpolator2D` (the path to
 //! follow) and `ContourCCC2D` (the exact line/arc estimators): the same names and
 //! defaults in both FMUs, so one set of values describes one path. The defaults are the
-//! built-in `line` and `arc` paths (contour_core::path::planar::builtin).
-
-use std::f64::consts::PI;
+//! core's built-in `line` and `arc` (`builtin::LINE_ENDS`, `builtin::ARC`): `line` and
+//! `arc` name the same paths in the core and in the FMUs until these parameters change.
 
 use crate::framework::variable_table::Reals;
 use crate::framework::variables::{Start, Values, Variable};
+use contour_core::path::planar::builtin;
 use contour_core::path::{CircularArc, Line};
 
 /// Number of variables in the block.
@@ -32,22 +32,22 @@ const fn length(name: &'static str, start: f64, description: &'static str) -> Va
 
 /// The block's variables, in offset order.
 pub const VARIABLES: [Variable; COUNT] = [
-    length("line.x0", 0.0, "Line start, x"),
-    length("line.y0", 0.0, "Line start, y"),
-    length("line.x1", 40.0, "Line end, x"),
-    length("line.y1", 30.0, "Line end, y"),
-    length("arc.cx", -20.0, "Arc centre, x"),
-    length("arc.cy", 0.0, "Arc centre, y"),
-    length("arc.r", 20.0, "Arc radius"),
+    length("line.x0", builtin::LINE_ENDS[0][0], "Line start, x"),
+    length("line.y0", builtin::LINE_ENDS[0][1], "Line start, y"),
+    length("line.x1", builtin::LINE_ENDS[1][0], "Line end, x"),
+    length("line.y1", builtin::LINE_ENDS[1][1], "Line end, y"),
+    length("arc.cx", builtin::ARC.0[0], "Arc centre, x"),
+    length("arc.cy", builtin::ARC.0[1], "Arc centre, y"),
+    length("arc.r", builtin::ARC.1, "Arc radius"),
     Variable::parameter(
         "arc.start",
-        Start::Real(0.0),
+        Start::Real(builtin::ARC.2),
         "Angle of the arc's start point as seen from its centre",
     )
     .unit("rad"),
     Variable::parameter(
         "arc.sweep",
-        Start::Real(-PI),
+        Start::Real(builtin::ARC.3),
         "Swept angle: > 0 counter-clockwise, < 0 clockwise, ±2π a full circle",
     )
     .unit("rad"),

@@ -328,7 +328,7 @@ impl Model for PathInterpolator2D {
                         .to_string(),
                 );
             }
-            let path = path_parameter::with_blends(path, tolerance);
+            let path = path.blended(tolerance);
             Reference::ConstantFeed(Interpolator::new(path, feed, ts).map_err(|e| e.to_string())?)
         };
         self.state = Some(State {

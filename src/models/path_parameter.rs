@@ -5,7 +5,7 @@
 use super::line_arc_parameters;
 use crate::framework::model::Environment;
 use crate::framework::variables::{Start, Values, Variable};
-use contour_core::path::planar::{blended, Path};
+use contour_core::path::planar::Path;
 
 /// The parameter's start value: the paper's circle.
 pub const DEFAULT: &str = "circle";
@@ -25,15 +25,6 @@ pub const TOLERANCE: Variable = Variable::parameter(
 )
 .unit("mm")
 .min(0.0);
-
-/// The path as planned: a program's blended corners rounded within `tolerance` (the
-/// same geometry in the interpolator and the controller); other paths unchanged.
-pub fn with_blends(path: Path, tolerance: f64) -> Path {
-    match path {
-        Path::Program(program) => Path::Program(blended(&program, tolerance)),
-        other => other,
-    }
-}
 
 /// The path `spec` names, with `line` and `arc` from the model's `line.*`/`arc.*`
 /// block; file errors name the file and line.

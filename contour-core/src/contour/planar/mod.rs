@@ -11,10 +11,12 @@ mod line;
 mod local_circle;
 mod program;
 mod true_error;
+mod true_error_index;
 
 pub use arc::ArcEstimator;
 pub use choice::{Estimator, EstimatorKind};
 pub use free_curve::FreeCurveEstimator;
 pub use line::LineEstimator;
 pub use program::{ProgramEstimator, ON_PATH};
-pub use true_error::{true_error, TrueError, TrueErrorIndex};
+pub use true_error::{true_error, TrueError};
+pub use true_error_index::TrueErrorIndex;

@@ -32,7 +32,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::free_curve::DEFAULT_CAPACITY;
-use super::true_error::{TrueError, TrueErrorIndex};
+use super::{TrueError, TrueErrorIndex};
 use crate::contour::{ContourEstimate, ContourEstimator};
 use crate::geometry::{self, Vector2};
 use crate::path::planar::Path;

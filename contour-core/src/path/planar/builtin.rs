@@ -33,14 +33,23 @@ pub fn circle() -> CircularArc {
     CircularArc::new([-10.0, 0.0], 10.0, 0.0, 2.0 * PI).expect("constant arc is valid")
 }
 
+/// The ends of [`line()`], mm: the two-axis FMUs' `line.*` defaults too, so that `line`
+/// names one path everywhere unless those parameters say otherwise.
+pub const LINE_ENDS: [[f64; 2]; 2] = [[0.0, 0.0], [40.0, 30.0]];
+
+/// [`arc()`] as its centre (mm), radius (mm), start angle and sweep (rad): the two-axis
+/// FMUs' `arc.*` defaults too.
+pub const ARC: ([f64; 2], f64, f64, f64) = ([-20.0, 0.0], 20.0, 0.0, -PI);
+
 /// A 50 mm straight line (0, 0) → (40, 30).
 pub fn line() -> Line {
-    Line::new([0.0, 0.0], [40.0, 30.0]).expect("constant line is valid")
+    Line::new(LINE_ENDS[0], LINE_ENDS[1]).expect("constant line is valid")
 }
 
 /// A clockwise half circle (0, 0) → (−40, 0) about (−20, 0).
 pub fn arc() -> CircularArc {
-    CircularArc::new([-20.0, 0.0], 20.0, 0.0, -PI).expect("constant arc is valid")
+    let (centre, radius, start, sweep) = ARC;
+    CircularArc::new(centre, radius, start, sweep).expect("constant arc is valid")
 }
 
 /// The "∞" path: cubic, 13 control points, knots 0,0,0,0,0.1,…,0.9,1,1,1,1.

@@ -63,6 +63,17 @@ impl Path {
         }
     }
 
+    /// The path as followed: a program's blended corners (G64) rounded within
+    /// `tolerance` where the program gave no tolerance of its own ([`blended`]); other
+    /// paths as they are. The one rule for the interpolator, the controller's estimator and
+    /// the planner alike.
+    pub fn blended(&self, tolerance: f64) -> Path {
+        match self {
+            Path::Program(program) => Path::Program(blended(program, tolerance)),
+            other => other.clone(),
+        }
+    }
+
     /// First point of the path.
     pub fn start_point(&self) -> Vector2 {
         self.point(self.param_range().0)
