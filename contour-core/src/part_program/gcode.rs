@@ -108,11 +108,11 @@ impl<'a> Reader<'a> {
     }
 
     /// Notes a skipped kind of word, with one warning per kind.
-    fn skip(&mut self, kind: &'static str, line: usize) {
+    fn skip(&mut self, kind: &'static str, place: Place) {
         if self.skipped.insert(kind) {
             self.warnings.push(Warning {
                 file: self.name.to_string(),
-                place: Place { line, column: 0 },
+                place,
                 message: format!(
                     "{kind} skipped (not part of the XY contour); further ones are skipped silently"
                 ),
@@ -208,13 +208,16 @@ impl<'a> Reader<'a> {
                     901 => self.arc_absolute = true,
                     911 => self.arc_absolute = false,
                     c @ (610 | 611 | 640) => corner_word = Some((c, column)),
-                    400 => self.skip("G40 (cutter compensation off)", line),
-                    490 => self.skip("G49 (tool length offset off)", line),
-                    800 => self.skip("G80 (canned cycle off)", line),
-                    940 => self.skip("G94 (feed per minute, the only feed mode here)", line),
+                    400 => self.skip("G40 (cutter compensation off)", Place { line, column }),
+                    490 => self.skip("G49 (tool length offset off)", Place { line, column }),
+                    800 => self.skip("G80 (canned cycle off)", Place { line, column }),
+                    940 => self.skip(
+                        "G94 (feed per minute, the only feed mode here)",
+                        Place { line, column },
+                    ),
                     540..=590 if w.value.fract() == 0.0 => self.skip(
                         "G54-G59 (work offsets: coordinates are taken as programmed)",
-                        line,
+                        Place { line, column },
                     ),
                     _ => {
                         return Err(self.error(
@@ -226,9 +229,9 @@ impl<'a> Reader<'a> {
                 },
                 'M' => match code()? {
                     20 | 300 => end = true,
-                    30..=50 => self.skip("M3-M5 (spindle)", line),
-                    60 => self.skip("M6 (tool change)", line),
-                    70..=90 => self.skip("M7-M9 (coolant)", line),
+                    30..=50 => self.skip("M3-M5 (spindle)", Place { line, column }),
+                    60 => self.skip("M6 (tool change)", Place { line, column }),
+                    70..=90 => self.skip("M7-M9 (coolant)", Place { line, column }),
                     _ => {
                         return Err(self.error(
                             line,
@@ -246,9 +249,9 @@ impl<'a> Reader<'a> {
                 'F' => feed = Some((w.value, column)),
                 'P' => p = Some((w.value, column)),
                 'N' => {}
-                'S' => self.skip("S (spindle speed)", line),
-                'T' => self.skip("T (tool number)", line),
-                'Q' => self.skip("Q (G64's naive-CAM tolerance)", line),
+                'S' => self.skip("S (spindle speed)", Place { line, column }),
+                'T' => self.skip("T (tool number)", Place { line, column }),
+                'Q' => self.skip("Q (G64's naive-CAM tolerance)", Place { line, column }),
                 'K' => {
                     return Err(self.error(line, column, "K is not an XY-plane arc word"));
                 }
@@ -444,6 +447,12 @@ mod tests {
         );
         assert_eq!(p.warnings.len(), 11, "{:#?}", p.warnings);
         assert!(p.warnings.iter().any(|w| w.starts_with("t.ngc:5: Z-only")));
+        // A skipped word is named where it stands.
+        assert!(
+            p.warnings[0].starts_with("t.ngc:1:5: G40 "),
+            "{}",
+            p.warnings[0]
+        );
         // The path starts at the first cut's start; the retract after the arc makes it an
         // exact stop; the last rapid is part of the path.
         assert_eq!(p.point(0.0), Vector2::new(10.0, 10.0));
