@@ -1,4 +1,6 @@
-"""A small fixed-step co-simulation master on fmpy's FMU2Slave.
+"""Engine: the fmpy master, a small fixed-step co-simulation master on fmpy's FMU2Slave
+(closed_loop, five_axis_closed_loop; contour_fmu.master.closed_loop is the documented
+entry point).
 
 Connects FMU outputs to inputs and steps every FMU with one communication step. Two
 coupling schemes:
@@ -20,9 +22,8 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-from .loops import LOOPS
+from ..loops.wiring import FIVE_AXIS, LOOPS, TWO_AXIS
 from .stepping import SCHEMES, Stepping
-from .wiring import FIVE_AXIS, TWO_AXIS
 
 
 def co_simulation_description(path):
@@ -116,7 +117,7 @@ class Master:
         """units: list of Unit in stepping order; connections: list of (source unit,
         output name, destination unit, input name); initial: connections applied once in
         initialization mode, in order (e.g. an output onto a parameter); log: a
-        contour_fmu.fmu_log.FmuLog that collects the FMUs' messages (default: fmpy's
+        contour_fmu.engines.fmu_log.FmuLog that collects the FMUs' messages (default: fmpy's
         logger, which prints them)."""
         if scheme not in SCHEMES:
             raise ValueError(f"unknown coupling scheme {scheme!r}; expected one of {SCHEMES}")
@@ -166,7 +167,7 @@ class Master:
         return slave.getString(vr)[0]
 
     def run(self, record):
-        """Steps from 0 to the stop time (contour_fmu.stepping). Returns two structured
+        """Steps from 0 to the stop time (contour_fmu.engines.stepping). Returns two structured
         arrays with a 'time' column and one column "unit.variable" per (unit, variable) in
         `record`: `before[k]` holds the outputs at t_k before the step from t_k, `after[k]`
         the outputs once every FMU has stepped to t_k+1 (for a sampled controller: the
@@ -194,14 +195,21 @@ def closed_loop(fmu_dir, path="circle", feed=None, stop=2.0, step=1e-3, controll
                 plant=None, scheme="gauss-seidel", interpolator=None):
     """Runs PathInterpolator2D -> ContourCCC2D <- XYServoPlant; returns (before, after).
     `interpolator` holds further PathInterpolator2D start values (they override `path`)."""
+    return _shipped_loop(TWO_AXIS, CLOSED_LOOP_RECORD, fmu_dir, path, feed, stop, step,
+                         controller, plant, scheme, interpolator)
+
+
+def _shipped_loop(structure, record, fmu_dir, path, feed, stop, step, controller, plant,
+                  scheme, interpolator):
+    """A shipped loop from t = 0 to `stop`, `record` recorded: (before, after)."""
     interpolator = {"path": path, **(interpolator or {})}
     if feed is not None:
         interpolator["feed"] = feed
-    units = loop_units(TWO_AXIS, fmu_dir, {"controller": controller, "plant": plant,
-                                           "interpolator": interpolator})
-    with Master(units, TWO_AXIS.connections, step, stop, scheme,
-                initial=TWO_AXIS.initial_copies) as master:
-        return master.run(CLOSED_LOOP_RECORD)
+    units = loop_units(structure, fmu_dir, {"controller": controller, "plant": plant,
+                                            "interpolator": interpolator})
+    with Master(units, structure.connections, step, stop, scheme,
+                initial=structure.initial_copies) as master:
+        return master.run(record)
 
 
 def loop_units(structure, fmu_dir, start_values):
@@ -212,7 +220,7 @@ def loop_units(structure, fmu_dir, start_values):
                  dict(start_values.get(name) or {})) for name in structure.order]
 
 
-# Every output the engines record for the five-axis loop (contour_fmu.loops).
+# Every output the engines record for the five-axis loop (contour_fmu.loops.wiring.LOOPS).
 FIVE_AXIS_RECORD = LOOPS["five_axis"].recorded
 
 
@@ -220,11 +228,5 @@ def five_axis_closed_loop(fmu_dir, path="tilted_helix", feed=None, stop=1.0, ste
                           controller=None, plant=None, scheme="gauss-seidel", interpolator=None):
     """Runs PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant; returns (before, after) as
     `closed_loop` does. `interpolator` holds further PathInterpolator5X start values."""
-    interpolator = {"path": path, **(interpolator or {})}
-    if feed is not None:
-        interpolator["feed"] = feed
-    units = loop_units(FIVE_AXIS, fmu_dir, {"controller": controller, "plant": plant,
-                                            "interpolator": interpolator})
-    with Master(units, FIVE_AXIS.connections, step, stop, scheme,
-                initial=FIVE_AXIS.initial_copies) as master:
-        return master.run(FIVE_AXIS_RECORD)
+    return _shipped_loop(FIVE_AXIS, FIVE_AXIS_RECORD, fmu_dir, path, feed, stop, step,
+                         controller, plant, scheme, interpolator)
