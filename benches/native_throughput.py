@@ -30,7 +30,8 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "python"))
 
-from contour_fmu import native, repo  # noqa: E402
+from contour_fmu import repo  # noqa: E402
+from contour_fmu.engines import native  # noqa: E402
 from contour_fmu.campaign import load  # noqa: E402
 from contour_fmu.campaign.execute import archives_of, job_of  # noqa: E402
 from contour_fmu.campaign.native_batch import run_batch as native_batch  # noqa: E402

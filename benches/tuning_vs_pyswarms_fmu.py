@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from contour_fmu import repo
-from contour_fmu.master import closed_loop
-from contour_fmu.reference_paths import ContourReference
+from contour_fmu.engines.master import closed_loop
+from contour_fmu.checks.reference_paths import ContourReference
 
 # The default search box of ccc-tune (contour-tune/src/objective.rs, docs/design/two-axis.md §4.4).
 SWARM, ITERATIONS, LOWER, UPPER = 50, 100, [0.0] * 5, [10.0, 10.0, 340.0, 6800.0, 3.8]

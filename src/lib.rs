@@ -2,7 +2,7 @@
 //!
 //! The algorithms live in the `contour-core` crate and know nothing of FMI. Here,
 //! [`framework`] is what every FMU is built from (model trait, variable tables, units,
-//! sample clock, state codec and checks), [`models`] holds the six FMUs (and two test-only
+//! sample clock, state codec and checks), [`models`] holds the eight FMUs (and two test-only
 //! ones), and [`fmi2`] is the only place that speaks the FMI C ABI (the only `unsafe`).
 
 pub mod build_identity;

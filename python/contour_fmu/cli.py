@@ -1,10 +1,10 @@
-"""The command line `contour-fmu` (the console script of python/pyproject.toml): one
-command per runner, each with its module's own arguments (`contour-fmu COMMAND --help`).
+"""Plumbing: the command line `contour-fmu` (the console script of python/pyproject.toml),
+one command per runner, each with its module's own arguments (`contour-fmu COMMAND --help`).
 
     contour-fmu demo [...]                 = python -m contour_fmu.demo
     contour-fmu campaign run|replay [...]  = python -m contour_fmu.campaign
-    contour-fmu libcosim [...]             = python -m contour_fmu.cosim_closed_loop
-    contour-fmu ecos [...]                 = python -m contour_fmu.ecos_closed_loop
+    contour-fmu libcosim [...]             = python -m contour_fmu.engines.libcosim
+    contour-fmu ecos [...]                 = python -m contour_fmu.engines.ecos
 
 A command whose extra is not installed says which one to install (exit status 2).
 """
@@ -19,14 +19,14 @@ PROG = "contour-fmu"
 
 # command -> (module, what it does)
 COMMANDS = {
-    "demo": ("contour_fmu.demo",
+    "demo": ("contour_fmu.demo.__main__",
              "the paper's comparison through the FMUs: tables, CSV and plots (extras plots, "
              "reference)"),
     "campaign": ("contour_fmu.campaign.__main__",
                  "run | replay a campaign of closed-loop runs on Dask (extra campaign)"),
-    "libcosim": ("contour_fmu.cosim_closed_loop",
+    "libcosim": ("contour_fmu.engines.libcosim",
                  "a closed loop in libcosim, printed as JSON (extra engines)"),
-    "ecos": ("contour_fmu.ecos_closed_loop", "a closed loop in ecos, printed as JSON (extra engines)"),
+    "ecos": ("contour_fmu.engines.ecos", "a closed loop in ecos, printed as JSON (extra engines)"),
 }
 
 

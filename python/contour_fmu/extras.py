@@ -1,16 +1,18 @@
-"""The package's extras (the optional dependencies in python/pyproject.toml), the modules
-each one brings, and the error that names the extra to install when one is missing.
+"""Plumbing: the package's extras (the optional dependencies in python/pyproject.toml), the
+modules each one brings, and the error that names the extra to install when one is missing.
 
-The core (fmpy, numpy, attrs) runs wiring, loops, master, stepping, fmu_log, tuned, repo,
-output_files, five_axis_truth, container_build, the campaign file (campaign.spec) and
-runner, and the command line `contour-fmu` up to its commands. The extras:
+The core (fmpy, numpy, attrs) runs loops (ssp, wiring), engines.master, .stepping,
+.fmu_log, .native and .container_build, checks.five_axis_truth and checks.gcode, tuned,
+repo, output_files, the campaign file (campaign.spec) and runner, and the command line
+`contour-fmu` up to its commands. The extras:
 
-- reference (geomdl, scipy): reference_paths, the built-in paths and the true contour error;
-- plots (matplotlib): the plots of the demo and the campaigns; the demo needs plots and
+- reference (geomdl, scipy): checks.reference_paths, the built-in paths and the true
+  contour error;
+- plots (matplotlib): the plots of the demos and the campaigns; the demos need plots and
   reference;
 - campaign (dask, distributed, pyarrow, tqdm, scipy, and plots and reference): running,
   replaying and reporting campaigns (campaign.execute, .store, .report, the command line);
-- engines (libcosimpy, ecospy): cosim_closed_loop, ecos_closed_loop.
+- engines (libcosimpy, ecospy): engines.libcosim, engines.ecos.
 """
 
 import contextlib

@@ -1,5 +1,5 @@
-"""Files the demo writes: CSV time series, and the FMI cross-check files of a controller
-FMU (the inputs it received, the outputs it gave, the options to replay them)."""
+"""Plumbing: files the demos write, CSV time series, and the FMI cross-check files of a
+controller FMU (the inputs it received, the outputs it gave, the options to replay them)."""
 
 import csv
 

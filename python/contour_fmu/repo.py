@@ -1,6 +1,6 @@
-"""Where things are in a contour-fmu checkout: its root, the FMUs that `fmu-build` writes
-(target/fmu), the demo's output folder (out/), the `ccc-tune` and `contour-cosim` programs
-(target/release/), and which Cargo package of the workspace builds a target.
+"""Plumbing: where things are in a contour-fmu checkout, its root, the FMUs that `fmu-build`
+writes (target/fmu), the demo's output folder (out/), the `ccc-tune` and `contour-cosim`
+programs (target/release/), and which Cargo package of the workspace builds a target.
 
 The root is, first found:
 1. the folder named by the environment variable CONTOUR_FMU_REPO (an error if it is not a
@@ -85,7 +85,7 @@ def ccc_tune():
 
 
 def contour_cosim():
-    """The native co-simulation master that contour_fmu.native runs: $CONTOUR_COSIM when
+    """The native co-simulation master that contour_fmu.engines.native runs: $CONTOUR_COSIM when
     set, else the checkout's release build."""
     named = os.environ.get("CONTOUR_COSIM")
     return Path(named) if named else target_dir() / "release" / "contour-cosim"

@@ -1,4 +1,4 @@
-"""Applying a `ccc-tune` result to the ContourCCC2D FMU.
+"""Plumbing: a `ccc-tune` result applied to the ContourCCC2D FMU as start values.
 
 `ccc-tune --out tuned.json` writes {"factors": {"ke": ..., "kde": ..., "kp": ...,
 "ki": ..., "kd": ...}, "settings": {...}, ...}; the FMU's parameters are fuzzy.<name>.

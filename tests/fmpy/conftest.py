@@ -5,8 +5,8 @@ import subprocess
 
 import pytest
 
-from contour_fmu import native
-from contour_fmu.loops import LOOPS
+from contour_fmu.engines import native
+from contour_fmu.loops.wiring import LOOPS
 from contour_fmu.repo import COSIM_PACKAGE
 from helpers.checkout import REPO, target_dir
 

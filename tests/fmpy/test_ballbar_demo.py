@@ -1,4 +1,4 @@
-"""The demo's ballbar test (contour_fmu.ballbar_demo): the circular test of ISO 230-4 on
+"""The demo's ballbar test (contour_fmu.demo.ballbar): the circular test of ISO 230-4 on
 XYServoPlant with friction through the FMUs. Its figures come from contour-eval; here
 they are recomputed from the runs' CSVs by the standard's definitions (scipy's
 least_squares for the least-squares circle), and the controllers must rank as a machine
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from contour_fmu import ballbar_demo
+from contour_fmu.demo import ballbar as ballbar_demo
 from helpers.checkout import REPO
 
 

@@ -18,8 +18,8 @@ from contour_fmu.campaign import CampaignError, load
 from contour_fmu.campaign.execute import execute
 from contour_fmu.campaign.metrics import compute
 from contour_fmu.campaign.store import OutputInUse
-from contour_fmu.master import closed_loop
-from contour_fmu.reference_paths import paper_circle_distance
+from contour_fmu.engines.master import closed_loop
+from contour_fmu.checks.reference_paths import paper_circle_distance
 from contour_fmu.tuned import start_values
 from helpers import campaign_faults
 from helpers.checkout import REPO
@@ -276,7 +276,7 @@ def test_five_axis_rows_are_the_fmpy_masters_and_a_boolean_sweep_is_reported(tmp
     """Run 1 (CCC on) follows run 0 (CCC off) on reset instances; both equal the master's
     fresh runs, and the Boolean swept column reaches the rows, summary and plots."""
     from contour_fmu.campaign import report
-    from contour_fmu.master import five_axis_closed_loop
+    from contour_fmu.engines.master import five_axis_closed_loop
 
     campaign = load(write_campaign(tmp_path, fmus, FIVE_AXIS))
     table = execute(campaign, tmp_path / "out", serial=True, show_progress=False).consolidate()

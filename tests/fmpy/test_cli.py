@@ -76,8 +76,8 @@ def test_the_demo_refuses_missing_fmus_before_running(tmp_path):
 
 
 @pytest.mark.parametrize("engine, name, step", [
-    ("libcosim", "contour_fmu.cosim_closed_loop", "1000000"),
-    ("ecos", "contour_fmu.ecos_closed_loop", "0.001"),
+    ("libcosim", "contour_fmu.engines.libcosim", "1000000"),
+    ("ecos", "contour_fmu.engines.ecos", "0.001"),
 ])
 def test_an_engine_run_is_the_modules(fmus, engine, name, step):
     args = ("--loop", "two_axis", fmus, step, 40, "plant.pos0.x=0.0", "plant.pos0.y=0.0")

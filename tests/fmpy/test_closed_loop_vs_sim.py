@@ -4,7 +4,7 @@ algorithms behind the FMI boundary, so the same numbers to 1e-9 mm."""
 import numpy as np
 import pytest
 
-from contour_fmu.master import closed_loop
+from contour_fmu.engines.master import closed_loop
 
 CASES = [("circle", "fuzzy"), ("infinity", "fuzzy"), ("trident", "fuzzy"), ("circle", "off"), ("trident", "fixed")]
 CONTROLLER = {"off": {"ccc.enable": False}, "fixed": {"fuzzy.enable": False}, "fuzzy": {}}

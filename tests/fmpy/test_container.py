@@ -1,6 +1,6 @@
 """Issue 4: the closed loop PathInterpolator2D -> ContourCCC2D <- XYServoPlant packed into
 ONE FMU with fmpy's container (fmpy.container_fmu), simulated with fmpy.simulate_fmu and
-compared with the Python master (contour_fmu.master) on the same three FMUs.
+compared with the Python master (contour_fmu.engines.master) on the same three FMUs.
 
 Coupling scheme of fmpy's container: JACOBI (parallel), not Gauss-Seidel.
 How it was established:
@@ -34,8 +34,8 @@ import pytest
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
-from contour_fmu.container_build import build_container
-from contour_fmu.master import closed_loop
+from contour_fmu.engines.container_build import build_container
+from contour_fmu.engines.master import closed_loop
 
 STEP, STOP = 1e-3, 2.0
 N = int(round(STOP / STEP))
@@ -132,7 +132,7 @@ PARALLEL_RUN = """
 import json
 import numpy as np
 from fmpy import simulate_fmu
-from contour_fmu.container_build import build_container
+from contour_fmu.engines.container_build import build_container
 fmu = build_container({fmus!r}, {work!r}, parallel_do_step=True)
 r = simulate_fmu(str(fmu), stop_time={stop!r}, output_interval={step!r})
 print(json.dumps({{c: r[c].tolist() for c in ("plant.pos.x", "plant.pos.y")}}))

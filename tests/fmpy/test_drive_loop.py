@@ -2,7 +2,7 @@
 with no code between the FMUs (issue 24): the SI PathInterpolator2D and ContourCCC2D, one
 ServoDrive per axis, and per axis a slide with viscous and Coulomb friction exported by
 pythonfmu (tests/fmpy/helpers/friction_slide.py: force in N, position in m, velocity in
-m/s), wired by contour_fmu.wiring.drive_loop_connections in the fmpy master.
+m/s), wired by contour_fmu.loops.wiring.drive_loop_connections in the fmpy master.
 
 The same loop with XYServoPlant configured alike is the reference: the slide carries the
 paper's axis reflected to the table (m = J k^2, b = B k^2, Fc = Tc k with k = 2 pi / lead,
@@ -22,9 +22,10 @@ import sys
 import numpy as np
 import pytest
 
-from contour_fmu import native, ssp
-from contour_fmu.master import Master, Unit, closed_loop
-from contour_fmu.wiring import drive_loop_connections, drive_loop_start
+from contour_fmu.engines import native
+from contour_fmu.loops import ssp
+from contour_fmu.engines.master import Master, Unit, closed_loop
+from contour_fmu.loops.wiring import drive_loop_connections, drive_loop_start
 from helpers.checkout import REPO
 
 LEAD = 0.01  # m
@@ -114,7 +115,7 @@ def test_the_nc_drives_a_foreign_si_plant_through_servo_drives(fmu_dir, slide_fm
 
 def test_the_drive_loop_with_a_pythonfmu_plant_runs_in_contour_cosim_as_in_fmpy(fmu_dir, slide_fmu,
                                                                                 cosim, tmp_path):
-    """The same loop as an SSP file (contour_fmu.ssp.write_loop) run by the native master,
+    """The same loop as an SSP file (contour_fmu.loops.ssp.write_loop) run by the native master,
     with the pythonfmu slides loaded into its process (libpython preloaded): fmpy's
     trajectory bit for bit, and without libpython a refusal that says what to do."""
     step, stop = 2e-4, 0.3

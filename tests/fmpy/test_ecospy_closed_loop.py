@@ -1,13 +1,13 @@
 """Issue 8: ecos (the ecospy package, Ecos-platform) as a second independent co-simulation
 engine for the closed loop PathInterpolator2D -> ContourCCC2D <- XYServoPlant, wired as in
-contour_fmu.wiring, run in a subprocess (contour_fmu.ecos_closed_loop) and compared with
-contour_fmu.master.closed_loop(scheme="jacobi") on the same three FMUs.
+contour_fmu.loops.wiring, run in a subprocess (contour_fmu.engines.ecos) and compared with
+contour_fmu.engines.master.closed_loop(scheme="jacobi") on the same three FMUs.
 
 Coupling scheme of ecos (ecospy 0.7.2), from its source (simulation::step and
 fixed_step_algorithm::step) and confirmed by the numbers below: at every step the fixed-step
 algorithm calls doStep(t_k, h) on every instance with the inputs it holds (optionally in
 parallel, with TBB, hence Debian's libtbb12), and only once all have stepped are the
-connections transferred (outputs at t_k+1 -> inputs). That is the Jacobi scheme of contour_fmu.master,
+connections transferred (outputs at t_k+1 -> inputs). That is the Jacobi scheme of contour_fmu.engines.master,
 the same as libcosim's. Initialization: ecos applies the parameter set in initialization
 mode, transfers the connections, exits initialization mode and transfers them again, so the
 first step sees the outputs at t_0, as the master's Jacobi run does.
@@ -29,8 +29,8 @@ import sys
 import numpy as np
 import pytest
 
-from contour_fmu.master import closed_loop
-from contour_fmu.reference_paths import paper_circle_distance as circle_error
+from contour_fmu.engines.master import closed_loop
+from contour_fmu.checks.reference_paths import paper_circle_distance as circle_error
 
 STEP = 1e-3
 TOL = 1e-9  # mm, mm/s
@@ -46,7 +46,7 @@ CASES = {
 
 
 def text(value):
-    """A start value as contour_fmu.ecos_closed_loop parses it back (true/false, 1.0, circle)."""
+    """A start value as contour_fmu.engines.ecos parses it back (true/false, 1.0, circle)."""
     if isinstance(value, bool):
         return str(value).lower()
     return repr(value) if isinstance(value, float) else str(value)
@@ -55,7 +55,7 @@ def text(value):
 def run_ecos(fmus, steps, assignments):
     args = [f"{k}={text(v)}" for k, v in assignments.items()]
     done = subprocess.run(
-        [sys.executable, "-m", "contour_fmu.ecos_closed_loop", str(fmus), repr(STEP), str(steps), *args],
+        [sys.executable, "-m", "contour_fmu.engines.ecos", str(fmus), repr(STEP), str(steps), *args],
         capture_output=True, text=True, timeout=300,
     )
     assert done.returncode == 0, f"ecos run failed ({done.returncode}):\n{done.stderr[-3000:]}"

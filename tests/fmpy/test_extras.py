@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from contour_fmu.extras import EXTRAS, MissingExtra, modules, needs, require
-from contour_fmu.master import closed_loop
+from contour_fmu.engines.master import closed_loop
 
 BLOCKED = modules(*EXTRAS)
 
@@ -45,12 +45,13 @@ def test_the_blocked_modules_are_every_extras_dependency():
 
 def test_the_core_runs_the_closed_loop_without_any_extra(fmu_dir):
     result = without_extras("""
-        import contour_fmu, contour_fmu.wiring, contour_fmu.loops, contour_fmu.stepping
-        import contour_fmu.fmu_log, contour_fmu.tuned, contour_fmu.repo, contour_fmu.output_files
-        import contour_fmu.five_axis_truth, contour_fmu.container_build, contour_fmu.cli
+        import contour_fmu, contour_fmu.loops.ssp, contour_fmu.loops.wiring, contour_fmu.engines.stepping
+        import contour_fmu.engines.fmu_log, contour_fmu.engines.native, contour_fmu.tuned, contour_fmu.repo
+        import contour_fmu.output_files, contour_fmu.checks.five_axis_truth, contour_fmu.checks.gcode
+        import contour_fmu.engines.container_build, contour_fmu.cli
         import contour_fmu.campaign, contour_fmu.campaign.spec, contour_fmu.campaign.runner
         from pathlib import Path
-        from contour_fmu.master import closed_loop
+        from contour_fmu.master import closed_loop  # the documented entry point
         before, after = closed_loop(Path(sys.argv[2]), stop=0.05)
         loaded = sorted({m.split(".")[0] for m in sys.modules} & BLOCKED)
         print(json.dumps({"loaded": loaded, "pos.x": list(before["plant.pos.x"]),
@@ -67,9 +68,9 @@ def test_a_module_of_a_missing_extra_names_the_extra():
         import importlib
         from contour_fmu.extras import MissingExtra
         found = {}
-        for module in ["contour_fmu.reference_paths", "contour_fmu.demo", "contour_fmu.cosim_closed_loop",
-                       "contour_fmu.ecos_closed_loop", "contour_fmu.campaign.store",
-                       "contour_fmu.campaign.execute"]:
+        for module in ["contour_fmu.checks.reference_paths", "contour_fmu.demo.__main__",
+                       "contour_fmu.engines.libcosim", "contour_fmu.engines.ecos",
+                       "contour_fmu.campaign.store", "contour_fmu.campaign.execute"]:
             try:
                 importlib.import_module(module)
                 found[module] = None
@@ -82,8 +83,9 @@ def test_a_module_of_a_missing_extra_names_the_extra():
             found["report.sensitivity"] = str(e)
         print(json.dumps(found))
     """)
-    extras = {"contour_fmu.reference_paths": "reference", "contour_fmu.demo": "plots,reference",
-              "contour_fmu.cosim_closed_loop": "engines", "contour_fmu.ecos_closed_loop": "engines",
+    extras = {"contour_fmu.checks.reference_paths": "reference",
+              "contour_fmu.demo.__main__": "plots,reference",
+              "contour_fmu.engines.libcosim": "engines", "contour_fmu.engines.ecos": "engines",
               "contour_fmu.campaign.store": "campaign", "contour_fmu.campaign.execute": "campaign",
               "report.sensitivity": "campaign"}
     for module, extra in extras.items():

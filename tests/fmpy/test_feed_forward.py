@@ -19,7 +19,7 @@ S-curve's phases meet) times at most Ts/6 each side: within jerk*Ts*(1/2 + 1/3).
 
 import numpy as np
 
-from contour_fmu.master import closed_loop
+from contour_fmu.engines.master import closed_loop
 from helpers.fmu_slave import Slave
 from test_two_axis_fmus import PART
 

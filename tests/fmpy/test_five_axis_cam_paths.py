@@ -2,16 +2,16 @@
 tool axis tilts through vertical, the same 0.5° beside vertical, a hemisphere raster over
 its apex. The planned reference keeps every joint within its limits (checked on the
 samples, by differences), and the CCC's maxima of tip and orientation error are below
-those without CCC, measured from the reference (contour_fmu.five_axis_truth, the
+those without CCC, measured from the reference (contour_fmu.checks.five_axis_truth, the
 tracking errors) and from the CL data themselves (brute force here)."""
 
 import numpy as np
 import pytest
 
-from contour_fmu import cam_paths
-from contour_fmu.five_axis_truth import contour_errors, forward
-from contour_fmu.master import five_axis_closed_loop
-from contour_fmu.wiring import FIVE_AXIS_JOINTS
+from contour_fmu.demo import cam_paths
+from contour_fmu.checks.five_axis_truth import contour_errors, forward
+from contour_fmu.engines.master import five_axis_closed_loop
+from contour_fmu.loops.wiring import FIVE_AXIS_JOINTS
 from helpers.fmu_slave import Slave
 
 TS = 1e-3

@@ -1,8 +1,8 @@
 """The five-axis loop PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant in the three outside
 engines of the two-axis loop: libcosim and ecos (subprocesses running
-contour_fmu.cosim_closed_loop / .ecos_closed_loop with --loop five_axis) and fmpy's container
-FMU (contour_fmu.container_build, loop="five_axis"). Each is compared with
-contour_fmu.master.five_axis_closed_loop(scheme="jacobi") on the same FMUs, as
+contour_fmu.engines.libcosim / .ecos with --loop five_axis) and fmpy's container
+FMU (contour_fmu.engines.container_build, loop="five_axis"). Each is compared with
+contour_fmu.engines.master.five_axis_closed_loop(scheme="jacobi") on the same FMUs, as
 test_libcosim_closed_loop, test_ecospy_closed_loop and test_container do for the two-axis
 loop: all three engines step every FMU on the inputs from t_k and exchange values at the
 step boundaries, so one Jacobi run of the master is the reference for all of them.
@@ -25,9 +25,9 @@ import pytest
 from fmpy import simulate_fmu
 from fmpy.validation import validate_fmu
 
-from contour_fmu.container_build import build_container
-from contour_fmu.master import five_axis_closed_loop
-from contour_fmu.wiring import FIVE_AXIS_JOINTS, FIVE_AXIS_PATH_START
+from contour_fmu.engines.container_build import build_container
+from contour_fmu.engines.master import five_axis_closed_loop
+from contour_fmu.loops.wiring import FIVE_AXIS_JOINTS, FIVE_AXIS_PATH_START
 
 PATH = "tilted_helix"
 STEP_NS, STEPS = 1_000_000, 500  # 1 ms for 0.5 s
@@ -89,7 +89,7 @@ def assert_matches_jacobi(engine, series, jacobi_rows, gauss_seidel_rows):
 
 
 def test_libcosim_five_axis_loop_matches_jacobi_master(fmus, jacobi, gauss_seidel, path_start):
-    result = run_engine("cosim_closed_loop", fmus, str(STEP_NS), path_start)
+    result = run_engine("engines.libcosim", fmus, str(STEP_NS), path_start)
     assert result["time_ns"] == STEPS * STEP_NS
     assert result["steps"] == list(range(1, STEPS + 1))
     assert result["time_ns_points"] == [n * STEP_NS for n in range(1, STEPS + 1)]
@@ -103,7 +103,7 @@ def test_libcosim_five_axis_loop_matches_jacobi_master(fmus, jacobi, gauss_seide
 
 
 def test_ecos_five_axis_loop_matches_jacobi_master(fmus, jacobi, gauss_seidel, path_start):
-    result = run_engine("ecos_closed_loop", fmus, repr(STEP), path_start)
+    result = run_engine("engines.ecos", fmus, repr(STEP), path_start)
     before, after = jacobi
     np.testing.assert_allclose(result["time"], after["time"], rtol=0, atol=1e-10)
     # After init, the outputs are the master's at t_0: the plant stands at the path's start.

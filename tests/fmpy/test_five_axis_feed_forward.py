@@ -3,7 +3,7 @@ are the reference joints' velocity and acceleration at each sample, and ContourC
 feedForward*vref + accelerationFeedForward*aref to its position loops' commands.
 
 vref and aref against independent references: at constant feed the tip, moved by the
-forward kinematics (written again in numpy, contour_fmu.five_axis_truth) along vref,
+forward kinematics (written again in numpy, contour_fmu.checks.five_axis_truth) along vref,
 travels at the feed; on a planned CAM path they are the central differences of the
 samples the FMU gave (so neither is a sample late).
 
@@ -17,10 +17,10 @@ lead its reference while braking) and, for the CAM path, against the CL data.
 import numpy as np
 import pytest
 
-from contour_fmu import cam_paths
-from contour_fmu.five_axis_truth import contour_errors, forward
-from contour_fmu.master import five_axis_closed_loop
-from contour_fmu.wiring import FIVE_AXIS_JOINTS
+from contour_fmu.demo import cam_paths
+from contour_fmu.checks.five_axis_truth import contour_errors, forward
+from contour_fmu.engines.master import five_axis_closed_loop
+from contour_fmu.loops.wiring import FIVE_AXIS_JOINTS
 from helpers.fmu_slave import Slave
 from test_five_axis_cam_paths import cl_errors
 

@@ -12,10 +12,10 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
-from contour_fmu import five_axis_demo
-from contour_fmu.master import five_axis_closed_loop
+from contour_fmu.demo import five_axis as five_axis_demo
+from contour_fmu.engines.master import five_axis_closed_loop
 from contour_fmu.output_files import write_cross_check
-from contour_fmu.wiring import FIVE_AXIS_JOINTS
+from contour_fmu.loops.wiring import FIVE_AXIS_JOINTS
 from helpers.fmu_slave import Slave
 
 REPO = Path(__file__).resolve().parents[2]

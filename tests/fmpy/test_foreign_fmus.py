@@ -10,10 +10,10 @@ import zipfile
 
 import pytest
 
-from contour_fmu import native
+from contour_fmu.engines import native
 from contour_fmu.campaign.spec import CampaignError, load
-from contour_fmu.ssp import SHIPPED
-from contour_fmu.master import closed_loop
+from contour_fmu.loops.ssp import SHIPPED
+from contour_fmu.engines.master import closed_loop
 from helpers.checkout import REPO
 
 

@@ -1,7 +1,7 @@
 """Issue 4: the closed loop PathInterpolator2D -> ContourCCC2D <- XYServoPlant in libcosim
 (libcosimpy: three CosimLocalSlave, six connect_real_variables, 1 ms fixed step), run in a
-subprocess (contour_fmu.cosim_closed_loop) and compared with
-contour_fmu.master.closed_loop(scheme="jacobi").
+subprocess (contour_fmu.engines.libcosim) and compared with
+contour_fmu.engines.master.closed_loop(scheme="jacobi").
 
 libcosim's fixed-step algorithm steps all slaves from t_k on the inputs they hold and then
 transfers outputs to inputs at the step boundary t_k+1: the Jacobi scheme of the master.
@@ -23,8 +23,8 @@ import sys
 import numpy as np
 import pytest
 
-from contour_fmu.master import closed_loop
-from contour_fmu.reference_paths import paper_circle_distance as circle_error
+from contour_fmu.engines.master import closed_loop
+from contour_fmu.checks.reference_paths import paper_circle_distance as circle_error
 
 STEP_NS, STEPS = 1_000_000, 2000  # 1 ms for 2 s
 STEP, STOP = STEP_NS * 1e-9, STEPS * STEP_NS * 1e-9
@@ -34,7 +34,7 @@ TOL = 1e-6  # mm
 
 def run_libcosim(fmus, assignments=()):
     done = subprocess.run(
-        [sys.executable, "-m", "contour_fmu.cosim_closed_loop", str(fmus), str(STEP_NS), str(STEPS),
+        [sys.executable, "-m", "contour_fmu.engines.libcosim", str(fmus), str(STEP_NS), str(STEPS),
          *assignments],
         capture_output=True, text=True, timeout=120,
     )

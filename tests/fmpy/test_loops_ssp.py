@@ -1,5 +1,5 @@
 """The loops as SSP 1.0 files (issue 25, step 1): contour_fmu/loops/*.ssd are what every
-master wires (contour_fmu.wiring reads them), and libcosim, an independent SSP reader,
+master wires (contour_fmu.loops.wiring reads them), and libcosim, an independent SSP reader,
 runs them as they are: the same trajectories, bit for bit, as the loop the libcosim script
 builds by hand, the parameter set of the default path applied by libcosim itself."""
 
@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from fmpy import read_model_description
 
-from contour_fmu import ssp
-from contour_fmu.wiring import FIVE_AXIS, TWO_AXIS
+from contour_fmu.loops import ssp
+from contour_fmu.loops.wiring import FIVE_AXIS, TWO_AXIS
 from helpers.fmu_slave import Slave
 
 STEP_NS = 1_000_000
@@ -42,7 +42,7 @@ def test_each_paths_parameter_set_starts_the_plant_at_the_paths_first_sample(fmu
 
 def libcosim(fmu_dir, loop, steps, flags=(), assignments=()):
     done = subprocess.run(
-        [sys.executable, "-m", "contour_fmu.cosim_closed_loop", "--loop", loop, *flags,
+        [sys.executable, "-m", "contour_fmu.engines.libcosim", "--loop", loop, *flags,
          str(fmu_dir), str(STEP_NS), str(steps), *assignments],
         capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-3000:]
@@ -67,7 +67,7 @@ def test_libcosim_runs_the_shipped_ssp_as_the_loop_built_by_hand(fmu_dir, struct
 
 
 def test_the_si_files_are_the_mm_files_in_metres():
-    """The SI build's SSP files are written from the mm ones (python -m contour_fmu.ssp):
+    """The SI build's SSP files are written from the mm ones (python -m contour_fmu.loops.ssp):
     the same wiring, lengths scaled by the SI model descriptions' units."""
     for name, si in SI.items():
         mm = ssp.shipped(name)

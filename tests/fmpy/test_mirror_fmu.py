@@ -10,8 +10,8 @@ import math
 import numpy as np
 import pytest
 
-from contour_fmu import demo
-from contour_fmu.master import closed_loop
+from contour_fmu.demo import paper
+from contour_fmu.engines.master import closed_loop
 
 LARGE_KP = {"fuzzy.ke": 3.0, "fuzzy.kde": 0.5, "fuzzy.kp": 300.0, "fuzzy.ki": 0.0, "fuzzy.kd": 3.0}
 CONTROLLERS = {"paper factors": {}, "large kp": LARGE_KP, "no CCC": {"ccc.enable": False}}
@@ -46,7 +46,7 @@ def test_counter_clockwise_and_clockwise_circles_give_mirrored_runs(fmu_dir, con
 
 
 def test_trident_and_its_mirror_image_from_a_file_give_mirrored_runs(fmu_dir, tmp_path):
-    mirror = demo.mirrored_interpolator("trident", tmp_path)
+    mirror = paper.mirrored_interpolator("trident", tmp_path)
     runs = [closed_loop(fmu_dir, path="trident", feed=50.0, stop=2.0, controller=LARGE_KP,
                         interpolator=geometry) for geometry in (None, mirror)]
     assert_mirrored(*runs)

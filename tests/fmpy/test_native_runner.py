@@ -1,5 +1,5 @@
 """The native master, contour-cosim (issue 25, step 2): the shipped loops' SSP files run
-through the FMUs give the trajectories of contour_fmu.master (fmpy) bit for bit, in both
+through the FMUs give the trajectories of contour_fmu.engines.master (fmpy) bit for bit, in both
 coupling schemes; libcosim reading the same SSP file agrees with its Jacobi run within the
 engines' known difference (libcosim's steps from integer nanoseconds); what it cannot run is
 refused before any run, naming the file."""
@@ -14,8 +14,8 @@ import zipfile
 import numpy as np
 import pytest
 
-from contour_fmu import native
-from contour_fmu.master import CLOSED_LOOP_RECORD, FIVE_AXIS_RECORD, closed_loop, five_axis_closed_loop
+from contour_fmu.engines import native
+from contour_fmu.engines.master import CLOSED_LOOP_RECORD, FIVE_AXIS_RECORD, closed_loop, five_axis_closed_loop
 from helpers import faulty_fmu
 
 STEP = 1e-3
@@ -69,7 +69,7 @@ def test_the_schemes_differ_and_a_parameter_set_equals_the_initial_copies(loops)
 
 def libcosim(fmu_dir, loop, steps):
     done = subprocess.run(
-        [sys.executable, "-m", "contour_fmu.cosim_closed_loop", "--loop", loop, "--ssp",
+        [sys.executable, "-m", "contour_fmu.engines.libcosim", "--loop", loop, "--ssp",
          str(fmu_dir), "1000000", str(steps)],
         capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-3000:]

@@ -1,4 +1,4 @@
-"""The part demo (contour_fmu.part_demo) on the shipped G-code part
+"""The part demo (contour_fmu.demo.part) on the shipped G-code part
 examples/parts/bracket.ngc, through the FMUs in fmpy: the program has every feature the
 demo is about (read here on its own), the fuzzy CCC lowers the largest true contour error
 on the part and on its mirror image, the planned reference stays within the tolerance of
@@ -10,7 +10,7 @@ import re
 import numpy as np
 import pytest
 
-from contour_fmu import part_demo
+from contour_fmu.demo import part as part_demo
 from helpers.checkout import REPO
 from test_two_axis_fmus import distance_to_pieces
 

@@ -9,7 +9,7 @@ import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
-from contour_fmu.master import closed_loop, five_axis_closed_loop
+from contour_fmu.engines.master import closed_loop, five_axis_closed_loop
 
 # The mm build's length units and their SI counterparts (SI value = 1e-3 × mm value).
 SI_OF = {"mm": "m", "mm/s": "m/s", "mm/s2": "m/s2", "mm/s3": "m/s3", "mm/rad": "m/rad"}
@@ -103,8 +103,8 @@ def test_the_si_five_axis_loop_is_the_mm_loop_in_metres(fmu_dir, si_dir):
 def test_the_master_refuses_a_loop_that_mixes_the_builds_naming_the_connection(fmu_dir, si_dir):
     """An mm controller on an SI plant would command metres as millimetres: the master
     reads the declared units of both ends of every connection before it starts an FMU."""
-    from contour_fmu.master import Master, Unit
-    from contour_fmu.wiring import CLOSED_LOOP_CONNECTIONS, PATH_START
+    from contour_fmu.engines.master import Master, Unit
+    from contour_fmu.loops.wiring import CLOSED_LOOP_CONNECTIONS, PATH_START
 
     def loop(plant_dir, connections=CLOSED_LOOP_CONNECTIONS):
         units = [Unit("controller", str(fmu_dir / "ContourCCC2D.fmu")),

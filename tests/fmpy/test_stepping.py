@@ -1,19 +1,19 @@
-"""The stepping loop of the master and the campaigns (contour_fmu.stepping) gives, to the
+"""The stepping loop of the master and the campaigns (contour_fmu.engines.stepping) gives, to the
 bit, what the plain loop gives: one get and one set per variable and connection."""
 
 import numpy as np
 import pytest
 
-from contour_fmu.loops import LOOPS
-from contour_fmu.master import Master, Unit
-from contour_fmu.stepping import SCHEMES
+from contour_fmu.loops.wiring import LOOPS
+from contour_fmu.engines.master import Master, Unit
+from contour_fmu.engines.stepping import SCHEMES
 
 STEP, STOP = 1e-3, 0.3
 ORDER = ("controller", "plant", "interpolator")
 
 
 def plain_loop(master, record, scheme):
-    """The loop one variable at a time (contour_fmu.master's before it shared the loop)."""
+    """The loop one variable at a time (contour_fmu.engines.master's before it shared the loop)."""
     before, after = [], []
     for k in range(int(round(STOP / STEP))):
         t = k * STEP

@@ -7,7 +7,8 @@ import subprocess
 import numpy as np
 import pytest
 
-from contour_fmu import demo, repo
+from contour_fmu import repo
+from contour_fmu.demo import paper as paper_demo
 from contour_fmu.tuned import start_values
 from helpers.checkout import REPO, target_dir
 
@@ -75,15 +76,15 @@ def test_same_seed_gives_the_same_file_on_one_and_two_threads(ccc_tune, tmp_path
     assert document["settings"]["seed"] == 42 and document["settings"]["swarm"] == 8
 
 
-@pytest.mark.parametrize("path, feed", demo.PATHS)
+@pytest.mark.parametrize("path, feed", paper_demo.PATHS)
 def test_tuned_factors_beat_the_papers_through_the_fmu(ccc_tune, fmu_dir, tmp_path, path, feed):
     out = tmp_path / "tuned.json"
     done = tune(ccc_tune, out, "--path", path, "--feed", repr(feed), "--fitness", "max",
                 "--swarm", 20, "--iters", 25, "--seed", 3)
     assert done.returncode == 0, done.stderr
     document = json.loads(out.read_text())
-    _, _, paper = demo.run_path(fmu_dir, path, feed, PAPER)
-    _, _, tuned = demo.run_path(fmu_dir, path, feed, start_values(out))
+    _, _, paper = paper_demo.run_path(fmu_dir, path, feed, PAPER)
+    _, _, tuned = paper_demo.run_path(fmu_dir, path, feed, start_values(out))
     # The FMU closed loop scores the factors exactly as the in-process objective did.
     assert abs(tuned.max() - document["fitness_mm"]) < 1e-6
     # 500 evaluations (a tenth of the paper's budget): 23 % to 73 % lower on these paths.

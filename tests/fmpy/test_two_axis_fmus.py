@@ -13,10 +13,10 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
-from contour_fmu import demo
-from contour_fmu.fmu_log import FmuLog
-from contour_fmu.master import Master, Unit, closed_loop
-from contour_fmu.reference_paths import ContourReference
+from contour_fmu.demo import paper
+from contour_fmu.engines.fmu_log import FmuLog
+from contour_fmu.engines.master import Master, Unit, closed_loop
+from contour_fmu.checks.reference_paths import ContourReference
 from helpers.fmu_slave import Slave
 
 CONTROLLER_OUTPUTS = ["u.x", "u.y", "contourError", "err.x", "err.y", "ccc.Kp", "ccc.Ki", "ccc.Kd"]
@@ -327,11 +327,11 @@ def test_missing_and_malformed_path_files_name_the_file_and_line(interpolator, t
 # ---------------------------------------------------------------------------------------
 # The closed loop
 
-@pytest.mark.parametrize("path, feed", demo.PATHS)
+@pytest.mark.parametrize("path, feed", paper.PATHS)
 def test_fuzzy_ccc_beats_no_ccc_through_the_fmus(fmu_dir, path, feed):
-    _, _, without = demo.run_path(fmu_dir, path, feed, {"ccc.enable": False})
-    _, _, fixed = demo.run_path(fmu_dir, path, feed, {"fuzzy.enable": False})
-    _, _, fuzzy = demo.run_path(fmu_dir, path, feed, {})
+    _, _, without = paper.run_path(fmu_dir, path, feed, {"ccc.enable": False})
+    _, _, fixed = paper.run_path(fmu_dir, path, feed, {"fuzzy.enable": False})
+    _, _, fuzzy = paper.run_path(fmu_dir, path, feed, {})
     assert fuzzy.max() < 0.5 * without.max()
     assert fixed.max() < 0.5 * without.max()
     assert fuzzy.mean() < 0.1 * without.mean()
@@ -342,7 +342,7 @@ def test_fuzzy_ccc_beats_no_ccc_through_the_fmus(fmu_dir, path, feed):
 
 def test_cross_check_files_reproduce_through_simulate_fmu(fmu_dir, tmp_path):
     before, after = closed_loop(fmu_dir, path="circle", stop=0.2)
-    demo.write_cross_check(tmp_path, before, after)
+    paper.write_cross_check(tmp_path, before, after)
     folder = tmp_path / "cross-check" / "ContourCCC2D"
     inputs = read_csv(folder / "ContourCCC2D_in.csv")
     reference = read_csv(folder / "ContourCCC2D_ref.csv")

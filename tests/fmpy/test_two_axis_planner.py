@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from ruckig import InputParameter, Ruckig, Trajectory
 
-from contour_fmu.fmu_log import FmuLog
-from contour_fmu.master import CLOSED_LOOP_RECORD, Master, Unit, closed_loop
-from contour_fmu.wiring import CLOSED_LOOP_CONNECTIONS, PATH_START
+from contour_fmu.engines.fmu_log import FmuLog
+from contour_fmu.engines.master import CLOSED_LOOP_RECORD, Master, Unit, closed_loop
+from contour_fmu.loops.wiring import CLOSED_LOOP_CONNECTIONS, PATH_START
 from helpers.fmu_slave import Slave
 from test_two_axis_fmus import ESTIMATOR, PART, PART_PIECES, distance_to_pieces
 

@@ -1,4 +1,4 @@
-"""The demo's true five-axis contour errors (contour_fmu.five_axis_truth: numpy forward
+"""The demo's true five-axis contour errors (contour_fmu.checks.five_axis_truth: numpy forward
 kinematics, Catmull-Rom densified reference, brute-force nearest point) against the Rust
 simulator's own truth (exact curves, closed-form segment search) on the same runs: two
 independent computations of the same quantity."""
@@ -6,7 +6,7 @@ independent computations of the same quantity."""
 import numpy as np
 import pytest
 
-from contour_fmu.five_axis_truth import contour_errors, forward
+from contour_fmu.checks.five_axis_truth import contour_errors, forward
 
 
 @pytest.mark.parametrize("path, mode", [

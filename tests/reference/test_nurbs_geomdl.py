@@ -1,7 +1,7 @@
 """The Rust NURBS evaluator (point, first and second derivative) against geomdl.
 
 The built-in curves are rebuilt from the control points listed in docs/design/two-axis.md §4.6
-(contour_fmu.reference_paths, not from the Rust output), so the test also checks the Rust
+(contour_fmu.checks.reference_paths, not from the Rust output), so the test also checks the Rust
 data entry. Rational evaluation is checked on the exact 9-point unit circle and on a random
 degree-4 NURBS with random weights and a non-uniform knot vector, written to a JSON file and
 loaded by the Rust file loader.
@@ -14,7 +14,7 @@ import random
 import numpy as np
 import pytest
 
-from contour_fmu.reference_paths import INFINITY, TRIDENT, clamped_uniform, geomdl_curve
+from contour_fmu.checks.reference_paths import INFINITY, TRIDENT, clamped_uniform, geomdl_curve
 
 S = math.sqrt(2) / 2
 UNIT_CIRCLE = dict(

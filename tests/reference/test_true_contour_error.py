@@ -1,7 +1,7 @@
 """The Rust true contour error against an independent brute force.
 
 Python side: the path is sampled densely (geomdl for the NURBS, rebuilt from
-docs/design/two-axis.md §4.6 in contour_fmu.reference_paths; closed forms for circle, line and
+docs/design/two-axis.md §4.6 in contour_fmu.checks.reference_paths; closed forms for circle, line and
 arc), every promising local minimum of the sampled distance is refined with scipy's
 bounded Brent minimiser, and the sign comes from the side of the tangent at the foot
 (positive right of travel). Rust side: `estimator_dump` prints the global brute force
@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
 
-from contour_fmu.reference_paths import INFINITY, TRIDENT, clamped_uniform, geomdl_curve
+from contour_fmu.checks.reference_paths import INFINITY, TRIDENT, clamped_uniform, geomdl_curve
 
 
 def nurbs_path(ctrl):

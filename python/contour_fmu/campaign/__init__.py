@@ -1,5 +1,5 @@
-"""Campaigns of closed-loop co-simulations on Dask: a TOML file names the loop, its FMUs,
-fixed and swept parameters, paths and metrics; every run becomes one Parquet row.
+"""Campaign: campaigns of closed-loop co-simulations on Dask: a TOML file names the loop,
+its FMUs, fixed and swept parameters, paths and metrics; every run becomes one Parquet row.
 
     python -m contour_fmu.campaign run FILE --out DIR [--scheduler ADDRESS] [--workers N]
                                                       [--resume] [--serial]

@@ -1,5 +1,5 @@
-"""The command line: python -m contour_fmu.campaign run | replay (see --help), also
-`contour-fmu campaign`. Needs the campaign extra (--help does not)."""
+"""Campaign: the command line, python -m contour_fmu.campaign run | replay (see --help),
+also `contour-fmu campaign`. Needs the campaign extra (--help does not)."""
 
 import argparse
 import sys

@@ -1,5 +1,6 @@
-"""Running a campaign's batches: on Dask (a LocalCluster of this machine, or a scheduler
-given by address) or serially in this process, writing each batch's rows as it finishes.
+"""Campaign: running a campaign's batches: on Dask (a LocalCluster of this machine, or a
+scheduler given by address) or serially in this process, writing each batch's rows as it
+finishes.
 
 Every batch is a task of plain data: the Job and the runs' start values. The FMU archives
 go to each worker once, as bytes in a worker plugin that Dask also runs on a worker that

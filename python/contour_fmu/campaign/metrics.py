@@ -1,10 +1,10 @@
-"""What a campaign measures on each run, computed from the run's trace.
+"""Campaign: what a campaign measures on each run, computed from the run's trace.
 
 True errors are computed in Python, independently of the controller: for the two-axis
-loop the distance to the built-in path (contour_fmu.reference_paths), for the five-axis
-loop the tip and orientation errors against the interpolator's own reference
-(contour_fmu.five_axis_truth). The estimated_* metrics are what the controller itself
-reported (its contourError outputs): available on any path.
+loop the distance to the built-in path (contour_fmu.checks.reference_paths), for the
+five-axis loop the tip and orientation errors against the interpolator's own reference
+(contour_fmu.checks.five_axis_truth). The estimated_* metrics are what the controller
+itself reported (its contourError outputs): available on any path.
 
 Lengths are in mm, angles in rad.
 """
@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..extras import needs
-from ..wiring import FIVE_AXIS_JOINTS
+from ..loops.wiring import FIVE_AXIS_JOINTS
 
 STATISTICS = ("max", "mean")
 
@@ -85,7 +85,7 @@ def check_metrics(loop, metrics, interpolator_values=None, interpolator_variable
 @functools.lru_cache(maxsize=None)
 def _two_axis_reference(path):
     with needs("campaign"):
-        from ..reference_paths import ContourReference
+        from ..checks.reference_paths import ContourReference
 
     return ContourReference(path)
 
@@ -102,7 +102,7 @@ def errors(loop, trace, interpolator_values, interpolator_variables):
             pos = np.column_stack([trace["plant.pos.x"], trace["plant.pos.y"]])
             found["contour_error"] = _two_axis_reference(path).distance(pos)
     else:
-        from ..five_axis_truth import contour_errors
+        from ..checks.five_axis_truth import contour_errors
 
         def pivot(name):
             value = interpolator_values.get(name, interpolator_variables[name].start)

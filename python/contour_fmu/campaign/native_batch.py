@@ -1,5 +1,6 @@
-"""Runs on a worker: a batch of a campaign's runs through contour-cosim, the native master
-(engine = "native", the default), in a child process.
+"""Campaign: runs on a worker a batch of a campaign's runs through contour-cosim, the native
+master (engine = "native", the default), in a child process (contour_fmu.engines.native's
+Batch).
 
 The child steps the loop's FMUs at their own cost and answers each run line with the
 run's trajectory (`contour-cosim batch`: a JSON line per run, then its rows as f64); it
@@ -15,8 +16,6 @@ worker plugin (execute.CampaignFiles), as it gets the FMUs for fmpy; nothing nee
 installed on it but this package.
 """
 
-import json
-import signal
 import subprocess
 import tempfile
 import threading
@@ -25,10 +24,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import native, ssp
-from ..loops import LOOPS
+from ..engines import native
+from ..engines.native import Batch, Ended, RunFailed
+from ..loops import ssp
+from ..loops.wiring import LOOPS
 from . import metrics as campaign_metrics
-from .runner import ORDER, RunFailed, _scratch, worker_name
+from .runner import ORDER, _scratch, worker_name
 
 PROGRAM = "contour-cosim"
 _prepared = {}  # job key -> folder holding loop.ssd, the FMUs and contour-cosim
@@ -71,26 +72,13 @@ def check_program(folder):
                         f"{done.returncode}): {done.stderr.decode(errors='replace').strip()[-500:]}")
 
 
-def text(value):
-    """A start value as contour-cosim's --start reads it (exact for floats: repr)."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, float):
-        return repr(value)
-    return str(value)
-
-
 def command(job, folder):
     """contour-cosim's command line for the job's runs, read from its standard input."""
-    columns = _columns(job.loop)
-    args = [str(folder / PROGRAM), "batch", str(folder / "loop.ssd"), "--step", repr(job.step),
-            "--record", ",".join(f"{u}.{n}" for u, n in columns), "--timeout", repr(job.timeout)]
-    if job.stop is None:
-        args += ["--until", "interpolator.done", "--settle", repr(job.settle),
-                 "--max-stop", repr(job.max_stop)]
-    else:
-        args += ["--stop", repr(job.stop)]
-    return args
+    until = {} if job.stop is not None else {
+        "until": "interpolator.done", "settle": job.settle, "max_stop": job.max_stop}
+    return native.arguments(folder / "loop.ssd", step=job.step, stop=job.stop,
+                            record=_columns(job.loop), timeout=job.timeout, scheme=None,
+                            command="batch", executable=folder / PROGRAM, **until)
 
 
 def _columns(loop):
@@ -115,103 +103,7 @@ def _row(run_id, status, message, began, metrics, values=None):
     return row
 
 
-def _signal_name(number):
-    try:
-        return signal.Signals(number).name
-    except ValueError:
-        return f"signal {number}"
-
-
-class Ended(Exception):
-    """The child process ended before it answered a run: (exit status, its stderr)."""
-
-
-# contour-cosim batch's exit status after a run in which an FMU returned fmi2Fatal: the
-# run was answered, and the next needs a new process.
-FATAL_STATUS = 4
-# Seconds a child that was told to stop may take to end before it is killed.
-END_WAIT = 30.0
-
-
-class Child:
-    """A contour-cosim process of the job, kept for the batches that follow (its FMUs
-    unpacked and loaded once per worker process): a run line in, the run's result out.
-    A child that answers out of turn or garbled is killed: it is never read again."""
-
-    def __init__(self, job, folder):
-        self.errors = tempfile.TemporaryFile(dir=folder)
-        self.process = subprocess.Popen(command(job, folder), stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE, stderr=self.errors)
-        header = self.process.stdout.readline()
-        if not header:
-            self.ended()
-        try:
-            self.width = len(json.loads(header)["columns"])
-        except (ValueError, KeyError, TypeError):
-            self.garbled(f"a first line that is not its columns: {header[:200]!r}")
-
-    def ended(self, kill=False):
-        """Raises Ended with the exit status and what the child said."""
-        if kill:
-            self.process.kill()
-        for stream in (self.process.stdin, self.process.stdout):
-            try:
-                stream.close()
-            except OSError:  # a broken pipe: the child is gone
-                pass
-        try:
-            status = self.process.wait(timeout=END_WAIT)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            status = self.process.wait()
-        self.errors.seek(0)
-        said = self.errors.read().decode(errors="replace").strip()
-        self.errors.close()
-        raise Ended(status, said)
-
-    def garbled(self, what):
-        """Kills the child and raises RunFailed: its answers can no longer be trusted."""
-        try:
-            self.ended(kill=True)
-        except Ended:
-            pass
-        raise RunFailed(f"contour-cosim answered {what}")
-
-    def run(self, run_id, start_values):
-        """(head, table): the child's result line and, when ok, its rows t_0..t_k."""
-        starts = [[unit, name, text(value)] for unit in ORDER
-                  for name, value in start_values.get(unit, {}).items()]
-        try:
-            self.process.stdin.write((json.dumps({"run": run_id, "start": starts}) + "\n").encode())
-            self.process.stdin.flush()
-        except OSError:
-            self.ended()
-        line = self.process.stdout.readline()
-        if not line:
-            self.ended()
-        try:
-            head = json.loads(line)
-            answered, ok, steps = head["run"], head["status"] == "ok", int(head["steps"])
-        except (ValueError, KeyError, TypeError):
-            self.garbled(f"a line that is not a run's result: {line[:200]!r}")
-        if answered != run_id:
-            self.garbled(f"run {answered} for run {run_id}")
-        if not ok:
-            return head, None
-        size = (steps + 1) * self.width * 8
-        data = self.process.stdout.read(size)
-        if data is None or len(data) != size:
-            self.ended()
-        return head, np.frombuffer(data, dtype="<f8").reshape(steps + 1, self.width)
-
-    def close(self):
-        try:
-            self.ended()
-        except Ended:
-            pass
-
-
-_children = {}  # command line -> Child, for this process's lifetime
+_children = {}  # command line -> Batch, for this process's lifetime
 # A worker with several threads runs batches at once: one of them talks to the child at a
 # time (a pipe carries one conversation).
 _lock = threading.Lock()
@@ -224,7 +116,7 @@ def _child(job, folder):
         for other in _children.values():
             other.close()
         _children.clear()
-        _children[key] = Child(job, folder)
+        _children[key] = Batch(list(key), folder)
     return _children[key]
 
 
@@ -232,8 +124,8 @@ def _ended_row(run_id, ended, began, metrics):
     """The row of the run a child's end took: crashed, timeout; anything else raises."""
     status, said = ended.args
     if status < 0:
-        return _row(run_id, "crashed", f"the FMUs' process was killed by {_signal_name(-status)} "
-                    f"(signal {-status})", began, metrics)
+        return _row(run_id, "crashed", f"the FMUs' process was killed by "
+                    f"{native.signal_name(-status)} (signal {-status})", began, metrics)
     if status == native.TIMEOUT_STATUS:
         last = said.splitlines()[-1] if said else "an FMU call did not return in time"
         return _row(run_id, "timeout", last.removeprefix("contour-cosim: "), began, metrics)
@@ -245,10 +137,10 @@ def _answer(job, folder, run_id, start_values):
     fmi2Fatal in the run before is replaced and asked again."""
     for attempt in (1, 2):
         try:
-            return _child(job, folder).run(run_id, start_values)
+            return _child(job, folder).run(run_id, start_values, ORDER)
         except Ended as ended:
             _children.pop(tuple(command(job, folder)), None)
-            if ended.args[0] != FATAL_STATUS or attempt == 2:
+            if ended.args[0] != native.FATAL_STATUS or attempt == 2:
                 raise
         except RunFailed:
             _children.pop(tuple(command(job, folder)), None)

@@ -1,4 +1,4 @@
-"""A finished campaign's summary (OUT/summary.md) and plots (OUT/distribution.png,
+"""Campaign: a finished campaign's summary (OUT/summary.md) and plots (OUT/distribution.png,
 OUT/sensitivity.png).
 
 - The distribution of each metric per variant and path (box plots; the table gives the

@@ -1,4 +1,5 @@
-"""Runs on a worker: a batch of a campaign's runs through one set of FMU instances.
+"""Campaign: runs on a worker a batch of a campaign's runs through one set of FMU instances
+(the fmpy engine).
 
 A worker receives the FMU archives as bytes once, through a worker plugin (which Dask
 also gives a worker that joins or restarts later), and then parameter sets only, never
@@ -8,10 +9,10 @@ loops of simulations. A run that fails (an FMU returns fmi2Error, the path never
 becomes a row with status "error" and the FMU's own log message; the instances are then
 made anew, so the next run starts clean.
 
-The stepping is contour_fmu.master's, the Gauss-Seidel loop of contour_fmu.stepping
-(controller, plant, interpolator; each input refreshed from its source just before its
-FMU steps): a campaign run gives exactly what master.closed_loop gives for the same start
-values.
+The stepping is contour_fmu.engines.master's, the Gauss-Seidel loop of
+contour_fmu.engines.stepping (controller, plant, interpolator; each input refreshed from
+its source just before its FMU steps): a campaign run gives exactly what
+master.closed_loop gives for the same start values.
 """
 
 import atexit
@@ -26,10 +27,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fmu_log import ERROR, FmuLog
-from ..loops import LOOPS
-from ..master import free_all, set_value
-from ..stepping import Stepping
+from ..engines.fmu_log import ERROR, FmuLog
+from ..engines.master import free_all, set_value
+from ..engines.native import RunFailed  # a run that cannot finish, whichever engine
+from ..engines.stepping import Stepping
+from ..loops.wiring import LOOPS
 from . import metrics as campaign_metrics
 
 ORDER = ("controller", "plant", "interpolator")
@@ -48,10 +50,6 @@ class Job:
     interpolator_variables: dict  # name -> spec.Variable, for the metrics' defaults
     engine: str = "native"  # native (native_batch) or fmpy (here)
     timeout: float = 60.0  # seconds an FMU call may take (native engine)
-
-
-class RunFailed(RuntimeError):
-    """A run that cannot finish; its message goes into the row."""
 
 
 _extracted = {}  # SHA-256 -> unzip directory, for this process's lifetime
@@ -84,7 +82,7 @@ class LoopInstances:
         """directories: unit -> unzip directory."""
         from fmpy.fmi2 import FMU2Slave
 
-        from ..master import co_simulation_description
+        from ..engines.master import co_simulation_description
 
         self.loop = LOOPS[loop]
         self.log = FmuLog(least=ERROR)  # the reasons a run failed

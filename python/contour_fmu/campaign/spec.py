@@ -1,11 +1,11 @@
-"""A campaign file (TOML) read, checked against the FMUs' model descriptions and expanded
-into runs. Everything a user can get wrong is refused here, before any run starts, with
-a CampaignError that names the file and the entry.
+"""Campaign: a campaign file (TOML) read, checked against the FMUs' model descriptions and
+expanded into runs. Everything a user can get wrong is refused here, before any run starts,
+with a CampaignError that names the file and the entry.
 
 The file (every key but `loop` optional; docs/campaigns.md has the whole reference):
 
     name = "two-axis robustness"
-    loop = "two_axis"                  # or "five_axis" (contour_fmu.loops)
+    loop = "two_axis"                  # or "five_axis" (contour_fmu.loops.wiring)
     step = 0.001                       # communication step (s)
     stop = "end_of_path"               # or a stop time in seconds
     settle = 0.05                      # seconds run after the end of the path
@@ -55,7 +55,7 @@ from pathlib import Path
 
 from .. import repo
 from ..extras import needs
-from ..loops import LOOPS
+from ..loops.wiring import LOOPS
 from ..tuned import start_values as tuned_start_values
 from .metrics import METRICS, check_metrics
 
@@ -67,7 +67,7 @@ DEFAULT_MAX_STOP = 600.0
 MAX_RUNS = 1_000_000
 TOP_KEYS = {"name", "loop", "step", "stop", "settle", "max_stop", "metrics", "batch_size",
             "engine", "timeout", "fmus", "fixed", "paths", "variants", "sweep"}
-# Who steps the FMUs: contour-cosim (contour_fmu.native), or fmpy in the worker's Python.
+# Who steps the FMUs: contour-cosim (contour_fmu.engines.native), or fmpy in the worker's Python.
 ENGINES = ("native", "fmpy")
 AUTO = "auto"
 

@@ -1,4 +1,4 @@
-"""A campaign's result rows on disk, written as they arrive.
+"""Campaign: a campaign's result rows on disk, written as they arrive.
 
 OUT/rows/ holds one Parquet file per finished batch, each written under a temporary name
 and renamed, so a campaign killed at any moment leaves only whole files: nothing written

@@ -1,7 +1,7 @@
 //! A catalogue of bad inputs, one table: every FMI function called in a wrong state, NULL
 //! where an importer can err, NaN and infinities on every kind of input, integers out of
 //! range, absurd parameters, corrupt and foreign FMU state bytes, missing resources and
-//! malformed path files, on all six models (and FaultProbe for the Error and Fatal modes).
+//! malformed path files, on all eight models (and FaultProbe for the Error and Fatal modes).
 //!
 //! Each case asserts three things:
 //! - the exact status;

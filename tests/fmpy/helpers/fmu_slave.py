@@ -7,7 +7,7 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-from contour_fmu.fmu_log import FmuLog
+from contour_fmu.engines.fmu_log import FmuLog
 
 
 class Slave:

@@ -1,5 +1,5 @@
-"""The built-in paths rebuilt in Python, and the true contour error computed from them,
-independently of the Rust code.
+"""Reference check: the built-in paths rebuilt in Python, and the true contour error
+computed from them, independently of the Rust code.
 
 The NURBS `infinity` and `trident` come from the control points listed in docs/design/two-axis.md
 §4.6 (cubic, clamped uniform knots; evaluated with geomdl), the circle, line and arc from
@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .extras import needs
+from ..extras import needs
 
 with needs("reference"):
     from geomdl import NURBS

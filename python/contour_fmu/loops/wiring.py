@@ -1,21 +1,64 @@
-"""The closed loops an outside engine (libcosim, ecos, fmpy's container) can run, by name:
-which FMUs and how they are wired (the shipped SSP files, contour_fmu.wiring), what is
-recorded. One table, so that each engine runs either loop from the same code. It imports
-nothing that loads fmpy or an engine, so an engine's own process can use it.
-"""
+"""Loop wiring: the two-axis and five-axis loops as every master runs them, read from the
+shipped SSP files (contour_fmu/loops/*.ssd, through contour_fmu.loops.ssp): their FMUs,
+connections and initial copies, by name with what each engine records (LOOPS), and the
+NC -> drive -> mechanics wiring of a foreign plant. Standard library only, so an engine's
+own process can use it without loading fmpy."""
 
 import argparse
 from dataclasses import dataclass
 from pathlib import Path
 
-from .ssp import SystemStructure
-from .wiring import FIVE_AXIS, FIVE_AXIS_JOINTS, TWO_AXIS
+from .ssp import SystemStructure, shipped
+
+TWO_AXIS = shipped("two_axis")
+FIVE_AXIS = shipped("five_axis")
+
+# Every step: the reference (with its velocity and acceleration, for the controller's
+# feed-forward), the measured position, the command.
+CLOSED_LOOP_CONNECTIONS = TWO_AXIS.connections
+# Once in initialization mode: the plant starts where the path does.
+PATH_START = TWO_AXIS.initial_copies
+
+FIVE_AXIS_JOINTS = ("X", "Y", "Z", "A", "C")
+
+# The five-axis loop: PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant.
+FIVE_AXIS_CONNECTIONS = FIVE_AXIS.connections
+# The plant starts at the path's start joints.
+FIVE_AXIS_PATH_START = FIVE_AXIS.initial_copies
+
+
+# NC -> drive -> the user's mechanics, for each of X and Y: the interpolator and the
+# controller, one ServoDrive per axis ("drive_x", "drive_y") and one mechanical axis FMU
+# per axis ("axis_x", "axis_y": force or torque in as `force_input`, position and velocity
+# out as `position_output`, `velocity_output`). Nothing is computed between the FMUs.
+def drive_loop_connections(force_input="F", position_output="x", velocity_output="v"):
+    connections = [
+        (source, output, "controller", input)
+        for source, output, destination, input in CLOSED_LOOP_CONNECTIONS
+        if source == "interpolator"
+    ]
+    for a in ("x", "y"):
+        connections += [
+            (f"axis_{a}", position_output, "controller", f"pos.{a}"),
+            ("controller", f"u.{a}", f"drive_{a}", "u"),
+            (f"axis_{a}", velocity_output, f"drive_{a}", "vel"),
+            (f"drive_{a}", "effort", f"axis_{a}", force_input),
+        ]
+    return connections
+
+
+def drive_loop_start(position_start="x0"):
+    """The mechanics start where the path does."""
+    return [("interpolator", f"ref.{a}", f"axis_{a}", position_start) for a in ("x", "y")]
+
+
+# --- the loops by name, for the engines (libcosim, ecos, the container, campaigns) ---------
 
 
 @dataclass(frozen=True)
 class Loop:
     structure: SystemStructure  # the FMUs and their wiring, from the loop's SSP file
-    recorded: list  # Real outputs every engine records; contour_fmu.master records them too
+    recorded: list  # Real outputs every engine records (contour_fmu.engines.master too)
     more_outputs: list  # further outputs a container FMU exposes
     parameters: list  # start values a container FMU exposes (besides the path_start targets)
     container_name: str

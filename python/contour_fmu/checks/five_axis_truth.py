@@ -1,6 +1,7 @@
-"""True five-axis contour errors of an FMU run, computed in Python independently of the
-Rust code: the machine's forward kinematics (docs/design/five-axis.md §5.1) written out again with
-numpy, and the nearest point on the reference found by brute force.
+"""Reference check: true five-axis contour errors of an FMU run, computed in Python
+independently of the Rust code: the machine's forward kinematics
+(docs/design/five-axis.md §5.1) written out again with numpy, and the nearest point on
+the reference found by brute force.
 
 The reference is the interpolator's own output, one pose per sample (0.05 mm apart at
 50 mm/s). Between samples the tip path is taken as the Catmull-Rom cubic through the

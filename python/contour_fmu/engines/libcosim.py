@@ -1,10 +1,11 @@
-"""Runs a closed loop (by default PathInterpolator2D -> ContourCCC2D <- XYServoPlant, with
---loop five_axis PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant; see
-contour_fmu.loops) in libcosim (libcosimpy) and prints the trajectories as one line of JSON.
+"""Engine: libcosim (libcosimpy) runs a closed loop (by default PathInterpolator2D ->
+ContourCCC2D <- XYServoPlant, with --loop five_axis PathInterpolator5X -> ContourCCC5X <-
+FiveAxisPlant; see contour_fmu.loops.wiring) and prints the trajectories as one line of
+JSON.
 
 Kept in its own process: libcosim can take the interpreter down on a broken FMU.
-usage: python -m contour_fmu.cosim_closed_loop [--loop two_axis|five_axis] [--ssp]
-                                               FMU_DIR STEP_NS STEPS [UNIT.VARIABLE=VALUE ...]
+usage: python -m contour_fmu.engines.libcosim [--loop two_axis|five_axis] [--ssp]
+                                              FMU_DIR STEP_NS STEPS [UNIT.VARIABLE=VALUE ...]
 
 By default the script adds the loop's FMUs and connections itself; with --ssp libcosim
 reads them from the loop's SSP file beside the FMUs (FMU_DIR/<loop>.ssd, which make fmus
@@ -29,8 +30,8 @@ Needs the engines extra (libcosimpy).
 import json
 import sys
 
-from .extras import needs
-from .loops import engine_arguments
+from ..extras import needs
+from ..loops.wiring import engine_arguments
 
 with needs("engines"):
     from libcosimpy.CosimEnums import CosimVariableType

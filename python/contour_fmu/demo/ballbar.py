@@ -1,5 +1,6 @@
-"""The ballbar demo: the circular test of ISO 230-4 on XYServoPlant with friction, through
-the FMUs, without CCC, with the fuzzy-PID CCC, and with the CCC and velocity feed-forward.
+"""Demo: the ballbar demo, the circular test of ISO 230-4 on XYServoPlant with friction,
+through the FMUs, without CCC, with the fuzzy-PID CCC, and with the CCC and velocity
+feed-forward.
 
 As a ballbar test runs it: a 50 mm circle at F1000 (mm/min) about the origin, entered
 and left along half-circle arcs of half the radius from the centre (so the start transient
@@ -8,7 +9,7 @@ is not the circle's deviation), counter-clockwise and clockwise, planned within
 makes the quadrant glitches. `contour-eval --circle` (the Rust tool) gives the figures on
 the samples whose reference is on the circle, and draws out/ballbar_<controller>.png.
 
-usage: python -m contour_fmu.ballbar_demo [--fmu-dir DIR] [--out DIR]
+usage: python -m contour_fmu.demo.ballbar [--fmu-dir DIR] [--out DIR]
 """
 
 import argparse
@@ -18,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from . import repo
-from .master import closed_loop
-from .output_files import write_csv
+from .. import repo
+from ..engines.master import closed_loop
+from ..output_files import write_csv
 
 RADIUS = 50.0  # mm, a ballbar's
 FEED = 1000.0  # mm/min
@@ -112,7 +113,7 @@ def print_table(results):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m contour_fmu.ballbar_demo")
+    parser = argparse.ArgumentParser(prog="python -m contour_fmu.demo.ballbar")
     parser.add_argument("--fmu-dir", type=Path, default=repo.fmu_dir())
     parser.add_argument("--out", type=Path, default=repo.out_dir())
     args = parser.parse_args(argv)

@@ -1,4 +1,4 @@
-"""FMUs' log messages kept in Python: fmpy's FMI 2.0 callbacks with a logger that
+"""Engine: FMUs' log messages kept in Python, fmpy's FMI 2.0 callbacks with a logger that
 collects the messages (formatted by fmpy's native proxy, which applies the variadic "%s"
 arguments the way a C importer would). Used by the campaigns' runner and the tests."""
 

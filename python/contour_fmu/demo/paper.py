@@ -1,9 +1,9 @@
-"""The paper's comparison of contour error with and without CCC, through the FMUs.
+"""Demo: the paper's comparison of contour error with and without CCC, through the FMUs.
 
 PathInterpolator2D -> ContourCCC2D <- XYServoPlant, stepped by the fixed-step master of
-contour_fmu.master (fmpy's FMU2Slave), on the circle, the infinity curve and the trident:
-without CCC, with the fuzzy-PID CCC and the paper's factors, and with factors tuned by PSO
-(`ccc-tune`, applied as start values).
+contour_fmu.engines.master (fmpy's FMU2Slave), on the circle, the infinity curve and the
+trident: without CCC, with the fuzzy-PID CCC and the paper's factors, and with factors
+tuned by PSO (`ccc-tune`, applied as start values).
 
 Every controller also runs on the mirror image of each path (about the x axis, so the
 circle turns clockwise): a controller must not care about the direction of travel, and
@@ -14,42 +14,26 @@ fitness histories (standard vs improved, like the paper's Figures 10 and 13), an
 cross-check files of ContourCCC2D (out/cross-check/ContourCCC2D/: _in.csv, _ref.csv,
 _ref.opt) from the fuzzy circle run.
 
-Then the part demo (contour_fmu.part_demo): the G-code part examples/parts/bracket.ngc
-planned within acceleration and jerk limits, without and with the CCC, on the part and on
-its mirror image; a table, CSVs and out/part_bracket.png. Then the ballbar test of ISO 230-4
-on the plant with friction (contour_fmu.ballbar_demo: no CCC, CCC, CCC + feed-forward;
-out/ballbar_*.png). Then the five-axis demo.
-
-usage: python -m contour_fmu.demo [--fmu-dir DIR] [--out DIR]
-                                  [--tune | --params tuned.json] [--ccc-tune PROGRAM]
-
---tune runs ccc-tune (improved and standard PSO, the paper's budget, fitness = max
-|true contour error|) on each path; --params applies one ccc-tune result to every path.
-The defaults are in the checkout <repo> (contour_fmu.repo: $CONTOUR_FMU_REPO, else the
-working directory or a parent of it, else the checkout the package is installed from in
-editable mode): <repo>/target/fmu, <repo>/out, <repo>/target/release/ccc-tune.
-
+`python -m contour_fmu.demo` runs it first, then the part, ballbar and five-axis demos.
 Needs the plots and reference extras (matplotlib; geomdl, scipy).
 """
 
-import argparse
 import json
 import math
 import subprocess
-from pathlib import Path
 
 import numpy as np
 
-from . import ballbar_demo, five_axis_demo, part_demo, repo
-from .extras import needs
-from .master import closed_loop
-from .output_files import write_csv
-from .output_files import write_cross_check as write_cross_check_files
-from .tuned import start_values
+from ..engines.master import closed_loop
+from ..extras import needs
+from ..output_files import write_csv
+from ..output_files import write_cross_check as write_cross_check_files
+from ..tuned import start_values
+from . import part
 
 with needs("plots", "reference"):
     import matplotlib  # noqa: F401  the plots, here so that a missing one stops us before any run
-    from .reference_paths import INFINITY, TRIDENT, ContourReference, clamped_uniform
+    from ..checks.reference_paths import INFINITY, TRIDENT, ContourReference, clamped_uniform
 
 STEP = 1e-3
 
@@ -59,7 +43,7 @@ PATHS = [("circle", 10 * math.pi), ("infinity", 50.0), ("trident", 50.0)]
 
 # No CCC and the fuzzy-PID CCC with the FMU's defaults (the paper's fuzzy factors), the
 # part demo's variants too.
-VARIANTS = part_demo.VARIANTS
+VARIANTS = part.VARIANTS
 
 
 # The tuner scores the maximum error: a part's tolerance band is about the worst point,
@@ -151,89 +135,46 @@ def plot(out, path, runs):
     plt.close(fig)
 
 
-FMUS = ("PathInterpolator2D.fmu", "ContourCCC2D.fmu", "XYServoPlant.fmu",
-        "PathInterpolator5X.fmu", "ContourCCC5X.fmu", "FiveAxisPlant.fmu")
-
-
-def build_ccc_tune():
-    """The cargo command that builds ccc-tune."""
-    return f"cargo build --release -p {repo.TUNER_PACKAGE} --bin ccc-tune"
-
-
-def parse_args(argv=None, prog="python -m contour_fmu.demo"):
-    """The options, with the defaults resolved in the checkout (only those needed: with
-    --fmu-dir and --out given, no checkout is needed unless --tune runs ccc-tune)."""
-    parser = argparse.ArgumentParser(
-        prog=prog, description=__doc__.splitlines()[0],
-        epilog=f"<repo> is the checkout: ${repo.ENV}, else the working directory or a parent of "
-               "it, else the checkout the package is installed from in editable mode; "
-               "$CARGO_TARGET_DIR replaces <repo>/target.")
-    parser.add_argument("--fmu-dir", type=Path, help="the FMUs (default: <repo>/target/fmu)")
-    parser.add_argument("--out", type=Path, help="the output folder (default: <repo>/out)")
-    choice = parser.add_mutually_exclusive_group()
-    choice.add_argument("--tune", action="store_true", help="tune each path with ccc-tune")
-    choice.add_argument("--params", type=Path, help="a ccc-tune JSON applied to every path")
-    parser.add_argument("--ccc-tune", type=Path,
-                        help="the tuner, for --tune (default: <repo>/target/release/ccc-tune)")
-    args = parser.parse_args(argv)
-    try:
-        args.fmu_dir = args.fmu_dir or repo.fmu_dir()
-        args.out = args.out or repo.out_dir()
-        if args.tune:
-            args.ccc_tune = args.ccc_tune or repo.ccc_tune()
-    except repo.RepoNotFound as e:
-        parser.error(str(e))
-    missing = [name for name in FMUS if not (args.fmu_dir / name).is_file()]
-    if missing:
-        parser.error(f"no {', '.join(missing)} in {args.fmu_dir}: build the FMUs with "
-                     "`cargo run --release -p fmu-build` (or `make fmus`), or give --fmu-dir")
-    if args.tune and not args.ccc_tune.is_file():
-        parser.error(f"no ccc-tune at {args.ccc_tune}: build it with `{build_ccc_tune()}` "
-                     "or give --ccc-tune")
-    if args.params and not args.params.is_file():
-        parser.error(f"no parameter file {args.params}")
-    if not repo.contour_eval().is_file():
-        parser.error(f"no contour-eval at {repo.contour_eval()} (the ballbar test runs "
-                     "it): build it with `cargo build --release -p contour-eval`")
-    return args
-
-
-def main(argv=None, prog="python -m contour_fmu.demo"):
-    args = parse_args(argv, prog)
-    args.out.mkdir(parents=True, exist_ok=True)
-
+def paper_demo(fmu_dir, out, ccc_tune=None, params=None):
+    """Runs every path with every variant, and on its mirror image: with `ccc_tune` (the
+    program) also with factors it tunes on the path, with `params` (a ccc-tune JSON) with
+    those. Writes the CSVs, plots and cross-check files to `out`; returns the table's rows
+    (path, feed, controller, max, mean, max and mean on the mirror image, reductions)."""
     rows = []
     for path, feed in PATHS:
         variants = list(VARIANTS)
-        if args.tune:
+        if ccc_tune:
             histories = {}
             for algorithm in ("improved", "standard"):
-                document = tune(args.ccc_tune, args.out, path, feed, algorithm)
+                document = tune(ccc_tune, out, path, feed, algorithm)
                 histories[algorithm] = json.loads(document.read_text())["history_mm"]
-            plot_histories(args.out, path, histories)
+            plot_histories(out, path, histories)
             for algorithm in ("improved", "standard"):
-                variants.append((f"PSO {algorithm}", start_values(args.out / f"tuned_{path}_{algorithm}.json")))
-        elif args.params:
-            variants.append(("PSO-tuned CCC", start_values(args.params)))
-        mirror = mirrored_interpolator(path, args.out)
+                variants.append((f"PSO {algorithm}", start_values(out / f"tuned_{path}_{algorithm}.json")))
+        elif params:
+            variants.append(("PSO-tuned CCC", start_values(params)))
+        mirror = mirrored_interpolator(path, out)
         runs, mirrored_runs = [], []
         for label, controller in variants:
-            before, after, error = run_path(args.fmu_dir, path, feed, controller)
+            before, after, error = run_path(fmu_dir, path, feed, controller)
             runs.append((label, before, error))
             columns = {name: before[name] for name in before.dtype.names}
             columns["trueContourError"] = error
-            write_csv(args.out / f"{path}_{label.replace(' ', '_')}.csv", columns)
+            write_csv(out / f"{path}_{label.replace(' ', '_')}.csv", columns)
             if path == "circle" and controller == {}:
-                write_cross_check(args.out, before, after)
-            _, _, mirrored_error = run_path(args.fmu_dir, path, feed, controller, mirror)
+                write_cross_check(out, before, after)
+            _, _, mirrored_error = run_path(fmu_dir, path, feed, controller, mirror)
             mirrored_runs.append(mirrored_error)
-        plot(args.out, path, runs)
+        plot(out, path, runs)
         base_max, base_mean = runs[0][2].max(), runs[0][2].mean()
         for (label, _, error), mirrored_error in zip(runs, mirrored_runs):
             rows.append((path, feed, label, error.max(), error.mean(), mirrored_error.max(),
                          mirrored_error.mean(), 100 * (1 - error.max() / base_max),
                          100 * (1 - error.mean() / base_mean)))
+    return rows
 
+
+def print_table(rows):
     print("Closed loop through the FMUs (PathInterpolator2D -> ContourCCC2D <- XYServoPlant), Ts = 1 ms;")
     print("|true contour error| in um on the path and on its mirror image (y -> -y, reversed turning sense)")
     print(f"{'path':9} {'feed mm/s':>9}  {'controller':15} {'max':>8} {'mean':>8} {'max mir.':>9} "
@@ -241,20 +182,3 @@ def main(argv=None, prog="python -m contour_fmu.demo"):
     for path, feed, label, emax, emean, mmax, mmean, rmax, rmean in rows:
         print(f"{path:9} {feed:9.2f}  {label:15} {emax * 1e3:8.3f} {emean * 1e3:8.3f} {mmax * 1e3:9.3f} "
               f"{mmean * 1e3:9.3f} {rmax:10.1f} {rmean:11.1f}")
-    print()
-    program = part_demo.default_program()
-    if program is None:
-        print(f"the part demo skipped: no checkout holds {part_demo.PROGRAM.as_posix()}")
-    else:
-        part_demo.print_table(part_demo.part_demo(args.fmu_dir, args.out, program))
-    print()
-    ballbar_demo.print_table(ballbar_demo.ballbar_demo(args.fmu_dir, args.out))
-    print()
-    five_axis_rows = five_axis_demo.main(args.fmu_dir, args.out)
-    five_axis_demo.print_table(five_axis_rows)
-    print(f"wrote CSV, PNG and cross-check files to {args.out}")
-    return rows
-
-
-if __name__ == "__main__":
-    main()

@@ -1,8 +1,9 @@
-"""The loops as SSP 1.0 system structure descriptions (.ssd): which FMUs, how they are
-wired, the start values of each built-in path, and what SSP itself has no word for (the
-order a Gauss-Seidel master steps the units in, and outputs copied onto parameters once in
-initialization mode), in an annotation of ours. Standard library only: any process can
-read a loop without loading fmpy or an engine.
+"""Loop wiring: the SSP 1.0 format of the loops, system structure descriptions (.ssd)
+read and written: which FMUs, how they are wired, the start values of each built-in path,
+and what SSP itself has no word for (the order a Gauss-Seidel master steps the units in,
+and outputs copied onto parameters once in initialization mode), in an annotation of
+ours. Standard library only: any process can read a loop without loading fmpy or an
+engine.
 """
 
 import re
@@ -16,7 +17,7 @@ SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
 LOOP = "urn:contour-fmu:ssp:loop"
 LOOP_ANNOTATION = "com.contour-fmu.loop"
 # The folder of the loops shipped with the package.
-SHIPPED = Path(__file__).resolve().parent / "loops"
+SHIPPED = Path(__file__).resolve().parent
 # xs:boolean is true, false, 1 or 0.
 TYPES = {"Real": float, "Integer": int, "Boolean": lambda text: {"true": True, "1": True,
                                                                  "false": False, "0": False}[text],
@@ -222,7 +223,7 @@ def si_variant(file, model_descriptions):
     """The text of the SSP file `file` for the SI build: every Real start value of a
     length (a variable the mm model description in `model_descriptions`, a folder of
     <Model>.xml, declares in mm, mm/s, ...) in metres; the rest unchanged, line for line.
-    make fmus puts the result beside the SI FMUs (python -m contour_fmu.ssp writes them)."""
+    make fmus puts the result beside the SI FMUs (python -m contour_fmu.loops.ssp writes them)."""
     file = Path(file)
     scale_of = {}
     for component, source in read(file).units.items():
@@ -241,8 +242,8 @@ def si_variant(file, model_descriptions):
             value = float(parameter.group(2)) * scale_of[component, parameter.group(1)]
             line = line.replace(f'value="{parameter.group(2)}"', f'value="{value!r}"')
         line = line.replace("copies it into target/fmu.", "copies it into target/fmu-si.")
-        line = line.replace("The loop every contour_fmu master runs (contour_fmu.wiring reads this file).",
-                            "The SI build's copy, lengths in m (python -m contour_fmu.ssp writes it).")
+        line = line.replace("The loop every contour_fmu master runs (contour_fmu.loops.wiring reads this file).",
+                            "The SI build's copy, lengths in m (python -m contour_fmu.loops.ssp writes it).")
         lines.append(line)
     return "".join(lines)
 

@@ -1,12 +1,13 @@
-"""The fixed-step stepping loop of contour_fmu.master and of the campaigns' runner: FMU2Slaves
-stepped one communication step at a time in a given order, their connections and the
-recorded variables resolved to value references once.
+"""Engine: the fixed-step stepping loop of the fmpy master (contour_fmu.engines.master) and
+of the campaigns' runner: FMU2Slaves stepped one communication step at a time in a given
+order, their connections and the recorded variables resolved to value references once.
 
-Two coupling schemes (contour_fmu.master explains them): "gauss-seidel", each FMU's inputs
-set from their sources just before it steps; "jacobi", every input set from the outputs
-at t_k, then every FMU steps. Consecutive connections between the same two FMUs (of the
-same types) are transferred with one get and one set, and consecutive recorded variables of
-one FMU and type read with one get: the values are those of one call per variable.
+Two coupling schemes (contour_fmu.engines.master explains them): "gauss-seidel", each
+FMU's inputs set from their sources just before it steps; "jacobi", every input set from
+the outputs at t_k, then every FMU steps. Consecutive connections between the same two
+FMUs (of the same types) are transferred with one get and one set, and consecutive
+recorded variables of one FMU and type read with one get: the values are those of one
+call per variable.
 """
 
 SCHEMES = ("gauss-seidel", "jacobi")

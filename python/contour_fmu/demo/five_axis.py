@@ -1,11 +1,11 @@
-"""The five-axis part of the demo: PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant
-through the fmpy master, without and with the five-axis CCC, on the two built-in paths,
-the example CL part (examples/cl/blade.cl, which PathInterpolator5X carries in its
-resources as blade.cl) and a hemisphere finishing raster with the tool normal to the
-surface, over the apex and beside it (contour_fmu.cam_paths, written to OUT), with the
-true contour errors computed in Python (contour_fmu.five_axis_truth). The reference is
-planned within the machine's default limits (docs/design/five-axis.md §5.3b); for the
-domes a plot shows every joint's speed and acceleration against its limit.
+"""Demo: the five-axis demo, PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant through the
+fmpy master, without and with the five-axis CCC, on the two built-in paths, the example CL
+part (examples/cl/blade.cl, which PathInterpolator5X carries in its resources as blade.cl)
+and a hemisphere finishing raster with the tool normal to the surface, over the apex and
+beside it (contour_fmu.demo.cam_paths, written to OUT), with the true contour errors
+computed in Python (contour_fmu.checks.five_axis_truth). The reference is planned within the
+machine's default limits (docs/design/five-axis.md §5.3b); for the domes a plot shows every
+joint's speed and acceleration against its limit.
 
 Writes to OUT: one CSV per run (joints, commands, estimates, true errors), one PNG per
 path (the tool-tip path with tool-axis glyphs, tip and orientation error against time)
@@ -16,12 +16,12 @@ need the plots extra (matplotlib).
 
 import numpy as np
 
+from ..checks.five_axis_truth import contour_errors, forward
+from ..engines.master import Master, Unit, five_axis_closed_loop
+from ..extras import needs
+from ..loops.wiring import FIVE_AXIS_JOINTS
+from ..output_files import write_cross_check, write_csv
 from . import cam_paths
-from .extras import needs
-from .five_axis_truth import contour_errors, forward
-from .master import Master, Unit, five_axis_closed_loop
-from .output_files import write_cross_check, write_csv
-from .wiring import FIVE_AXIS_JOINTS
 
 STEP = 1e-3
 SETTLE = 0.1  # seconds run after the reference is done, as the in-process simulator

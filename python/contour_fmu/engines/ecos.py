@@ -1,18 +1,18 @@
-"""Runs a closed loop (by default PathInterpolator2D -> ContourCCC2D <- XYServoPlant, with
---loop five_axis PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant; see
-contour_fmu.loops) in ecos (the ecospy package) and prints the trajectories as one line of
+"""Engine: ecos (the ecospy package) runs a closed loop (by default PathInterpolator2D ->
+ContourCCC2D <- XYServoPlant, with --loop five_axis PathInterpolator5X -> ContourCCC5X <-
+FiveAxisPlant; see contour_fmu.loops.wiring) and prints the trajectories as one line of
 JSON.
 
 Kept in its own process: ecos is native code that can take the interpreter down on a broken
 FMU, and it loads its own copy of each FMU.
-usage: python -m contour_fmu.ecos_closed_loop [--loop two_axis|five_axis] FMU_DIR STEP STEPS
-                                              [UNIT.VARIABLE=VALUE ...]
+usage: python -m contour_fmu.engines.ecos [--loop two_axis|five_axis] FMU_DIR STEP STEPS
+                                          [UNIT.VARIABLE=VALUE ...]
 
 Values are typed by their text: true/false -> Boolean, an integer -> Integer, a number ->
 Real, anything else -> String (ecospy picks the setter from the Python type). They go into
 an ecos parameter set applied in initialization mode; this is also how the plant's pos0.*
 get the path's start point (ecos connections are transferred at every step, so they cannot
-carry an output onto a fixed parameter once, as contour_fmu.master's PATH_START does).
+carry an output onto a fixed parameter once, as contour_fmu.engines.master's initial copies do).
 
 The printed object holds
 - "initial": {"unit.variable": value} after ecos' init() (outputs at t_0);
@@ -27,8 +27,8 @@ Needs the engines extra (ecospy, whose engine needs Debian's libtbb12).
 import json
 import sys
 
-from .extras import needs
-from .loops import engine_arguments
+from ..extras import needs
+from ..loops.wiring import engine_arguments
 
 with needs("engines"):
     from ecospy import EcosLib, EcosSimulation, EcosSimulationStructure, SimulationListener

@@ -1,6 +1,7 @@
-"""Packs a closed loop (by default PathInterpolator2D -> ContourCCC2D <- XYServoPlant, or
-PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant; see contour_fmu.loops) into one FMI 2.0
-co-simulation container FMU with fmpy.container_fmu.
+"""Engine: fmpy's container FMU, a closed loop (by default PathInterpolator2D ->
+ContourCCC2D <- XYServoPlant, or PathInterpolator5X -> ContourCCC5X <- FiveAxisPlant; see
+contour_fmu.loops.wiring) packed into one FMI 2.0 co-simulation container FMU with
+fmpy.container_fmu.
 
 The container exposes the loop's outputs and some parameters as "<component>.<variable>",
 among them the targets of the loop's path_start (the plant's pos0.*): the container's
@@ -35,7 +36,7 @@ from fmpy.container_fmu.config import Component, Connection
 from fmpy.model_description import (CoSimulation, DefaultExperiment, ModelDescription,
                                     ModelVariable, Unknown)
 
-from .loops import LOOPS
+from ..loops.wiring import LOOPS
 
 _FMI3_TYPES = {"Real": "Float64", "Integer": "Int32", "Enumeration": "Int32"}
 
@@ -66,7 +67,7 @@ def _as_fmi3_type(variable):
 
 def build_container(fmu_dir, workdir, step=1e-3, stop=2.0, order=None, parallel_do_step=False,
                     loop="two_axis"):
-    """Writes the container FMU of `loop` (a name in contour_fmu.loops.LOOPS) into
+    """Writes the container FMU of `loop` (a name in contour_fmu.loops.wiring.LOOPS) into
     `workdir` and returns its path (ContourLoop.fmu for the two-axis loop).
 
     order: the components' order in container.json, in which the runtime steps them
@@ -101,7 +102,7 @@ def build_container(fmu_dir, workdir, step=1e-3, stop=2.0, order=None, parallel_
         modelName=loop.container_name,
         instantiationToken="{" + str(uuid.uuid4()) + "}",
         description=f"{loop.title} in an fmpy container",
-        generationTool="contour_fmu.container_build (fmpy.container_fmu)",
+        generationTool="contour_fmu.engines.container_build (fmpy.container_fmu)",
         variableNamingConvention="structured",
         coSimulation=CoSimulation(modelIdentifier="container_fmu", fixedInternalStepSize=step,
                                   canHandleVariableCommunicationStepSize=False),

@@ -1,5 +1,6 @@
-"""CL data shaped like a five-axis CAM system's output, for the tests and the demo: the
-tool normal to a surface, through or beside vertical (docs/design/five-axis.md §5.3b).
+"""Demo: CL data shaped like a five-axis CAM system's output, for the five-axis demo and the
+tests: the tool normal to a surface, through or beside vertical (docs/design/five-axis.md
+§5.3b).
 
 Each function returns APT text (`GOTO/x,y,z,i,j,k`, mm, workpiece frame)."""
 
