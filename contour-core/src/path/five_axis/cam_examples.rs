@@ -1,6 +1,6 @@
 //! Poses shaped like a five-axis CAM system's CL data, for tests and benchmarks: the tool
 //! normal to a surface, through or beside vertical (docs/design/five-axis.md §5.3b). The
-//! Python package writes the same shapes as CL files (`contour_fmu.cam_paths`).
+//! Python package writes the same shapes as CL files (`contour_fmu.demo.cam_paths`).
 
 use crate::geometry::Vector;
 use crate::kinematics::Pose;
