@@ -13,6 +13,7 @@ mod instance;
 mod logger;
 mod registry;
 mod resource_uri;
+mod slab;
 mod state_machine;
 mod status;
 
