@@ -12,8 +12,7 @@ use super::line_arc_parameters;
 use super::path_parameter;
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
-use crate::framework::state_check;
-use crate::framework::state_codec::{SavedState, StateLayout};
+use crate::framework::saved_state::{self, SavedState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, AxisUnit, XY};
 use crate::framework::variables::{EnumItem, EnumType, Start, Values, Variable};
 use contour_core::contour::planar::{
@@ -183,7 +182,7 @@ struct State {
 impl SavedState for State {
     /// Checks a restored state like the parameters it was built from; the error names
     /// the offending value.
-    fn validate(&self, time: f64) -> Result<(), String> {
+    fn validate(&self, time: f64, _environment: &Environment) -> Result<(), String> {
         self.clock.validate_at(time)?;
         controller_parameters::check_feed_forward(
             self.feed_forward,
@@ -216,8 +215,8 @@ impl SavedState for State {
                 config.ts,
             )?;
         }
-        state_check::all_positive(self, "radius").map_err(|e| format!("estimator: {e}"))?;
-        state_check::all_finite(self)
+        saved_state::all_positive(self, "radius").map_err(|e| format!("estimator: {e}"))?;
+        saved_state::all_finite(self)
     }
 }
 
@@ -383,7 +382,7 @@ impl Model for ContourCCC2D {
         std::mem::take(&mut self.warnings)
     }
 
-    crate::framework::state_codec::sampled_state_methods!(State, LAYOUT);
+    crate::framework::saved_state::sampled_state_methods!(State, LAYOUT);
 }
 
 #[cfg(test)]

@@ -14,7 +14,7 @@ use super::controller_parameters::{self, axis_gain, nonnegative};
 use super::{joint_limits_parameters, kinematics_parameters};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
-use crate::framework::state_codec::{SavedState, StateLayout};
+use crate::framework::saved_state::{SavedState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, AxisUnit, Int, XYZAC};
 use crate::framework::variables::{Start, Values, Variable};
 use contour_core::contour::five_axis::hmm::HmmParams;
@@ -260,7 +260,12 @@ pub static INFO: ModelInfo = ModelInfo {
     // Every output starts at 0: the control law first runs in fmi2DoStep.
     initial_dependencies: &[],
     initial_dependencies_on_some_paths: &[],
-    create: |_: &Environment| Box::new(ContourCCC5X { state: None }),
+    create: |environment: &Environment| {
+        Box::new(ContourCCC5X {
+            environment: environment.clone(),
+            state: None,
+        })
+    },
 };
 
 /// Version 1: `Option<State>` as below. Version 2: the controller carries the machine's
@@ -283,7 +288,7 @@ struct State {
 }
 
 impl SavedState for State {
-    fn validate(&self, time: f64) -> Result<(), String> {
+    fn validate(&self, time: f64, _environment: &Environment) -> Result<(), String> {
         self.clock.validate_at(time)?;
         controller_parameters::check_feed_forward(
             self.feed_forward,
@@ -323,6 +328,8 @@ impl SavedState for State {
 }
 
 pub struct ContourCCC5X {
+    /// For the check of a restored state (`sampled_state_methods!`).
+    environment: Environment,
     state: Option<State>,
 }
 
@@ -491,7 +498,7 @@ impl Model for ContourCCC5X {
         Ok(())
     }
 
-    crate::framework::state_codec::sampled_state_methods!(State, LAYOUT);
+    crate::framework::saved_state::sampled_state_methods!(State, LAYOUT);
 }
 
 #[cfg(test)]

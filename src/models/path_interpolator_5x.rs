@@ -13,7 +13,7 @@ use super::axis_variables::{REFERENCE_ACCELERATION_OUT, REFERENCE_OUT, REFERENCE
 use super::{joint_limits_parameters, kinematics_parameters};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
-use crate::framework::state_codec::{SavedState, StateLayout};
+use crate::framework::saved_state::{SavedState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, XYZAC};
 use crate::framework::variables::{Start, Values, Variable};
 use contour_core::limits::PathLimits;
@@ -218,9 +218,9 @@ struct State {
 }
 
 impl SavedState for State {
-    fn validate(&self, time: f64) -> Result<(), String> {
+    fn validate(&self, time: f64, _environment: &Environment) -> Result<(), String> {
         self.clock.validate_at(time)?;
-        // Not `state_check::all_finite`: it names every float of the path, megabytes of
+        // Not `saved_state::all_finite`: it names every float of the path, megabytes of
         // text for a built-in; the path checked itself when decoded, and `check` covers
         // the rest (a plan checked its place when restored).
         self.reference
@@ -364,7 +364,7 @@ impl Model for PathInterpolator5X {
         Ok(())
     }
 
-    crate::framework::state_codec::sampled_state_methods!(State, LAYOUT);
+    crate::framework::saved_state::sampled_state_methods!(State, LAYOUT);
 }
 
 impl PathInterpolator5X {
