@@ -14,6 +14,7 @@ use super::instance::Instance;
 use super::logger::{Category, Logger};
 use super::registry;
 use super::resource_uri::resource_dir;
+use super::slab::is_handle;
 use super::state_machine::{Call, Mode};
 use super::status::{Failure, Outcome, Status};
 use crate::framework::model::Environment;
@@ -612,8 +613,8 @@ pub unsafe extern "C" fn fmi2SetString(
 /// # Safety
 /// `slot` is NULL, one of our handles, or points to a writable `fmi2FMUstate`.
 unsafe fn state_slot<'a>(slot: *mut fmi2FMUstate) -> Outcome<&'a mut fmi2FMUstate> {
-    if registry::is_handle(slot as usize) {
-        // Live or freed, a handle of ours is not an address (see registry.rs).
+    if is_handle(slot as usize) {
+        // Live or freed, a handle of ours is not an address (see slab.rs).
         return Err(Failure::error(
             "the FMUstate* argument is an FMU state, not the address of a variable holding one",
         ));
@@ -630,14 +631,14 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUst
         let slot = state_slot(state)?;
         let existing = *slot as usize;
         // FMI 2.0: a non-NULL *FMUstate is an earlier state to be overwritten.
-        if existing != 0 && !instance.owns_state(existing) {
-            return Err(instance.unknown_state(existing));
+        if existing != 0 && !instance.states.contains(existing) {
+            return Err(instance.states.unknown(existing));
         }
         let bytes = instance.snapshot()?;
         if existing == 0 {
-            *slot = instance.new_state(bytes) as fmi2FMUstate;
+            *slot = instance.states.add(bytes) as fmi2FMUstate;
         } else {
-            instance.overwrite_state(existing, bytes)?;
+            instance.states.overwrite(existing, bytes)?;
         }
         Ok(())
     })
@@ -666,14 +667,14 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
         // address of the variable holding it. Dereferencing it (as the standard signature
         // asks) would read our own state object as a pointer and then free whatever that
         // points to: the SIGSEGV this used to be. Handles are never user-space addresses
-        // (registry.rs), so the misuse is recognised exactly, also with a freed state.
+        // (slab.rs), so the misuse is recognised exactly, also with a freed state.
         // We free the state and answer fmi2OK (with a warning in the log):
         // - memory stays safe either way: the importer's variable keeps the stale value,
         //   but every later use of it is looked up here first and refused, never read;
         // - refusing would leak the state until fmi2FreeInstance and, worse, end fmusim's
         //   run (it aborts on any status above fmi2OK), although the intent is clear.
-        if instance.owns_state(handle) {
-            instance.free_state(handle)?;
+        if instance.states.contains(handle) {
+            instance.states.free(handle)?;
             instance.log_warning(&format!(
                 "fmi2FreeFMUstate: the argument is the FMU state {handle:#x} itself, not the \
                  address of a variable holding it (an importer bug); the state was freed, \
@@ -681,10 +682,10 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
             ));
             return Ok(());
         }
-        if registry::is_handle(handle) {
+        if is_handle(handle) {
             // The same misuse with another instance's state or a freed one: refused, and
             // never dereferenced (a handle is not an address).
-            return Err(instance.unknown_state(handle));
+            return Err(instance.states.unknown(handle));
         }
         // FMI 2.0: a NULL pointer (or a variable holding NULL) is ignored.
         let Some(slot) = state.as_mut() else {
@@ -693,7 +694,7 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
         if slot.is_null() {
             return Ok(());
         }
-        instance.free_state(*slot as usize)?;
+        instance.states.free(*slot as usize)?;
         *slot = ptr::null_mut();
         Ok(())
     })
@@ -711,7 +712,7 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
         c,
         Call::FmuState("fmi2SerializedFMUstateSize"),
         |instance| {
-            let bytes = instance.state_bytes(state as usize)?;
+            let bytes = instance.states.bytes(state as usize)?;
             *size
                 .as_mut()
                 .ok_or_else(|| Failure::error("size is NULL"))? = bytes.len();
@@ -731,7 +732,7 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     size: usize,
 ) -> fmi2Status {
     dispatch(c, Call::FmuState("fmi2SerializeFMUstate"), |instance| {
-        let bytes = instance.state_bytes(state as usize)?;
+        let bytes = instance.states.bytes(state as usize)?;
         if size < bytes.len() {
             return Err(Failure::error(format!(
                 "buffer of {size} bytes is too small for the state's {} bytes",
@@ -760,10 +761,10 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
         let existing = *slot as usize;
         // A state of this instance is reused; anything else in the variable (NULL, or
         // whatever an importer left there) is replaced by a new state, never read.
-        if instance.owns_state(existing) {
-            instance.overwrite_state(existing, bytes.to_vec())?;
+        if instance.states.contains(existing) {
+            instance.states.overwrite(existing, bytes.to_vec())?;
         } else {
-            *slot = instance.new_state(bytes.to_vec()) as fmi2FMUstate;
+            *slot = instance.states.add(bytes.to_vec()) as fmi2FMUstate;
         }
         Ok(())
     })

@@ -2,12 +2,10 @@
 //! Every public method is one FMI function minus the C plumbing; the mode has already
 //! been checked against the state machine by the caller.
 
-use std::collections::BTreeMap;
 use std::ffi::CString;
 
-use super::fmu_state::{self, Snapshot};
+use super::fmu_state::{self, Snapshot, States};
 use super::logger::{to_c_string, Category, Logger};
-use super::registry::{self, StateOwner};
 use super::state_machine::{Call, Mode};
 use super::status::{Failure, Outcome, Status};
 use crate::framework::interface::Interface;
@@ -17,12 +15,6 @@ use crate::framework::variables::{Causality, Value, Values, VarType, Variability
 /// Relative tolerance when comparing the importer's communication point with our clock:
 /// importers accumulate time in floating point (fmpy: 0.009999999999999998).
 const TIME_TOLERANCE: f64 = 1e-9;
-
-/// An FMU state handed to the importer (its `fmi2FMUstate` is a registry handle).
-/// It holds the serialized snapshot, so serializing is a copy and every restore checks it.
-pub struct StoredState {
-    bytes: Vec<u8>,
-}
 
 /// What the per-sample calls need to know of a variable, by value reference (see
 /// [`Access::of`]): one byte instead of the table's row, checked once per value.
@@ -52,11 +44,6 @@ impl Access {
 
 pub struct Instance {
     pub info: &'static ModelInfo,
-    /// The handle the importer knows this instance by (its `fmi2Component`), set at
-    /// registration; the owner recorded for its FMU states.
-    pub handle: usize,
-    /// The instance name, for messages about FMU states that belong to it.
-    name: String,
     /// [`Access`] of every variable, by value reference.
     access: Box<[Access]>,
     /// The Real outputs, in table order: checked for overflow after each step.
@@ -82,18 +69,8 @@ pub struct Instance {
     pub logger: Logger,
     /// Strings handed out by the last `fmi2GetString`, valid until the next call.
     returned_strings: Vec<CString>,
-    /// The live FMU states of this instance, by handle (the registry knows them too).
-    states: BTreeMap<usize, Box<StoredState>>,
-}
-
-impl Drop for Instance {
-    /// The FMU states die with their instance: unregister them, also one created by a
-    /// call that was still running when another thread freed the instance.
-    fn drop(&mut self) {
-        for &handle in self.states.keys() {
-            registry::remove_state(handle);
-        }
-    }
+    /// The live FMU states of this instance; they die with it.
+    pub states: States,
 }
 
 fn time_matches(a: f64, b: f64) -> bool {
@@ -116,7 +93,6 @@ impl Instance {
         let info = interface.model;
         Instance {
             info,
-            name: name.to_owned(),
             access: interface.variables.iter().map(Access::of).collect(),
             real_outputs: info
                 .variables
@@ -138,9 +114,14 @@ impl Instance {
             needs_initialize: true,
             logger,
             returned_strings: Vec::new(),
-            handle: 0,
-            states: BTreeMap::new(),
+            states: States::new(name),
         }
+    }
+
+    /// The instance is in the registry as `handle` (its `fmi2Component`), the owner of
+    /// the FMU states it makes.
+    pub fn registered_as(&mut self, handle: usize) {
+        self.states.registered_as(handle);
     }
 
     pub fn log_event(&self, message: &str) {
@@ -637,79 +618,9 @@ impl Instance {
         Ok(())
     }
 
-    // -----------------------------------------------------------------------------------
-    // FMU state handles. The importer's `fmi2FMUstate` values are only ever used as keys
-    // here, never dereferenced: a freed, foreign or made-up handle is an error, not a read.
-
-    /// Whether `handle` is a live FMU state of this instance.
-    pub fn owns_state(&self, handle: usize) -> bool {
-        self.states.contains_key(&handle)
-    }
-
-    /// Why `handle` is not usable as an FMU state of this instance.
-    pub fn unknown_state(&self, handle: usize) -> Failure {
-        if handle == 0 {
-            return Failure::error("FMUstate is NULL");
-        }
-        match registry::state_owner(handle) {
-            Some(owner) if owner.handle != self.handle => Failure::error(format!(
-                "FMUstate {handle:#x} belongs to instance '{}', not to this one: an FMU state \
-                 can only be used with the instance that made it (serialize it and \
-                 deserialize it here to move it)",
-                owner.name
-            )),
-            _ => Failure::error(format!(
-                "FMUstate {handle:#x} is not a live FMU state of this instance (already \
-                 freed, or not an FMU state)"
-            )),
-        }
-    }
-
-    /// The stored bytes of one of this instance's FMU states.
-    pub fn state_bytes(&self, handle: usize) -> Outcome<&[u8]> {
-        self.states
-            .get(&handle)
-            .map(|s| s.bytes.as_slice())
-            .ok_or_else(|| self.unknown_state(handle))
-    }
-
-    /// Stores a new FMU state; returns its handle.
-    pub fn new_state(&mut self, bytes: Vec<u8>) -> usize {
-        let handle = registry::new_state_handle();
-        self.states.insert(handle, Box::new(StoredState { bytes }));
-        registry::add_state(
-            handle,
-            StateOwner {
-                handle: self.handle,
-                name: self.name.clone(),
-            },
-        );
-        handle
-    }
-
-    /// Replaces the bytes of one of this instance's FMU states.
-    pub fn overwrite_state(&mut self, handle: usize, bytes: Vec<u8>) -> Outcome {
-        match self.states.get_mut(&handle) {
-            Some(state) => {
-                state.bytes = bytes;
-                Ok(())
-            }
-            None => Err(self.unknown_state(handle)),
-        }
-    }
-
-    /// Frees one of this instance's FMU states.
-    pub fn free_state(&mut self, handle: usize) -> Outcome {
-        if self.states.remove(&handle).is_none() {
-            return Err(self.unknown_state(handle));
-        }
-        registry::remove_state(handle);
-        Ok(())
-    }
-
     /// Restores one of this instance's FMU states.
     pub fn restore_state(&mut self, handle: usize) -> Outcome {
-        let bytes = self.state_bytes(handle)?.to_vec();
+        let bytes = self.states.bytes(handle)?.to_vec();
         self.restore(&bytes)
     }
 

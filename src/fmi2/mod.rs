@@ -14,6 +14,7 @@ mod logger;
 mod plans;
 mod registry;
 mod resource_uri;
+mod slab;
 mod state_machine;
 mod status;
 

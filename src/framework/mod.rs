@@ -2,13 +2,12 @@
 //! knowing no FMU and no control law. A model declares its variables ([`variables`],
 //! assembled per axis by [`variable_table`], with [`units`] and fixed [`text`]), steps on
 //! a [`sample_clock`], implements [`model::Model`], and saves its state through
-//! [`state_codec`], checked on restore by [`state_check`].
+//! [`saved_state`], which also checks it on restore.
 
 pub mod interface;
 pub mod model;
 pub mod sample_clock;
-pub mod state_check;
-pub mod state_codec;
+pub mod saved_state;
 pub mod text;
 pub mod units;
 pub mod variable_table;

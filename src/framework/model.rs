@@ -56,14 +56,15 @@ pub trait Model: Send {
         Ok(())
     }
 
-    /// The internal state as bytes, for FMU state save/restore: [`encode_state`](super::state_codec::encode_state) with the
-    /// model's own [`StateLayout`](super::state_codec::StateLayout).
+    /// The internal state as bytes, for FMU state save/restore: [`encode_state`](super::saved_state::encode_state) with the
+    /// model's own [`StateLayout`](super::saved_state::StateLayout).
     fn save_state(&self) -> Result<Vec<u8>, String>;
 
     /// Checks bytes as [`Model::restore_state`] would, without applying them: the layout
     /// version, then every value like a parameter (periods, radii, finite memories) and,
     /// for a sampled model, that its sample clock is at `time`, the instance time saved
-    /// with the state. The error names the cause.
+    /// with the state (the model's one check: its [`SavedState`](super::saved_state::SavedState),
+    /// which sees the model's [`Environment`]). The error names the cause.
     fn check_state(&self, bytes: &[u8], time: f64) -> ModelResult;
 
     /// Restores what [`Model::save_state`] produced at instance time `time`; nothing

@@ -7,19 +7,20 @@ use super::axis_variables::{
     COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_ACCELERATION_IN, REFERENCE_IN,
     REFERENCE_VELOCITY_IN,
 };
-use super::controller_parameters::{self, axis_gain, nonnegative};
+use super::controller_parameters::{
+    self, axis_gain, nonnegative, ControllerState, SavedController,
+};
 use super::line_arc_parameters;
 use super::path_parameter;
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
-use crate::framework::state_check;
-use crate::framework::state_codec::{SavedState, StateLayout};
-use crate::framework::variable_table::{axis_block, variable_table, AxisUnit, XY};
+use crate::framework::saved_state::{self, StateLayout};
+use crate::framework::variable_table::{axis_block, variable_table, Axis, AxisUnit, XY};
 use crate::framework::variables::{EnumItem, EnumType, Start, Values, Variable};
 use contour_core::contour::planar::{Estimator, EstimatorKind, FreeCurveEstimator, ON_PATH};
 use contour_core::control::{
     CccConfig, ConfigError, ControllerConfig, CrossCoupledController, FuzzyFactor, FuzzyFactors,
-    Parameter, PidGains,
+    Parameter, Pid, PidGains,
 };
 use contour_core::geometry::{Vector, Vector2};
 
@@ -167,54 +168,34 @@ const LAYOUT: StateLayout = StateLayout {
     version: 5,
 };
 
-#[derive(Clone, serde::Serialize, serde::Deserialize)]
-struct State {
-    controller: CrossCoupledController<Estimator>,
-    clock: SampleClock,
-    /// The velocity feed-forward gain (`feedForward`).
-    feed_forward: f64,
-    /// The acceleration feed-forward time (`accelerationFeedForward`), s.
-    acceleration_feed_forward: f64,
-}
+type State = ControllerState<CrossCoupledController<Estimator>>;
 
-impl SavedState for State {
-    /// Checks a restored state like the parameters it was built from; the error names
-    /// the offending value.
-    fn validate(&self, time: f64) -> Result<(), String> {
-        self.clock.validate_at(time)?;
-        controller_parameters::check_feed_forward(
-            self.feed_forward,
-            self.acceleration_feed_forward,
-        )?;
-        let controller = &self.controller;
-        let config = controller.config();
-        config
-            .validate()
-            .map_err(|e| format!("controller configuration: {}", config_message(e)))?;
-        if self.clock.period() != config.ts {
-            return Err(format!(
-                "sample clock period {} s differs from the controller's Ts = {} s",
-                self.clock.period(),
-                config.ts
-            ));
-        }
-        for (axis, pid) in XY.iter().zip(controller.axes()) {
-            controller_parameters::check_pid(
-                &format!("{} position loop", axis.label),
-                pid,
-                config.ts,
-            )?;
-        }
-        controller_parameters::check_pid("contour PID", controller.law().pid(), config.ts)?;
+impl SavedController for CrossCoupledController<Estimator> {
+    const AXES: &'static [Axis] = &XY;
+
+    fn ts(&self) -> f64 {
+        self.config().ts
+    }
+
+    fn check_config(&self) -> Result<(), String> {
+        self.config().validate().map_err(config_message)
+    }
+
+    fn position_loops(&self) -> &[Pid] {
+        self.axes()
+    }
+
+    /// The contour PID and the per-axis contour PIDs, the estimator's radii, and every
+    /// number finite.
+    fn check_rest(state: &State) -> Result<(), String> {
+        let controller = &state.controller;
+        let ts = controller.ts();
+        controller_parameters::check_pid("contour PID", controller.law().pid(), ts)?;
         for (axis, pid) in XY.iter().zip(controller.contour_axes()) {
-            controller_parameters::check_pid(
-                &format!("{} contour PID", axis.label),
-                pid,
-                config.ts,
-            )?;
+            controller_parameters::check_pid(&format!("{} contour PID", axis.label), pid, ts)?;
         }
-        state_check::all_positive(self, "radius").map_err(|e| format!("estimator: {e}"))?;
-        state_check::all_finite(self)
+        saved_state::all_positive(state, "radius").map_err(|e| format!("estimator: {e}"))?;
+        saved_state::all_finite(state)
     }
 }
 
@@ -381,7 +362,7 @@ impl Model for ContourCCC2D {
         std::mem::take(&mut self.warnings)
     }
 
-    crate::framework::state_codec::sampled_state_methods!(State, LAYOUT);
+    crate::framework::saved_state::sampled_state_methods!(State, LAYOUT);
 }
 
 #[cfg(test)]

@@ -10,16 +10,18 @@ use super::axis_variables::{
     COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_ACCELERATION_IN, REFERENCE_IN,
     REFERENCE_VELOCITY_IN,
 };
-use super::controller_parameters::{self, axis_gain, nonnegative};
+use super::controller_parameters::{
+    self, axis_gain, nonnegative, ControllerState, SavedController,
+};
 use super::{joint_limits_parameters, kinematics_parameters};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
-use crate::framework::state_codec::{SavedState, StateLayout};
-use crate::framework::variable_table::{axis_block, variable_table, AxisUnit, Int, XYZAC};
+use crate::framework::saved_state::StateLayout;
+use crate::framework::variable_table::{axis_block, variable_table, Axis, AxisUnit, Int, XYZAC};
 use crate::framework::variables::{Start, Values, Variable};
 use contour_core::contour::five_axis::hmm::HmmParams;
 use contour_core::control::{
-    CccConfig, CccMode, ConfigError, FuzzyFactor, FuzzyFactors, Parameter, PidGains,
+    CccConfig, CccMode, ConfigError, FuzzyFactor, FuzzyFactors, Parameter, Pid, PidGains,
 };
 use contour_core::control::{FiveAxisConfig, FiveAxisController};
 use contour_core::geometry::Vector;
@@ -260,7 +262,12 @@ pub static INFO: ModelInfo = ModelInfo {
     // Every output starts at 0: the control law first runs in fmi2DoStep.
     initial_dependencies: &[],
     initial_dependencies_on_some_paths: &[],
-    create: |_: &Environment| Box::new(ContourCCC5X { state: None }),
+    create: |environment: &Environment| {
+        Box::new(ContourCCC5X {
+            environment: environment.clone(),
+            state: None,
+        })
+    },
 };
 
 /// Version 1: `Option<State>` as below. Version 2: the controller carries the machine's
@@ -272,49 +279,34 @@ const LAYOUT: StateLayout = StateLayout {
     version: 4,
 };
 
-#[derive(Clone, serde::Serialize, serde::Deserialize)]
-struct State {
-    controller: FiveAxisController,
-    clock: SampleClock,
-    /// The velocity feed-forward gain (`feedForward`).
-    feed_forward: f64,
-    /// The acceleration feed-forward time (`accelerationFeedForward`), s.
-    acceleration_feed_forward: f64,
-}
+type State = ControllerState<FiveAxisController>;
 
-impl SavedState for State {
-    fn validate(&self, time: f64) -> Result<(), String> {
-        self.clock.validate_at(time)?;
-        controller_parameters::check_feed_forward(
-            self.feed_forward,
-            self.acceleration_feed_forward,
-        )?;
-        let controller = &self.controller;
-        let config = controller.config();
-        config
-            .validate()
-            .map_err(|e| format!("controller configuration: {}", config_message(e)))?;
-        if self.clock.period() != config.ts {
-            return Err(format!(
-                "sample clock period {} s differs from the controller's Ts = {} s",
-                self.clock.period(),
-                config.ts
-            ));
-        }
-        for (axis, pid) in XYZAC.iter().zip(controller.axes()) {
-            controller_parameters::check_pid(
-                &format!("{} position loop", axis.label),
-                pid,
-                config.ts,
-            )?;
-        }
+impl SavedController for FiveAxisController {
+    const AXES: &'static [Axis] = &XYZAC;
+
+    fn ts(&self) -> f64 {
+        self.config().ts
+    }
+
+    fn check_config(&self) -> Result<(), String> {
+        self.config().validate().map_err(config_message)
+    }
+
+    fn position_loops(&self) -> &[Pid] {
+        self.axes()
+    }
+
+    /// The tip and orientation laws with their components, and the controller's memory.
+    fn check_rest(state: &State) -> Result<(), String> {
+        let controller = &state.controller;
+        let ts = controller.ts();
         for (name, law) in ["tip", "orientation"].iter().zip(controller.laws()) {
-            controller_parameters::check_pid(&format!("{name} law"), law.law().pid(), config.ts)?;
+            controller_parameters::check_pid(&format!("{name} law"), law.law().pid(), ts)?;
             for (axis, pid) in ["x", "y", "z"].iter().zip(law.components()) {
                 controller_parameters::check_pid(
                     &format!("{name} law, {axis} component"),
                     pid,
-                    config.ts,
+                    ts,
                 )?;
             }
         }
@@ -323,6 +315,8 @@ impl SavedState for State {
 }
 
 pub struct ContourCCC5X {
+    /// For the check of a restored state (`sampled_state_methods!`).
+    environment: Environment,
     state: Option<State>,
 }
 
@@ -491,7 +485,7 @@ impl Model for ContourCCC5X {
         Ok(())
     }
 
-    crate::framework::state_codec::sampled_state_methods!(State, LAYOUT);
+    crate::framework::saved_state::sampled_state_methods!(State, LAYOUT);
 }
 
 #[cfg(test)]

@@ -1,8 +1,11 @@
 //! Parameter building blocks both controller models use (`ContourCCC2D`, `ContourCCC5X`):
 //! gains that must be ≥ 0, per-axis position-loop gains, and the CCC mode from the two
-//! switches.
+//! switches; and their internal state ([`ControllerState`]), whose check both share.
 
-use crate::framework::variable_table::{AxisTemplate, AxisUnit, AxisWord};
+use crate::framework::model::Environment;
+use crate::framework::sample_clock::SampleClock;
+use crate::framework::saved_state::SavedState;
+use crate::framework::variable_table::{Axis, AxisTemplate, AxisUnit, AxisWord};
 use crate::framework::variables::{Start, Variable};
 use contour_core::control::{CccMode, Gain, Pid};
 
@@ -33,7 +36,7 @@ pub const ACCELERATION_FEED_FORWARD: Variable = nonnegative(
 
 /// Checks a restored state's feed-forward parameters (`feedForward`,
 /// `accelerationFeedForward`) as the parameters' own checks would.
-pub fn check_feed_forward(velocity: f64, acceleration: f64) -> Result<(), String> {
+fn check_feed_forward(velocity: f64, acceleration: f64) -> Result<(), String> {
     for (parameter, value) in [
         (&FEED_FORWARD, velocity),
         (&ACCELERATION_FEED_FORWARD, acceleration),
@@ -116,4 +119,63 @@ pub fn check_pid(name: &str, pid: &Pid, ts: f64) -> Result<(), String> {
         ));
     }
     Ok(())
+}
+
+/// A controller model's internal state (saved as `Option<ControllerState<_>>` with the
+/// model's layout): its control law `C`, the sample clock it runs on and the feed-forward.
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
+pub struct ControllerState<C> {
+    pub controller: C,
+    pub clock: SampleClock,
+    /// The velocity feed-forward gain (`feedForward`).
+    pub feed_forward: f64,
+    /// The acceleration feed-forward time (`accelerationFeedForward`), s.
+    pub acceleration_feed_forward: f64,
+}
+
+/// A controller model's control law, as the check of its restored [`ControllerState`]
+/// sees it: the part both models share is checked once, the rest by the model.
+pub trait SavedController: Sized {
+    /// The axes of the position loops.
+    const AXES: &'static [Axis];
+
+    /// The configuration's sample period Ts, s.
+    fn ts(&self) -> f64;
+
+    /// The configuration's own check; the error names the model's parameter.
+    fn check_config(&self) -> Result<(), String>;
+
+    /// The position loops, one per axis of [`SavedController::AXES`].
+    fn position_loops(&self) -> &[Pid];
+
+    /// The model's own part of the check: its contour laws and their memories (`state`
+    /// whole, so that a field's path in a message starts at the state).
+    fn check_rest(state: &ControllerState<Self>) -> Result<(), String>;
+}
+
+impl<C> SavedState for ControllerState<C>
+where
+    C: SavedController + serde::de::DeserializeOwned,
+{
+    /// Checks a restored state like the parameters it was built from; the error names
+    /// the offending value.
+    fn validate(&self, time: f64, _environment: &Environment) -> Result<(), String> {
+        self.clock.validate_at(time)?;
+        check_feed_forward(self.feed_forward, self.acceleration_feed_forward)?;
+        let controller = &self.controller;
+        controller
+            .check_config()
+            .map_err(|e| format!("controller configuration: {e}"))?;
+        let ts = controller.ts();
+        if self.clock.period() != ts {
+            return Err(format!(
+                "sample clock period {} s differs from the controller's Ts = {ts} s",
+                self.clock.period(),
+            ));
+        }
+        for (axis, pid) in C::AXES.iter().zip(controller.position_loops()) {
+            check_pid(&format!("{} position loop", axis.label), pid, ts)?;
+        }
+        C::check_rest(self)
+    }
 }

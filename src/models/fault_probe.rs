@@ -3,7 +3,7 @@
 //! `Fatal` modes and check that a panic becomes `fmi2Fatal`, never an abort.
 
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
-use crate::framework::state_codec::{decode_state, encode_state, StateLayout};
+use crate::framework::saved_state::{decode_state, encode_state, StateLayout};
 use crate::framework::variable_table::variable_table;
 use crate::framework::variables::Value;
 use crate::framework::variables::{Start, Values, Variable};

@@ -7,7 +7,7 @@
 use super::axis_variables::{COMMAND_IN, INITIAL_POSITION, POSITION_OUT, VELOCITY_OUT};
 use super::servo_plant::{self, FIELDS};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
-use crate::framework::state_codec::StateLayout;
+use crate::framework::saved_state::StateLayout;
 use crate::framework::variable_table::{axis_block, variable_table, Axis, XYZAC};
 use crate::framework::variables::Values;
 use contour_core::plant::{AxisParams, ServoAxes, ServoAxesParams};

@@ -7,7 +7,7 @@
 //! outputs for `ContourCCC2D`, 10 / 7 for `ContourCCC5X`.
 
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
-use crate::framework::state_codec::{decode_state, encode_state, StateLayout};
+use crate::framework::saved_state::{decode_state, encode_state, StateLayout};
 use crate::framework::variable_table::variable_table;
 use crate::framework::variables::Values;
 use crate::framework::variables::Variable;

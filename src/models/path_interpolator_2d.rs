@@ -11,8 +11,7 @@ use super::axis_variables::{REFERENCE_ACCELERATION_OUT, REFERENCE_OUT, REFERENCE
 use super::{line_arc_parameters, path_parameter};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
-use crate::framework::state_check;
-use crate::framework::state_codec::{SavedState, StateLayout};
+use crate::framework::saved_state::{self, SavedState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, Real, XY};
 use crate::framework::variables::{Start, Values, Variable};
 use contour_core::path::planar::{Path, XyLimits, XyReference};
@@ -187,7 +186,7 @@ struct State {
 impl SavedState for State {
     /// Checks a restored state like the parameters it was built from; the error names
     /// the offending value. (A NURBS path is validated by its own decoder.)
-    fn validate(&self, time: f64) -> Result<(), String> {
+    fn validate(&self, time: f64, _environment: &Environment) -> Result<(), String> {
         self.clock.validate_at(time)?;
         let it = match &self.reference {
             Reference::ConstantFeed(it) => it,
@@ -200,7 +199,7 @@ impl SavedState for State {
                         self.clock.period()
                     ));
                 }
-                return state_check::all_finite(self);
+                return saved_state::all_finite(self);
             }
         };
         if !(it.feed().is_finite() && it.feed() >= 0.0) {
@@ -226,7 +225,7 @@ impl SavedState for State {
             // Both decoders check their paths as their constructors do.
             Path::Nurbs(_) | Path::Program(_) => {}
         }
-        state_check::all_finite(self)?;
+        saved_state::all_finite(self)?;
         let (u0, u1) = it.path().param_range();
         if !(u0..=u1).contains(&it.parameter()) {
             return Err(format!(
@@ -359,7 +358,7 @@ impl Model for PathInterpolator2D {
         Ok(())
     }
 
-    crate::framework::state_codec::sampled_state_methods!(State, LAYOUT);
+    crate::framework::saved_state::sampled_state_methods!(State, LAYOUT);
 }
 
 #[cfg(test)]

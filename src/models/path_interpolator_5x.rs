@@ -13,7 +13,7 @@ use super::axis_variables::{REFERENCE_ACCELERATION_OUT, REFERENCE_OUT, REFERENCE
 use super::{joint_limits_parameters, kinematics_parameters};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
-use crate::framework::state_codec::{decode_state, encode_state, StateLayout};
+use crate::framework::saved_state::{RestoredState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, XYZAC};
 use crate::framework::variables::{Start, Values, Variable};
 use contour_core::limits::PathLimits;
@@ -227,16 +227,31 @@ struct SavedStateData {
     clock: SampleClock,
 }
 
-impl State {
-    /// The check every restored state passes (as a `SavedState`'s).
-    fn validate(&self, time: f64) -> Result<(), String> {
-        self.clock.validate_at(time)?;
-        // Not `state_check::all_finite`: it names every float of the path, megabytes of
+impl RestoredState for State {
+    type Saved = SavedStateData;
+
+    /// The saved reference on the plan the instance's planner keeps or makes again, its
+    /// place checked against it.
+    fn restore(
+        saved: SavedStateData,
+        time: f64,
+        environment: &Environment,
+    ) -> Result<Self, String> {
+        saved.clock.validate_at(time)?;
+        let reference = saved
+            .reference
+            .resume(&environment.planner)
+            .map_err(|e| format!("reference: {e}"))?;
+        // Not `saved_state::all_finite`: it names every float of the path, megabytes of
         // text for a built-in; the path checked itself when decoded, and `check` covers
         // the rest (a plan checked its place when restored).
-        self.reference
-            .check(self.clock.period())
-            .map_err(|e| format!("reference: {e}"))
+        reference
+            .check(saved.clock.period())
+            .map_err(|e| format!("reference: {e}"))?;
+        Ok(State {
+            reference,
+            clock: saved.clock,
+        })
     }
 }
 
@@ -374,47 +389,10 @@ impl Model for PathInterpolator5X {
         Ok(())
     }
 
-    fn save_state(&self) -> Result<Vec<u8>, String> {
-        encode_state(LAYOUT, &self.state)
-    }
-
-    fn check_state(&self, bytes: &[u8], time: f64) -> ModelResult {
-        self.decode_state(bytes, time).map(drop)
-    }
-
-    fn restore_state(&mut self, bytes: &[u8], time: f64) -> ModelResult {
-        self.state = self.decode_state(bytes, time)?;
-        Ok(())
-    }
-
-    fn check_step(&self, time: f64, step: f64) -> ModelResult {
-        match &self.state {
-            Some(state) => state.clock.check_step(time + step),
-            None => Ok(()),
-        }
-    }
+    crate::framework::saved_state::sampled_state_methods!(State, LAYOUT);
 }
 
 impl PathInterpolator5X {
-    /// The state saved in `bytes` at `time`, its plan found or made again by the
-    /// instance's planner, checked like any other model's.
-    fn decode_state(&self, bytes: &[u8], time: f64) -> Result<Option<State>, String> {
-        let saved: Option<SavedStateData> = decode_state(LAYOUT, bytes)?;
-        let Some(saved) = saved else {
-            return Ok(None);
-        };
-        saved.clock.validate_at(time)?;
-        let state = State {
-            reference: saved
-                .reference
-                .resume(&self.environment.planner)
-                .map_err(|e| format!("reference: {e}"))?,
-            clock: saved.clock,
-        };
-        state.validate(time)?;
-        Ok(Some(state))
-    }
-
     fn write_outputs(&mut self, values: &mut Values) {
         if let Some(state) = &mut self.state {
             let out = state.reference.current();

@@ -12,8 +12,7 @@
 //! outputs the effort for that step (no direct feedthrough).
 
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
-use crate::framework::state_check;
-use crate::framework::state_codec::{decode_state, encode_state, StateLayout};
+use crate::framework::saved_state::{self, decode_state, encode_state, StateLayout};
 use crate::framework::variable_table::variable_table;
 use crate::framework::variables::{Start, Values, Variable};
 use contour_core::control::{DriveParams, VelocityDrive};
@@ -187,7 +186,7 @@ fn decode(bytes: &[u8]) -> Result<Option<VelocityDrive>, String> {
     let drive: Option<VelocityDrive> = decode_state(LAYOUT, bytes)?;
     if let Some(d) = &drive {
         d.params().validate()?;
-        state_check::all_finite(d)?;
+        saved_state::all_finite(d)?;
         if d.effort().abs() > d.params().effort_max || d.integral().abs() > d.params().effort_max {
             return Err(format!(
                 "an effort or integral beyond effortMax {}",

@@ -3,8 +3,7 @@
 //! nonlinear effects from a block of five (friction, backlash, current limit), and
 //! checking a restored table of axes.
 
-use crate::framework::state_check;
-use crate::framework::state_codec::{decode_state, StateLayout};
+use crate::framework::saved_state::{self, decode_state, StateLayout};
 use crate::framework::variable_table::{Axis, AxisKind, AxisTemplate, AxisUnit, AxisWord, Reals};
 use crate::framework::variables::{Values, Variable};
 use contour_core::plant::{AxisEffects, AxisParams, ServoAxes, Transmission};
@@ -211,7 +210,7 @@ pub fn axis_params<const N: usize>(
 macro_rules! plant_state_methods {
     ($layout:expr, $axes:expr) => {
         fn save_state(&self) -> Result<Vec<u8>, String> {
-            $crate::framework::state_codec::encode_state($layout, &self.table)
+            $crate::framework::saved_state::encode_state($layout, &self.table)
         }
 
         fn check_state(&self, bytes: &[u8], _time: f64) -> $crate::framework::model::ModelResult {
@@ -261,7 +260,7 @@ pub fn validate<const D: usize>(table: &ServoAxes<D>, axes: &[Axis; D]) -> Resul
                 "axis {name}: a transmission of the wrong kind for this axis"
             ));
         }
-        state_check::all_finite(servo).map_err(|e| format!("axis {name}: {e}"))?;
+        saved_state::all_finite(servo).map_err(|e| format!("axis {name}: {e}"))?;
         servo
             .check_play()
             .map_err(|e| format!("axis {name}: {e}"))?;

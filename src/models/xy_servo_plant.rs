@@ -6,7 +6,7 @@
 use super::axis_variables::{COMMAND_IN, INITIAL_POSITION, POSITION_OUT, VELOCITY_OUT};
 use super::servo_plant;
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
-use crate::framework::state_codec::StateLayout;
+use crate::framework::saved_state::StateLayout;
 use crate::framework::variable_table::{axis_block, variable_table, AxisTemplate, XY};
 use crate::framework::variables::Values;
 use contour_core::plant::{AxisParams, XyTable, XyTableParams};

@@ -1,18 +1,34 @@
-//! One codec for every model's internal state (a layout version, then postcard), the
-//! check a restored state runs on itself, and the state methods of a sampled model
-//! written once.
+//! A model's internal state in an FMU state, all of it on the model's side: one codec for
+//! every model (a [`StateLayout`] version, then postcard), the one check of each model's
+//! restored state ([`SavedState`], [`Model::check_state`](super::model::Model::check_state)),
+//! the checks every number in it can get ([`all_finite`], [`all_positive`], from `walk`),
+//! and the state methods of a sampled model written once (`sampled_state_methods!`).
+//! The FMI side (the snapshot around it, handles, ownership) is `crate::fmi2::fmu_state`.
+
+mod walk;
+
+pub use walk::{all_finite, all_positive};
+
+use super::model::Environment;
 
 /// The three state methods of a sampled model whose internal state is
-/// `self.state: Option<State>` (`None` before initialization), saved with layout `$layout`,
-/// and its step check (the sample clock's): the same in every such model, written once.
+/// `self.state: Option<State>` (`None` before initialization), saved with layout `$layout`
+/// and checked by its [`SavedState`] in the model's `self.environment`, and its step check
+/// (the sample clock's): the same in every such model, written once.
 macro_rules! sampled_state_methods {
     ($state:ty, $layout:expr) => {
         fn save_state(&self) -> Result<Vec<u8>, String> {
-            $crate::framework::state_codec::encode_state($layout, &self.state)
+            $crate::framework::saved_state::encode_state($layout, &self.state)
         }
 
         fn check_state(&self, bytes: &[u8], time: f64) -> $crate::framework::model::ModelResult {
-            $crate::framework::state_codec::decode_checked::<$state>($layout, bytes, time).map(drop)
+            $crate::framework::saved_state::decode_checked::<$state>(
+                $layout,
+                bytes,
+                time,
+                &self.environment,
+            )
+            .map(drop)
         }
 
         fn restore_state(
@@ -20,7 +36,12 @@ macro_rules! sampled_state_methods {
             bytes: &[u8],
             time: f64,
         ) -> $crate::framework::model::ModelResult {
-            self.state = $crate::framework::state_codec::decode_checked($layout, bytes, time)?;
+            self.state = $crate::framework::saved_state::decode_checked(
+                $layout,
+                bytes,
+                time,
+                &self.environment,
+            )?;
             Ok(())
         }
 
@@ -47,24 +68,47 @@ pub struct StateLayout {
     pub version: u16,
 }
 
-/// A model's internal state that checks itself once restored, like the parameters it was
-/// built from, at the instance time `time` saved with it; the error names the cause.
+/// A sampled model's internal state, which has one check once restored: like the
+/// parameters it was built from, at the instance time `time` saved with it, in the
+/// `environment` of the model it is restored into (what a restore that rebuilds part of
+/// the state, a plan, may need); the error names the cause.
 pub trait SavedState: serde::de::DeserializeOwned {
-    fn validate(&self, time: f64) -> Result<(), String>;
+    fn validate(&self, time: f64, environment: &Environment) -> Result<(), String>;
+}
+
+/// How a sampled model's state comes back from its bytes. A [`SavedState`] is read as it
+/// is and then checked; a state that rebuilds part of itself on restore (the five-axis
+/// interpolator's plan, through the environment's planner) is read in a form of the same
+/// layout, `Saved`, and made from it, checked on the way.
+pub trait RestoredState: Sized {
+    /// What the bytes are read as.
+    type Saved: serde::de::DeserializeOwned;
+    /// The state made from what was read, at the instance time `time`, in the
+    /// `environment` of the model it is restored into; the error names the cause.
+    fn restore(saved: Self::Saved, time: f64, environment: &Environment) -> Result<Self, String>;
+}
+
+impl<S: SavedState> RestoredState for S {
+    type Saved = S;
+
+    fn restore(state: S, time: f64, environment: &Environment) -> Result<S, String> {
+        state.validate(time, environment)?;
+        Ok(state)
+    }
 }
 
 /// [`decode_state`] of a sampled model's optional state (`None` before initialization),
-/// then its [`SavedState::validate`].
-pub fn decode_checked<S: SavedState>(
+/// then its [`RestoredState::restore`].
+pub fn decode_checked<S: RestoredState>(
     layout: StateLayout,
     bytes: &[u8],
     time: f64,
+    environment: &Environment,
 ) -> Result<Option<S>, String> {
-    let state: Option<S> = decode_state(layout, bytes)?;
-    if let Some(state) = &state {
-        state.validate(time)?;
-    }
-    Ok(state)
+    let saved: Option<S::Saved> = decode_state(layout, bytes)?;
+    saved
+        .map(|saved| S::restore(saved, time, environment))
+        .transpose()
 }
 
 /// Serialises a model's internal state with the same codec for every model: the layout

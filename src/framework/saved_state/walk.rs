@@ -1,4 +1,4 @@
-//! Checks on a restored model state that reach every number in it, also the private
+//! The checks on a restored model state that reach every number in it, also the private
 //! fields of the algorithm types (estimator geometry, PID memories, cached matrices):
 //! the state is walked through its own `Serialize` implementation, which is exactly what
 //! was saved, and every floating-point value is reported with its field path, e.g.
