@@ -158,7 +158,7 @@ asan:
 		|| { echo "asan: the library under test is not instrumented"; exit 1; }
 	@echo "asan: no report from AddressSanitizer or LeakSanitizer"
 
-# Regenerates src/fmi2/bindings.rs from the FMI 2.0 headers.
+# Regenerates fmi2-bindings/src/bindings.rs from the FMI 2.0 headers.
 bindings: libclang
 	$(CARGO) run -p xtask -- bindings
 

@@ -1,5 +1,5 @@
-//! Fingerprints the sources the library is built from (its own `src/`, contour-core's
-//! `src/`, the manifests and `Cargo.lock`), so that every platform's binary built from the
+//! Fingerprints the sources the library is built from (its own `src/`, contour-core's and
+//! fmi2-bindings' `src/`, the manifests and `Cargo.lock`), so that every platform's binary built from the
 //! same tree carries the same build identity and the packager can refuse an FMU whose
 //! binaries come from different trees (`src/build_identity.rs`).
 
@@ -15,6 +15,8 @@ fn main() {
         root.join("Cargo.lock"),
         root.join("contour-core").join("src"),
         root.join("contour-core").join("Cargo.toml"),
+        root.join("fmi2-bindings").join("src"),
+        root.join("fmi2-bindings").join("Cargo.toml"),
     ];
     let mut files = Vec::new();
     for input in &inputs {

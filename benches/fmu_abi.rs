@@ -51,10 +51,10 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use contour_core::sim::{simulate_five_axis, FiveAxisSimConfig, SimConfig, Simulator};
-use contour_fmu::fmi2::bindings::{fmi2CallbackFunctions, fmi2Component, fmi2FMUstate};
 use contour_fmu::framework::model::ModelInfo;
 use contour_fmu::models;
 use criterion::{BenchmarkGroup, Criterion, SamplingMode, Throughput};
+use fmi2_bindings::{fmi2CallbackFunctions, fmi2Component, fmi2FMUstate};
 
 #[path = "../tests/abi/common/linked.rs"]
 mod linked;

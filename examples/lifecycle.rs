@@ -18,11 +18,7 @@ use contour_fmu::models;
 use linked::*;
 
 /// One cycle of `model`; panics on a failed call.
-fn cycle(
-    model: &ModelInfo,
-    functions: &contour_fmu::fmi2::bindings::fmi2CallbackFunctions,
-    n: usize,
-) {
+fn cycle(model: &ModelInfo, functions: &fmi2_bindings::fmi2CallbackFunctions, n: usize) {
     let inputs: Vec<u32> = model
         .variables
         .iter()

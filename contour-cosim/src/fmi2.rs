@@ -3,7 +3,7 @@
 //! works with [`Library`] and [`Instance`], whose methods are safe.
 //!
 //! Types and function typedefs are the ones our FMUs are built against
-//! (`contour_fmu::fmi2::bindings`, generated from the standard's headers).
+//! (the `fmi2-bindings` crate, generated from the standard's headers).
 
 // The status constants keep the standard's C names.
 #![allow(non_upper_case_globals)]
@@ -14,7 +14,7 @@ use std::ptr::NonNull;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
-use contour_fmu::fmi2::bindings::*;
+use fmi2_bindings::*;
 
 use crate::Error;
 
@@ -170,7 +170,7 @@ impl Library {
             {
                 " (a pythonfmu FMU: load libpython first, LD_PRELOAD=<its libpython3.x.so>, with \
                  PYTHONPATH naming the site-packages that hold pythonfmu; \
-                 contour_fmu.native.pythonfmu_environment() gives both)"
+                 contour_fmu.engines.native.pythonfmu_environment() gives both)"
             } else {
                 ""
             };

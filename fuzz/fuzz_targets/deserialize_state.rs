@@ -24,7 +24,7 @@ use std::cell::RefCell;
 use std::ffi::c_char;
 use std::ptr;
 
-use contour_fmu::fmi2::bindings::{
+use fmi2_bindings::{
     fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Status, fmi2String,
 };
 use contour_fmu::framework::model::{Environment, ModelInfo};

@@ -19,7 +19,7 @@ use std::sync::atomic::Ordering;
 use std::sync::OnceLock;
 
 use arbitrary::Arbitrary;
-use contour_fmu::fmi2::bindings::{
+use fmi2_bindings::{
     fmi2Boolean, fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Integer, fmi2Real,
     fmi2Status, fmi2String, fmi2ValueReference,
 };

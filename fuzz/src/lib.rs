@@ -11,7 +11,7 @@
 use std::ffi::{c_char, CStr};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use contour_fmu::fmi2::bindings::{
+use fmi2_bindings::{
     fmi2Boolean, fmi2CallbackFunctions, fmi2Component, fmi2ComponentEnvironment, fmi2Integer,
     fmi2Real, fmi2Status, fmi2StatusKind, fmi2String, fmi2ValueReference,
 };
@@ -335,7 +335,7 @@ pub unsafe fn started(
 /// # Safety
 /// `c` is a live instance.
 pub unsafe fn serialized_state(c: fmi2Component) -> Option<Vec<u8>> {
-    let mut state: contour_fmu::fmi2::bindings::fmi2FMUstate = std::ptr::null_mut();
+    let mut state: fmi2_bindings::fmi2FMUstate = std::ptr::null_mut();
     if fmi2GetFMUstate(c, &mut state) != 0 {
         return None;
     }

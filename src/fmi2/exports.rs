@@ -8,7 +8,7 @@ use std::ffi::{c_char, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::ptr;
 
-use super::bindings::*;
+use fmi2_bindings::*;
 
 use super::instance::Instance;
 use super::logger::{Category, Logger};
@@ -942,7 +942,7 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
 
 // ---------------------------------------------------------------------------------------
 // Compile-time check of every signature against the standard's header (the fmi2...TYPE
-// typedefs that bindings.rs holds, generated from third_party/fmi2/):
+// typedefs that fmi2-bindings holds, generated from third_party/fmi2/):
 // a mismatch is a type error here, not a crash in an importer.
 
 const _: () = {

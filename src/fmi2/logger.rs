@@ -5,7 +5,7 @@
 use std::cell::RefCell;
 use std::ffi::{c_char, CStr, CString};
 
-use super::bindings::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2String};
+use fmi2_bindings::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2String};
 
 use super::status::Status;
 

@@ -1,6 +1,6 @@
 //! Status codes and the error type every instance operation returns.
 
-use super::bindings::{
+use fmi2_bindings::{
     fmi2Status, fmi2Status_fmi2Discard, fmi2Status_fmi2Error, fmi2Status_fmi2Fatal,
     fmi2Status_fmi2OK, fmi2Status_fmi2Warning,
 };

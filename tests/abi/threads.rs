@@ -10,12 +10,12 @@ use crate::common::linked::{
     fmi2DoStep, fmi2EnterInitializationMode, fmi2ExitInitializationMode, fmi2FreeInstance,
     fmi2GetReal, fmi2Instantiate, fmi2SetReal, fmi2SetupExperiment, quiet_callbacks,
 };
-use contour_fmu::fmi2::bindings::{
-    fmi2CallbackFunctions, fmi2Component, fmi2Type_fmi2CoSimulation, fmi2ValueReference,
-};
 use contour_fmu::framework::model::ModelInfo;
 use contour_fmu::framework::variables::{Causality, VarType};
 use contour_fmu::models;
+use fmi2_bindings::{
+    fmi2CallbackFunctions, fmi2Component, fmi2Type_fmi2CoSimulation, fmi2ValueReference,
+};
 
 const INSTANCES: usize = 64;
 const THREADS: usize = 8;

@@ -128,7 +128,7 @@ pub fn generate() -> Result<Vec<Output>, Error> {
 
     // The ABI tests' view: `Fmi2Binding`, which dlopens a built FMU library (with
     // libloading) and calls its fmi2* functions as an importer would. The types are the
-    // library's own (contour_fmu::fmi2::bindings), not a second copy.
+    // library's own (fmi2_bindings), not a second copy.
     let test_library = with_preamble(
         builder(&root)?
             .allowlist_function("fmi2.*")
@@ -139,10 +139,10 @@ pub fn generate() -> Result<Vec<Output>, Error> {
         "`Fmi2Binding`, which loads an FMU's library and calls it (types from the library).",
     )
     .raw_line("#![allow(clippy::missing_safety_doc, clippy::too_many_arguments)]")
-    .raw_line("use contour_fmu::fmi2::bindings::*;");
+    .raw_line("use fmi2_bindings::*;");
 
     Ok(vec![
-        generate_one(library, "src/fmi2/bindings.rs")?,
+        generate_one(library, "fmi2-bindings/src/bindings.rs")?,
         generate_one(test_library, "tests/abi/common/fmi2_library.rs")?,
     ])
 }

@@ -5,7 +5,7 @@
 // this file is out of date.
 #![allow(non_camel_case_types, non_snake_case, non_upper_case_globals, dead_code)]
 #![allow(clippy::missing_safety_doc, clippy::too_many_arguments)]
-use contour_fmu::fmi2::bindings::*;
+use fmi2_bindings::*;
 
 pub struct Fmi2Binding {
     __library: ::libloading::Library,

@@ -11,14 +11,14 @@
 
 use std::ffi::{c_char, CStr};
 
-use contour_fmu::fmi2::bindings::{
+use contour_fmu::framework::interface::{Interface, UnitSystem};
+use contour_fmu::framework::model::ModelInfo;
+use contour_fmu::models;
+use fmi2_bindings::{
     fmi2Boolean, fmi2Byte, fmi2CallbackFunctions, fmi2CallbackLogger, fmi2Component,
     fmi2ComponentEnvironment, fmi2FMUstate, fmi2Integer, fmi2Real, fmi2Status, fmi2String,
     fmi2Type, fmi2Type_fmi2CoSimulation, fmi2ValueReference,
 };
-use contour_fmu::framework::interface::{Interface, UnitSystem};
-use contour_fmu::framework::model::ModelInfo;
-use contour_fmu::models;
 
 extern "C" {
     pub fn fmi2Instantiate(

@@ -12,7 +12,7 @@ use contour_fmu::framework::variables::Values;
 // Generated from third_party/fmi2/ by `cargo run -p xtask -- bindings` (kept as bindgen
 // wrote it): `Fmi2Binding`, the dlopen'ed library's functions; the FMI 2.0 types are the
 // library's own.
-pub use contour_fmu::fmi2::bindings::*;
+pub use fmi2_bindings::*;
 #[rustfmt::skip]
 mod fmi2_library;
 pub use fmi2_library::*;
