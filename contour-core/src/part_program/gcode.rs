@@ -122,6 +122,9 @@ impl<'a> Reader<'a> {
 
     /// The words of one line, letters upper-cased.
     fn words(&self, text: &str, line: usize) -> Result<Vec<Word>, PathError> {
+        if let Some(column) = two_signs(text) {
+            return Err(self.error(line, column, "a number takes one sign, not '+-'"));
+        }
         let snippet = snippet_parser(text).map_err(|e| {
             self.error(
                 line,
@@ -400,6 +403,29 @@ impl<'a> Reader<'a> {
     }
 }
 
+/// The 1-based column of a word's value signed twice (`X+-1.5`) outside comments, which
+/// the `g-code` crate's parser (0.6.0) meets with `unreachable!` instead of an error.
+fn two_signs(text: &str) -> Option<usize> {
+    let bytes = text.as_bytes();
+    let mut depth = 0usize;
+    for (i, &b) in bytes.iter().enumerate() {
+        match b {
+            b'(' => depth += 1,
+            b')' => depth = depth.saturating_sub(1),
+            b';' if depth == 0 => return None,
+            b'+' if depth == 0
+                && bytes.get(i + 1) == Some(&b'-')
+                && i > 0
+                && (bytes[i - 1].is_ascii_alphabetic() || bytes[i - 1] == b'$') =>
+            {
+                return Some(i + 1)
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -413,6 +439,21 @@ mod tests {
 
     fn refused(text: &str) -> String {
         Program::parse_gcode(text, "t.ngc").unwrap_err().to_string()
+    }
+
+    #[test]
+    fn a_value_signed_twice_is_refused_where_it_stands() {
+        // Found by fuzz/gcode_program: the g-code crate's parser panics on it.
+        assert_eq!(
+            refused("G1 X1\nt+-1.\0r"),
+            "t.ngc:2:2: a number takes one sign, not '+-'"
+        );
+        assert!(refused("G1 X+-.5").starts_with("t.ngc:1:5: a number takes one sign"));
+        let found = String::from_utf8_lossy(b"t+-1.\0r\xcb%\0\0");
+        assert!(refused(&found).starts_with("t.ngc:1:2: a number takes one sign"));
+        // In a comment it is text.
+        let p = Program::parse_gcode("G1 X1 (tolerance +-0.01)\nG1 X2 ; X+-1.\n", "t.ngc");
+        assert!(p.is_ok(), "{p:?}");
     }
 
     #[test]
