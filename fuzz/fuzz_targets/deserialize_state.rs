@@ -27,6 +27,7 @@ use std::ptr;
 use fmi2_bindings::{
     fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Status, fmi2String,
 };
+use contour_core::path::five_axis::Planner;
 use contour_fmu::framework::model::{Environment, ModelInfo};
 use contour_fmu::framework::variables::{Values, VarType};
 use contour_fmu::models;
@@ -161,9 +162,25 @@ unsafe fn through_fmi(index: usize, model: &'static ModelInfo, bytes: &[u8]) {
     rewind(index);
 }
 
+/// The environment a model is created in here: the FMU library's own planner is not
+/// reachable from outside, so one of the same kind, planning within the fuzz budget and
+/// kept across inputs as the library keeps its own.
+fn fuzz_environment() -> Environment {
+    static PLANNER: std::sync::OnceLock<std::sync::Arc<Planner>> = std::sync::OnceLock::new();
+    let planner = PLANNER.get_or_init(|| {
+        let planner = Planner::new();
+        planner.set_sample_budget(FUZZ_SAMPLE_BUDGET);
+        std::sync::Arc::new(planner)
+    });
+    Environment {
+        resource_dir: None,
+        planner: std::sync::Arc::clone(planner),
+    }
+}
+
 /// Straight into the model: `check_state`, then `restore_state`, a few steps and a save.
 fn through_model(model: &'static ModelInfo, bytes: &[u8]) {
-    let mut m = (model.create)(&Environment::default());
+    let mut m = (model.create)(&fuzz_environment());
     let checked = m.check_state(bytes, 0.0);
     let restored = m.restore_state(bytes, 0.0);
     assert_eq!(
