@@ -7,8 +7,8 @@
 
 use contour_core::kinematics::TableTiltingAc;
 use contour_core::part_program::cl_data::parse_cl;
-use contour_core::path::Curve;
 use contour_core::path::five_axis::{JointReference, ToolPath};
+use contour_core::path::Curve;
 use contour_fmu_fuzz::install_panic_hook;
 use libfuzzer_sys::fuzz_target;
 

@@ -24,15 +24,13 @@ use std::cell::RefCell;
 use std::ffi::c_char;
 use std::ptr;
 
-use fmi2_bindings::{
-    fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Status, fmi2String,
-};
 use contour_core::path::five_axis::Planner;
 use contour_fmu::framework::model::{Environment, ModelInfo};
 use contour_fmu::framework::variables::{Values, VarType};
 use contour_fmu::models;
 use contour_fmu_fuzz::envelope::{self, Mode, Snapshot};
 use contour_fmu_fuzz::*;
+use fmi2_bindings::{fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Status, fmi2String};
 use libfuzzer_sys::fuzz_target;
 
 const OK: fmi2Status = 0;

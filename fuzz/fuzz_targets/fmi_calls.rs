@@ -19,14 +19,14 @@ use std::sync::atomic::Ordering;
 use std::sync::OnceLock;
 
 use arbitrary::Arbitrary;
-use fmi2_bindings::{
-    fmi2Boolean, fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Integer, fmi2Real,
-    fmi2Status, fmi2String, fmi2ValueReference,
-};
 use contour_fmu::framework::model::ModelInfo;
 use contour_fmu::framework::variables::VarType;
 use contour_fmu::models;
 use contour_fmu_fuzz::*;
+use fmi2_bindings::{
+    fmi2Boolean, fmi2CallbackFunctions, fmi2Component, fmi2FMUstate, fmi2Integer, fmi2Real,
+    fmi2Status, fmi2String, fmi2ValueReference,
+};
 use libfuzzer_sys::fuzz_target;
 
 const SLOTS: usize = 4;

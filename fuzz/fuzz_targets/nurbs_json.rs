@@ -12,8 +12,8 @@
 
 use contour_core::kinematics::TableTiltingAc;
 use contour_core::path::five_axis::{JointReference, ToolPath};
-use contour_core::path::{nurbs_file, Curve, Interpolator, Nurbs};
 use contour_core::path::planar::Path;
+use contour_core::path::{nurbs_file, Curve, Interpolator, Nurbs};
 use contour_fmu_fuzz::install_panic_hook;
 use libfuzzer_sys::fuzz_target;
 
