@@ -27,7 +27,7 @@
 
 use contour_core::contour::planar::{TrueError, TrueErrorIndex};
 use contour_core::geometry::{self, Vector2};
-use contour_core::path::planar::{Path, Shape};
+use contour_core::path::planar::{blended, Path, Shape};
 
 /// Path length (mm) every stretch reaches beyond what the tool's move and its distance
 /// from the path call for: 1 µm.
@@ -62,13 +62,12 @@ impl Geometry {
     /// corners rounded as the interpolator rounds them (bare G64 and the start within
     /// `tolerance`, G64 P within P); a line, an arc or a NURBS is planned on itself.
     pub fn new(path: Path, tolerance: f64) -> Result<Geometry, String> {
-        let planned = match (&path, path.blended(tolerance)) {
-            (Path::Program(program), Path::Program(planned))
-                if planned.moves() != program.moves() =>
-            {
-                Some(Path::Program(planned))
+        let planned = match &path {
+            Path::Program(program) => {
+                let planned = blended(program, tolerance);
+                (planned.moves() != program.moves()).then_some(Path::Program(planned))
             }
-            _ => None,
+            Path::Line(_) | Path::Arc(_) | Path::Nurbs(_) => None,
         };
         Ok(Geometry {
             programmed: path,

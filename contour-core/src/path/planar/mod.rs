@@ -64,13 +64,12 @@ impl Path {
     }
 
     /// The path as followed: a program's blended corners (G64) rounded within
-    /// `tolerance` where the program gave no tolerance of its own ([`blended`]); other
-    /// paths as they are. The one rule for the interpolator, the controller's estimator and
-    /// the planner alike.
-    pub fn blended(&self, tolerance: f64) -> Path {
+    /// `tolerance` where the program gave no tolerance of its own ([`blended`], which the
+    /// planner and contour-eval call on a program directly); other paths as they are.
+    pub fn blended(self, tolerance: f64) -> Path {
         match self {
-            Path::Program(program) => Path::Program(blended(program, tolerance)),
-            other => other.clone(),
+            Path::Program(program) => Path::Program(blended(&program, tolerance)),
+            other => other,
         }
     }
 

@@ -21,7 +21,7 @@ use crate::geometry::{self, Vector2};
 use crate::math;
 use crate::part_program::{Corner, Speed};
 use crate::path::piece_profile::{plan_piece, reachable, Phase, PieceLimits};
-use crate::path::planar::{Move, Path, Program, Shape, MIN_BLEND_TURN};
+use crate::path::planar::{blended, Move, Path, Program, Shape, MIN_BLEND_TURN};
 use crate::path::{Curve, PathError};
 
 /// What the plan obeys.
@@ -129,10 +129,11 @@ pub fn planned_geometry(path: &Path, tolerance: f64) -> Result<Path, PathError> 
         }])
         .map(Path::Program)
     };
-    match path.blended(tolerance) {
-        Path::Line(l) => one(Shape::Line(l)),
-        Path::Arc(a) => one(Shape::Arc(a)),
-        blended => Ok(blended),
+    match path {
+        Path::Program(program) => Ok(Path::Program(blended(program, tolerance))),
+        Path::Line(l) => one(Shape::Line(l.clone())),
+        Path::Arc(a) => one(Shape::Arc(a.clone())),
+        Path::Nurbs(n) => Ok(Path::Nurbs(n.clone())),
     }
 }
 
