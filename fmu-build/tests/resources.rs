@@ -138,7 +138,7 @@ fn bad_resource_requests_are_refused_with_a_clear_message() {
     let program = dir.join("part.NGC");
     std::fs::write(&program, "G21\nG1 X10 F600\nG18\n").unwrap();
     let e = Resource::new("PathInterpolator2D", &program).unwrap_err();
-    assert!(e.contains("part.NGC:3:1: only the XY plane"), "{e}");
+    assert!(e.contains("part.NGC:3:1: G18 arcs are in a plane"), "{e}");
     std::fs::write(&program, "G21\nG1 X10 F600\nG2 X0 R5\n").unwrap();
     assert!(Resource::new("PathInterpolator2D", &program).is_ok());
 

@@ -134,6 +134,9 @@ variable_table! {
     FEED_FORWARD: Real = controller_parameters::FEED_FORWARD;
     AREF: Reals<2> = axis_block(&XY, &[REFERENCE_ACCELERATION_IN]);
     ACCELERATION_FEED_FORWARD: Real = controller_parameters::ACCELERATION_FEED_FORWARD;
+    DIALECT: Int = path_parameter::DIALECT;
+    OPTIONAL_STOP: Bool = path_parameter::OPTIONAL_STOP;
+    HOME: Reals<3> = path_parameter::HOME;
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -162,10 +165,18 @@ pub static INFO: ModelInfo = ModelInfo {
 /// `Option<State>` as below. Version 2: the controller became N-axis (per-axis contour
 /// PIDs, unused in the plane, joined its state). Version 3: the program estimator's track
 /// keeps its last two foot points (its next search's guess). Version 4: the velocity
-/// feed-forward gain. Version 5: the acceleration feed-forward time.
+/// feed-forward gain. Version 5: the acceleration feed-forward time. Version 6: a program's
+/// moves carry their standstill (dwells, stops, Z alone).
 const LAYOUT: StateLayout = StateLayout {
     model: "ContourCCC2D",
-    version: 5,
+    version: 6,
+};
+
+/// The G-code reader's parameters.
+const READER: path_parameter::ReaderParameters = path_parameter::ReaderParameters {
+    dialect: DIALECT,
+    optional_stop: OPTIONAL_STOP,
+    home: HOME,
 };
 
 type State = ControllerState<CrossCoupledController<Estimator>>;
@@ -302,7 +313,7 @@ fn estimator(
         EstimatorKind::Arc => "arc",
         EstimatorKind::Program => PATH.get(values),
     };
-    let mut path = path_parameter::path(spec, values, GEOMETRY, environment)?;
+    let mut path = path_parameter::path(spec, values, GEOMETRY, READER, environment)?;
     let warnings = path_parameter::reader_warnings(&mut path);
     let path = path.blended(TOLERANCE.get(values));
     Ok((Estimator::for_path(kind, &path), warnings))

@@ -78,6 +78,9 @@ variable_table! {
     .unit("s");
     VREF: Reals<2> = axis_block(&XY, &[REFERENCE_VELOCITY_OUT]);
     AREF: Reals<2> = axis_block(&XY, &[REFERENCE_ACCELERATION_OUT]);
+    DIALECT: Int = path_parameter::DIALECT;
+    OPTIONAL_STOP: Bool = path_parameter::OPTIONAL_STOP;
+    HOME: Reals<3> = path_parameter::HOME;
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -161,10 +164,17 @@ const DURATION_KNOWNS: [usize; 16] = {
 };
 
 /// Version 2: `Option<State>` as below (version 1 had the constant-feed interpolator
-/// alone).
+/// alone). Version 3: a program's moves carry their standstill (dwells, stops, Z alone).
 const LAYOUT: StateLayout = StateLayout {
     model: "PathInterpolator2D",
-    version: 2,
+    version: 3,
+};
+
+/// The G-code reader's parameters.
+const READER: path_parameter::ReaderParameters = path_parameter::ReaderParameters {
+    dialect: DIALECT,
+    optional_stop: OPTIONAL_STOP,
+    home: HOME,
 };
 
 /// The reference the parameters choose.
@@ -257,7 +267,7 @@ fn positive(values: &Values, variable: Real) -> Result<f64, String> {
 
 /// The path the parameters describe; file errors name the file and line.
 fn path(values: &Values, environment: &Environment) -> Result<Path, String> {
-    path_parameter::path(PATH.get(values), values, GEOMETRY, environment)
+    path_parameter::path(PATH.get(values), values, GEOMETRY, READER, environment)
 }
 
 impl PathInterpolator2D {

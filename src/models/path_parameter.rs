@@ -4,7 +4,10 @@
 
 use super::line_arc_parameters;
 use crate::framework::model::Environment;
-use crate::framework::variables::{Start, Values, Variable};
+use crate::framework::variable_table::{Bool, Int, Reals};
+use crate::framework::variables::{EnumItem, EnumType, Start, Values, Variable};
+use contour_core::geometry::Vector;
+use contour_core::part_program::gcode::{Dialect, GcodeOptions};
 use contour_core::path::planar::Path;
 
 /// The parameter's start value: the paper's circle.
@@ -26,19 +29,118 @@ pub const TOLERANCE: Variable = Variable::parameter(
 .unit("mm")
 .min(0.0);
 
+/// The `dialect` parameter's type: which controller a G-code program was written for.
+pub static DIALECT_TYPE: EnumType = EnumType {
+    name: "GcodeDialect",
+    description: "The controller a G-code program was written for, where readings differ",
+    items: &[
+        EnumItem {
+            name: "linuxcnc",
+            description: "LinuxCNC (RS-274/NGC): G4 P in seconds",
+        },
+        EnumItem {
+            name: "fanuc",
+            description: "Fanuc, Haas: G4 P (and a cycle's P) in milliseconds",
+        },
+    ],
+};
+
+/// The dialects in the order of [`DIALECT_TYPE`]'s items.
+const DIALECTS: [Dialect; 2] = [Dialect::LinuxCnc, Dialect::Fanuc];
+
+/// The `dialect` parameter, the same in both models.
+pub const DIALECT: Variable = Variable::parameter(
+    "dialect",
+    Start::Integer(1),
+    "How a G-code program's words are read where controllers differ: linuxcnc (G4 P in \
+     seconds) or fanuc (G4 P in milliseconds)",
+)
+.enumeration(&DIALECT_TYPE);
+
+/// The `optionalStop` parameter, the same in both models.
+pub const OPTIONAL_STOP: Variable = Variable::parameter(
+    "optionalStop",
+    Start::Boolean(false),
+    "Whether a G-code program's M1 stops the reference (the optional-stop switch); M0 \
+     always does",
+);
+
+/// The `home.*` parameters, the same in both models.
+pub const HOME: [Variable; 3] = [
+    home(HOME_NAMES[0]),
+    home(HOME_NAMES[1]),
+    home(HOME_NAMES[2]),
+];
+
+const HOME_NAMES: [&str; 3] = ["home.x", "home.y", "home.z"];
+
+const fn home(name: &'static str) -> Variable {
+    Variable::parameter(
+        name,
+        Start::Real(0.0),
+        "The machine's home in the program's coordinates: where G28 and G30 go, what G53 \
+         counts from (default: the program's origin)",
+    )
+    .unit("mm")
+}
+
+/// A model's handles of the G-code reader's parameters.
+#[derive(Clone, Copy)]
+pub struct ReaderParameters {
+    pub dialect: Int,
+    pub optional_stop: Bool,
+    pub home: Reals<3>,
+}
+
+impl ReaderParameters {
+    /// How the model's G-code program is read.
+    pub fn options(&self, values: &Values) -> Result<GcodeOptions, String> {
+        let value = self.dialect.get(values);
+        let dialect = usize::try_from(value)
+            .ok()
+            .and_then(|v| v.checked_sub(1))
+            .and_then(|i| DIALECTS.get(i).copied())
+            .ok_or_else(|| {
+                format!(
+                    "parameter 'dialect' = {value} is not one of {}",
+                    DIALECT_TYPE.listing()
+                )
+            })?;
+        let home = self.home.get(values);
+        if let Some(bad) = home.iter().position(|v| !v.is_finite()) {
+            return Err(format!(
+                "parameter '{}' = {} must be finite",
+                HOME_NAMES[bad], home[bad]
+            ));
+        }
+        Ok(GcodeOptions {
+            dialect,
+            optional_stop: self.optional_stop.get(values),
+            home: Vector::<3>::new(home[0], home[1], home[2]),
+        })
+    }
+}
+
 /// The path `spec` names, with `line` and `arc` from the model's `line.*`/`arc.*`
-/// block; file errors name the file and line.
+/// block and a G-code program read with the model's reader parameters; file errors name
+/// the file and line.
 pub fn path(
     spec: &str,
     values: &Values,
     geometry: line_arc_parameters::Block,
+    reader: ReaderParameters,
     environment: &Environment,
 ) -> Result<Path, String> {
     let spec = spec.trim();
     match spec.to_ascii_lowercase().as_str() {
         "line" => line_arc_parameters::line(values, geometry).map(Path::Line),
         "arc" => line_arc_parameters::arc(values, geometry).map(Path::Arc),
-        _ => Path::from_spec(spec, environment.resource_dir.as_deref()).map_err(|e| {
+        _ => Path::from_spec_with(
+            spec,
+            environment.resource_dir.as_deref(),
+            &reader.options(values)?,
+        )
+        .map_err(|e| {
             let e = e.to_string();
             format!(
                 "parameter 'path': {e}{}",

@@ -1,7 +1,9 @@
 //! Reading a G-code program into a [`PartProgram`] (docs/design/two-axis.md §4.7): the
-//! RS-274/NGC subset LinuxCNC reads, arcs in the XY plane. The `g-code` crate reads the syntax
-//! (words with exact decimals, comments, line by line); the modal state, the units and the
-//! arc geometry are this file's. Every refusal names the file, line and column.
+//! RS-274/NGC words CAM posts write, as LinuxCNC reads them, or as Fanuc does where the two
+//! differ ([`Dialect`]). The `g-code` crate reads the syntax (words with exact decimals,
+//! comments, line by line); the modal state, the units, the arc geometry ([`arc_words`])
+//! and the drilling cycles ([`drilling`]) are this module's. Every refusal names the file,
+//! line and column.
 
 use std::collections::BTreeSet;
 
@@ -10,31 +12,71 @@ use g_code::parse::ast::Spanned;
 use g_code::parse::snippet_parser;
 
 use super::arc_words::{self, Circle};
+use super::drilling::{self, Cycle, CycleKind};
 use super::{Corner, Motion, PartMove, PartProgram, Place, Speed, Warning};
 use crate::geometry::{Vector, Vector2};
 use crate::path::nurbs_file::read_path_file;
 use crate::path::PathError;
 
+/// Where two controllers read the same words differently, which one the program was
+/// written for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Dialect {
+    /// LinuxCNC (RS-274/NGC): `G4 P` in seconds.
+    #[default]
+    LinuxCnc,
+    /// Fanuc (and Haas): `G4 P` in milliseconds.
+    Fanuc,
+}
+
+/// How a program is read: what the file cannot say.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GcodeOptions {
+    /// The controller the program was written for.
+    pub dialect: Dialect,
+    /// Whether M1 stops (the operator's optional-stop switch); M0 always does.
+    pub optional_stop: bool,
+    /// The machine's home (its reference point) in the program's coordinates, mm: where
+    /// G28 and G30 go and what G53's machine coordinates count from.
+    pub home: Vector<3>,
+}
+
+impl Default for GcodeOptions {
+    fn default() -> Self {
+        GcodeOptions {
+            dialect: Dialect::LinuxCnc,
+            optional_stop: false,
+            home: Vector::<3>::zeros(),
+        }
+    }
+}
+
 /// Reads a G-code file (see the module docs).
-pub fn load_gcode(file: impl AsRef<std::path::Path>) -> Result<PartProgram, PathError> {
+pub fn load_gcode(
+    file: impl AsRef<std::path::Path>,
+    options: &GcodeOptions,
+) -> Result<PartProgram, PathError> {
     let (name, text) = read_path_file(file.as_ref())?;
-    parse_gcode(&text, &name)
+    parse_gcode(&text, &name, options)
 }
 
 /// Reads the text of a G-code program; `name` is used in messages.
-pub fn parse_gcode(text: &str, name: &str) -> Result<PartProgram, PathError> {
-    let mut reader = Reader::new(name);
-    let mut percents = 0;
-    for (index, line) in text.lines().enumerate() {
-        let number = index + 1;
-        if line.trim() == "%" {
-            percents += 1;
-            if percents == 2 {
-                break;
-            }
-            continue;
-        }
-        if !reader.block(line, number)? {
+pub fn parse_gcode(
+    text: &str,
+    name: &str,
+    options: &GcodeOptions,
+) -> Result<PartProgram, PathError> {
+    let mut reader = Reader::new(name, *options);
+    let blocks = reader.blocks(text)?;
+    reader.decimals = blocks
+        .iter()
+        .flat_map(|(_, words)| words)
+        .filter(|w| "XYZIJR".contains(w.letter))
+        .map(|w| w.decimals)
+        .max()
+        .unwrap_or(0);
+    for (line, words) in blocks {
+        if !reader.block(line, words)? {
             break;
         }
     }
@@ -53,45 +95,94 @@ enum Mode {
     Linear,
     Clockwise,
     CounterClockwise,
+    /// A drilling cycle (G73, G81–G83, G85, G89).
+    Drilling(CycleKind),
 }
 
-/// One word of a block: its letter, value and 1-based column.
+/// The one-block codes of modal group 0 that are read.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum OneBlock {
+    /// G4.
+    Dwell,
+    /// G28 or G30: to home, through the point the axis words give.
+    Home,
+    /// G53: the axis words in machine coordinates (from [`GcodeOptions::home`]).
+    MachineCoordinates,
+}
+
+/// One word of a block: its letter, value, 1-based column and the decimals it was
+/// written with.
+#[derive(Clone, Copy, Debug)]
 struct Word {
     letter: char,
     value: f64,
     column: usize,
+    decimals: u32,
+}
+
+/// The words of a block other than G, M, N and O, by letter; each is taken by what uses
+/// it, and one left over is refused.
+struct Letters([Option<Word>; 26]);
+
+impl Letters {
+    fn slot(letter: char) -> usize {
+        (letter as u8 - b'A') as usize
+    }
+    fn take(&mut self, letter: char) -> Option<Word> {
+        self.0[Self::slot(letter)].take()
+    }
+    fn has(&self, letter: char) -> bool {
+        self.0[Self::slot(letter)].is_some()
+    }
+    fn column(&self, letter: char) -> Option<usize> {
+        self.0[Self::slot(letter)].map(|w| w.column)
+    }
+    /// The first word left, by column.
+    fn left_over(&self) -> Option<Word> {
+        self.0.iter().flatten().min_by_key(|w| w.column).copied()
+    }
 }
 
 /// The modal state and what has been read so far.
 struct Reader<'a> {
     name: &'a str,
+    options: GcodeOptions,
+    /// The most decimals any X, Y, Z, I, J or R word of the program has: the resolution
+    /// its post rounds to (the arc rule's rounding allowance).
+    decimals: u32,
     /// mm per program unit: 1 (G21) or 25.4 (G20).
     scale: f64,
     absolute: bool,
     arc_absolute: bool,
     motion: Option<Mode>,
+    /// The drilling cycle's sticky words, from its first block to G80 or another motion.
+    cycle: Option<Cycle>,
+    /// G98 (the default): a cycle retracts to where Z was when it began; G99: to R.
+    retract_to_start: bool,
     feed: Option<f64>,
     corner: Corner,
-    position: Vector2,
-    /// The tip's z, mm: 0 until programmed (the program's origin).
-    z: f64,
+    /// The tip, mm: the program's origin until programmed.
+    position: Vector<3>,
     moves: Vec<PartMove>,
     skipped: BTreeSet<&'static str>,
     warnings: Vec<Warning>,
 }
 
 impl<'a> Reader<'a> {
-    fn new(name: &'a str) -> Self {
+    fn new(name: &'a str, options: GcodeOptions) -> Self {
         Reader {
             name,
+            options,
+            decimals: 0,
             scale: 1.0,
             absolute: true,
             arc_absolute: false,
             motion: None,
+            cycle: None,
+            retract_to_start: true,
             feed: None,
             corner: Corner::BlendDefault,
-            position: Vector2::zeros(),
-            z: 0.0,
+            position: Vector::<3>::zeros(),
             moves: Vec::new(),
             skipped: BTreeSet::new(),
             warnings: Vec::new(),
@@ -108,16 +199,43 @@ impl<'a> Reader<'a> {
     }
 
     /// Notes a skipped kind of word, with one warning per kind.
-    fn skip(&mut self, kind: &'static str, place: Place) {
+    fn skip(&mut self, kind: &'static str, line: usize, column: usize) {
         if self.skipped.insert(kind) {
             self.warnings.push(Warning {
                 file: self.name.to_string(),
-                place,
+                place: Place { line, column },
                 message: format!(
-                    "{kind} skipped (not part of the XY contour); further ones are skipped silently"
+                    "{kind} skipped (not part of the contour); further ones are skipped silently"
                 ),
             });
         }
+    }
+
+    /// The words of every line up to the program's end (a second `%` line, M2, M30),
+    /// with their line numbers: a byte-order mark and any line end (LF, CRLF, CR) read.
+    fn blocks(&self, text: &str) -> Result<Vec<(usize, Vec<Word>)>, PathError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let mut blocks = Vec::new();
+        let mut percents = 0;
+        for (index, line) in lines(text).enumerate() {
+            let number = index + 1;
+            if line.trim() == "%" {
+                percents += 1;
+                if percents == 2 {
+                    break;
+                }
+                continue;
+            }
+            let words = self.words(line, number)?;
+            let ends = words
+                .iter()
+                .any(|w| w.letter == 'M' && (w.value == 2.0 || w.value == 30.0));
+            blocks.push((number, words));
+            if ends {
+                break;
+            }
+        }
+        Ok(blocks)
     }
 
     /// The words of one line, letters upper-cased.
@@ -140,18 +258,23 @@ impl<'a> Reader<'a> {
             let (Some(letter), None) = (chars.next(), chars.next()) else {
                 return Err(self.error(line, column, format!("unknown word '{letters}'")));
             };
-            let value = match value {
-                Value::Integer(i) => i as f64,
-                Value::Rational(d) => d.to_string().parse::<f64>().unwrap_or(f64::NAN),
-                Value::Float(f) => f,
+            let (value, decimals) = match value {
+                Value::Integer(i) => (i as f64, 0),
+                Value::Rational(d) => (d.to_string().parse::<f64>().unwrap_or(f64::NAN), d.scale()),
+                Value::Float(f) => (f, 0),
                 Value::String(_) => {
                     return Err(self.error(line, column, "a word's value must be a number"))
                 }
             };
+            let letter = letter.to_ascii_uppercase();
+            if !letter.is_ascii_uppercase() {
+                return Err(self.error(line, column, format!("unknown word '{letters}'")));
+            }
             words.push(Word {
-                letter: letter.to_ascii_uppercase(),
+                letter,
                 value,
                 column,
+                decimals,
             });
         }
         if let Some(flag) = snippet.iter_flags().next() {
@@ -161,15 +284,10 @@ impl<'a> Reader<'a> {
     }
 
     /// Reads one block; `false` at the program's end (M2, M30).
-    fn block(&mut self, text: &str, line: usize) -> Result<bool, PathError> {
-        let words = self.words(text, line)?;
-        let mut motion: Option<(Mode, usize)> = None;
-        let mut end = false;
-        let (mut axes, mut z, mut centre, mut radius) = ([None; 2], None, [None; 2], None);
-        let (mut p, mut feed) = (None, None);
-        let mut corner_word: Option<(u32, usize)> = None;
-        for w in &words {
-            let column = w.column;
+    fn block(&mut self, line: usize, words: Vec<Word>) -> Result<bool, PathError> {
+        let mut letters = Letters([None; 26]);
+        let (mut g_codes, mut m_codes) = (Vec::new(), Vec::new());
+        for w in words {
             let code = || -> Result<u32, PathError> {
                 let tenths = w.value * 10.0;
                 if tenths.fract() == 0.0 && (0.0..=9999.0).contains(&tenths) {
@@ -177,230 +295,582 @@ impl<'a> Reader<'a> {
                 } else {
                     Err(self.error(
                         line,
-                        column,
+                        w.column,
                         format!("unknown code {}{}", w.letter, w.value),
                     ))
                 }
             };
             match w.letter {
-                'G' => match code()? {
-                    c @ (0 | 10 | 20 | 30) => {
-                        if motion.is_some() {
-                            return Err(self.error(line, column, "two motion codes in one block"));
-                        }
-                        let m = [
-                            Mode::Rapid,
-                            Mode::Linear,
-                            Mode::Clockwise,
-                            Mode::CounterClockwise,
-                        ][c as usize / 10];
-                        motion = Some((m, column));
-                    }
-                    170 => {}
-                    180 | 190 => {
-                        return Err(self.error(
-                            line,
-                            column,
-                            "only the XY plane (G17) is supported: the table has two axes",
-                        ))
-                    }
-                    200 => self.scale = 25.4,
-                    210 => self.scale = 1.0,
-                    900 => self.absolute = true,
-                    910 => self.absolute = false,
-                    901 => self.arc_absolute = true,
-                    911 => self.arc_absolute = false,
-                    c @ (610 | 611 | 640) => corner_word = Some((c, column)),
-                    400 => self.skip("G40 (cutter compensation off)", Place { line, column }),
-                    490 => self.skip("G49 (tool length offset off)", Place { line, column }),
-                    800 => self.skip("G80 (canned cycle off)", Place { line, column }),
-                    940 => self.skip(
-                        "G94 (feed per minute, the only feed mode here)",
-                        Place { line, column },
-                    ),
-                    540..=590 if w.value.fract() == 0.0 => self.skip(
-                        "G54-G59 (work offsets: coordinates are taken as programmed)",
-                        Place { line, column },
-                    ),
-                    _ => {
-                        return Err(self.error(
-                            line,
-                            column,
-                            format!("G{} is not supported", w.value),
-                        ))
-                    }
-                },
-                'M' => match code()? {
-                    20 | 300 => end = true,
-                    30..=50 => self.skip("M3-M5 (spindle)", Place { line, column }),
-                    60 => self.skip("M6 (tool change)", Place { line, column }),
-                    70..=90 => self.skip("M7-M9 (coolant)", Place { line, column }),
-                    _ => {
-                        return Err(self.error(
-                            line,
-                            column,
-                            format!("M{} is not supported", w.value),
-                        ))
-                    }
-                },
-                'X' => axes[0] = Some((w.value, column)),
-                'Y' => axes[1] = Some((w.value, column)),
-                'Z' => z = Some((w.value, column)),
-                'I' => centre[0] = Some((w.value, column)),
-                'J' => centre[1] = Some((w.value, column)),
-                'R' => radius = Some((w.value, column)),
-                'F' => feed = Some((w.value, column)),
-                'P' => p = Some((w.value, column)),
-                'N' => {}
-                'S' => self.skip("S (spindle speed)", Place { line, column }),
-                'T' => self.skip("T (tool number)", Place { line, column }),
-                'Q' => self.skip("Q (G64's naive-CAM tolerance)", Place { line, column }),
-                'K' => {
-                    return Err(self.error(line, column, "K is not an XY-plane arc word"));
+                'G' => g_codes.push((code()?, w.column)),
+                'M' => m_codes.push((code()?, w.column)),
+                // Block and program numbers.
+                'N' | 'O' => {}
+                'D' | 'A' | 'B' | 'C' | 'E' | 'V' | 'W' => {
+                    return Err(self.error(
+                        line,
+                        w.column,
+                        format!(
+                            "the word {} is not supported (axes X, Y and Z only)",
+                            w.letter
+                        ),
+                    ))
                 }
-                other => {
+                letter => {
+                    let slot = &mut letters.0[Letters::slot(letter)];
+                    if slot.is_some() {
+                        return Err(self.error(
+                            line,
+                            w.column,
+                            format!("two {letter} words in one block"),
+                        ));
+                    }
+                    *slot = Some(w);
+                }
+            }
+        }
+        let mut motion: Option<(Option<Mode>, usize)> = None;
+        let mut one_block: Option<(OneBlock, usize)> = None;
+        let mut corner_word: Option<(u32, usize)> = None;
+        for &(code, column) in &g_codes {
+            let set_motion = |motion: &mut Option<(Option<Mode>, usize)>, m: Option<Mode>| {
+                if motion.is_some() {
+                    return Err(self.error(line, column, "two motion codes in one block"));
+                }
+                *motion = Some((m, column));
+                Ok(())
+            };
+            let set_one_block = |one: &mut Option<(OneBlock, usize)>, o: OneBlock| {
+                if one.is_some() {
+                    return Err(self.error(line, column, "two of G4, G28, G30, G53 in one block"));
+                }
+                *one = Some((o, column));
+                Ok(())
+            };
+            match code {
+                0 => set_motion(&mut motion, Some(Mode::Rapid))?,
+                10 => set_motion(&mut motion, Some(Mode::Linear))?,
+                20 => set_motion(&mut motion, Some(Mode::Clockwise))?,
+                30 => set_motion(&mut motion, Some(Mode::CounterClockwise))?,
+                800 => set_motion(&mut motion, None)?,
+                c @ (730 | 810 | 820 | 830 | 850 | 890) => {
+                    let kind = CycleKind::from_code(c / 10).expect("a cycle's code");
+                    set_motion(&mut motion, Some(Mode::Drilling(kind)))?
+                }
+                40 => set_one_block(&mut one_block, OneBlock::Dwell)?,
+                280 | 300 => set_one_block(&mut one_block, OneBlock::Home)?,
+                530 => set_one_block(&mut one_block, OneBlock::MachineCoordinates)?,
+                170 => {}
+                180 | 190 => {
                     return Err(self.error(
                         line,
                         column,
-                        format!("the word {other} is not supported (axes X, Y and Z only)"),
+                        format!(
+                            "G{} arcs are in a plane with the third axis, which the XY table \
+                             does not have: run the program on the five-axis machine \
+                             (PathInterpolator5X)",
+                            code / 10
+                        ),
+                    ))
+                }
+                200 => self.scale = 25.4,
+                210 => self.scale = 1.0,
+                900 => self.absolute = true,
+                910 => self.absolute = false,
+                901 => self.arc_absolute = true,
+                911 => self.arc_absolute = false,
+                980 => self.retract_to_start = true,
+                990 => self.retract_to_start = false,
+                c @ (610 | 611 | 640) => corner_word = Some((c, column)),
+                400 => self.skip("G40 (cutter compensation off)", line, column),
+                430 => {
+                    self.skip(
+                        "G43 H (tool length offset: the program gives the tip)",
+                        line,
+                        column,
+                    );
+                    letters.take('H');
+                }
+                490 => self.skip("G49 (tool length offset off)", line, column),
+                940 => self.skip(
+                    "G94 (feed per minute, the only feed mode here)",
+                    line,
+                    column,
+                ),
+                540..=590 if code % 10 == 0 => self.skip(
+                    "G54-G59 (work offsets: coordinates are taken as programmed)",
+                    line,
+                    column,
+                ),
+                410 | 420 => {
+                    return Err(self.error(
+                        line,
+                        column,
+                        "cutter radius compensation (G41, G42) is not supported: program the \
+                         tool centre",
+                    ))
+                }
+                _ => {
+                    return Err(self.error(
+                        line,
+                        column,
+                        format!("G{} is not supported", code as f64 / 10.0),
                     ))
                 }
             }
         }
-        if let Some((f, column)) = feed {
-            if !(f.is_finite() && f > 0.0) {
-                return Err(self.error(line, column, format!("feed F{f} must be > 0")));
-            }
-            self.feed = Some(f * self.scale / 60.0);
-        }
-        let mut p_used = false;
-        if let Some((c, _)) = corner_word {
-            self.corner = match (c, p) {
-                (640, Some((tol, column))) => {
-                    p_used = true;
-                    if !(tol.is_finite() && tol >= 0.0) {
-                        return Err(self.error(line, column, "G64's P must be >= 0"));
-                    }
-                    if tol == 0.0 {
-                        // LinuxCNC: no limit on the blend; here the `tolerance` parameter's.
-                        Corner::BlendDefault
+        let mut stop = false;
+        let mut end = false;
+        for &(code, column) in &m_codes {
+            match code {
+                0 => stop = true,
+                10 => {
+                    if self.options.optional_stop {
+                        stop = true;
                     } else {
-                        Corner::Blend(tol * self.scale)
+                        self.skip("M1 (optional stop, off)", line, column);
                     }
                 }
-                (640, None) => Corner::BlendDefault,
-                _ => Corner::ExactStop,
-            };
+                20 | 300 => end = true,
+                30..=50 => self.skip("M3-M5 (spindle)", line, column),
+                60 => self.skip("M6 (tool change)", line, column),
+                70..=90 => self.skip("M7-M9 (coolant)", line, column),
+                _ => {
+                    return Err(self.error(
+                        line,
+                        column,
+                        format!("M{} is not supported", code as f64 / 10.0),
+                    ))
+                }
+            }
+        }
+        if let Some(w) = letters.take('F') {
+            if !(w.value.is_finite() && w.value > 0.0) {
+                return Err(self.error(line, w.column, format!("feed F{} must be > 0", w.value)));
+            }
+            self.feed = Some(w.value * self.scale / 60.0);
+        }
+        for (letter, kind) in [('S', "S (spindle speed)"), ('T', "T (tool number)")] {
+            if let Some(w) = letters.take(letter) {
+                self.skip(kind, line, w.column);
+            }
+        }
+        if let Some(w) = letters.take('H') {
+            self.skip("H (tool length offset number)", line, w.column);
+        }
+        if let Some((c, _)) = corner_word {
+            self.corner = self.corner_mode(c, &mut letters, line)?;
         }
         if let Some((m, _)) = motion {
-            self.motion = Some(m);
-        }
-        let moves_axes = axes.iter().any(Option::is_some);
-        let arc_words = centre.iter().chain([&radius]).find_map(|w| *w);
-        if !moves_axes && z.is_none() {
-            if let Some((_, column)) = arc_words.filter(|_| motion.is_some()) {
-                return Err(self.error(line, column, "an arc needs its end point (X, Y)"));
+            self.motion = m;
+            if !matches!(m, Some(Mode::Drilling(_))) {
+                self.cycle = None;
             }
-            if let Some((_, column)) = arc_words.or(p.filter(|_| !p_used)) {
-                return Err(self.error(line, column, "this word belongs to a move"));
-            }
-            return Ok(!end);
         }
-        let Some(mode) = self.motion else {
-            let column = axes.iter().chain([&z]).find_map(|w| w.map(|(_, c)| c));
+        match one_block {
+            Some((OneBlock::Dwell, column)) => {
+                self.dwell(&mut letters, motion, line, column)?;
+            }
+            Some((OneBlock::Home, column)) => {
+                self.home(&mut letters, motion, line, column)?;
+            }
+            Some((OneBlock::MachineCoordinates, column)) => {
+                self.machine_move(&mut letters, line, column)?;
+            }
+            None => self.motion(&mut letters, motion, line)?,
+        }
+        if let Some(w) = letters.left_over() {
+            let message = match w.letter {
+                'I' | 'J' | 'K' | 'R' | 'P' | 'Q' => format!(
+                    "the word {} belongs to an arc, a dwell or a cycle, not to this block",
+                    w.letter
+                ),
+                letter => format!("the word {letter} has no use in this block"),
+            };
+            return Err(self.error(line, w.column, message));
+        }
+        if stop {
+            self.push(Motion::Dwell(0.0), Speed::Rapid, self.position, line, None);
+        }
+        Ok(!end)
+    }
+
+    /// The corner mode of G61, G61.1 or G64 (with its P).
+    fn corner_mode(
+        &mut self,
+        code: u32,
+        letters: &mut Letters,
+        line: usize,
+    ) -> Result<Corner, PathError> {
+        if code != 640 {
+            return Ok(Corner::ExactStop);
+        }
+        if let Some(q) = letters.take('Q') {
+            self.skip("Q (G64's naive-CAM tolerance)", line, q.column);
+        }
+        let Some(p) = letters.take('P') else {
+            return Ok(Corner::BlendDefault);
+        };
+        if !(p.value.is_finite() && p.value >= 0.0) {
+            return Err(self.error(line, p.column, "G64's P must be >= 0"));
+        }
+        // LinuxCNC's P0: no limit on the blend; here the `tolerance` parameter's.
+        Ok(if p.value == 0.0 {
+            Corner::BlendDefault
+        } else {
+            Corner::Blend(p.value * self.scale)
+        })
+    }
+
+    /// G4: the tool stands for P (seconds in LinuxCNC, milliseconds in Fanuc) or for X or
+    /// U seconds (Fanuc's; LinuxCNC refuses them, so they conflict with nothing).
+    fn dwell(
+        &mut self,
+        letters: &mut Letters,
+        motion: Option<(Option<Mode>, usize)>,
+        line: usize,
+        column: usize,
+    ) -> Result<(), PathError> {
+        if let Some((_, c)) = motion {
             return Err(self.error(
                 line,
-                column.unwrap_or(1),
-                "axis words without a motion code (G0, G1, G2, G3) in force",
+                c,
+                "G4 takes a block of its own, without a motion code",
             ));
+        }
+        let seconds = [letters.take('X'), letters.take('U')];
+        let p = letters.take('P');
+        let (time, word) = match (seconds, p) {
+            ([Some(w), None] | [None, Some(w)], None) => (w.value, w),
+            ([None, None], Some(w)) => (w.value * self.dwell_unit(), w),
+            ([None, None], None) => {
+                return Err(self.error(line, column, "G4 needs its time: P (or X or U seconds)"))
+            }
+            (_, _) => return Err(self.error(line, column, "G4 takes one time: P, X or U")),
         };
-        // The programmed end.
-        let mut end_point = self.position;
-        for (k, word) in axes.iter().enumerate() {
-            if let Some((v, _)) = word {
-                let v = v * self.scale;
-                end_point[k] = if self.absolute { v } else { end_point[k] + v };
+        if !(time.is_finite() && time >= 0.0) {
+            return Err(self.error(line, word.column, "a dwell's time must be >= 0"));
+        }
+        self.push(Motion::Dwell(time), Speed::Rapid, self.position, line, None);
+        Ok(())
+    }
+
+    /// G28 or G30: at rapid to the point the axis words give (only the axes named move),
+    /// then those axes (all of them when none is named) to home.
+    fn home(
+        &mut self,
+        letters: &mut Letters,
+        motion: Option<(Option<Mode>, usize)>,
+        line: usize,
+        column: usize,
+    ) -> Result<(), PathError> {
+        if let Some((_, c)) = motion {
+            return Err(self.error(line, c, "G28 and G30 take no motion code in their block"));
+        }
+        let (through, named, z_place) = self.axis_target(letters, line);
+        self.push(Motion::Line, Speed::Rapid, through, line, z_place);
+        let mut home = through;
+        for k in 0..3 {
+            if named[k] || named == [false; 3] {
+                home[k] = self.options.home[k];
             }
         }
-        let mut end_z = self.z;
-        let z_place = z.map(|(v, column)| {
-            let v = v * self.scale;
-            end_z = if self.absolute { v } else { self.z + v };
-            Place { line, column }
-        });
+        let z_place = (home[2] != through[2]).then_some(Place { line, column });
+        self.push(Motion::Line, Speed::Rapid, home, line, z_place);
+        Ok(())
+    }
+
+    /// G53 with G0 or G1: the axis words are machine coordinates, counted from home.
+    fn machine_move(
+        &mut self,
+        letters: &mut Letters,
+        line: usize,
+        column: usize,
+    ) -> Result<(), PathError> {
+        let speed = match self.motion {
+            Some(Mode::Rapid) => Speed::Rapid,
+            Some(Mode::Linear) => self.speed(),
+            _ => {
+                return Err(self.error(line, column, "G53 moves with G0 or G1 only"));
+            }
+        };
+        let mut end = self.position;
+        let mut z_place = None;
+        for (k, letter) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+            if let Some(w) = letters.take(letter) {
+                end[k] = self.options.home[k] + w.value * self.scale;
+                if k == 2 {
+                    z_place = Some(Place {
+                        line,
+                        column: w.column,
+                    });
+                }
+            }
+        }
+        self.push(Motion::Line, speed, end, line, z_place);
+        Ok(())
+    }
+
+    /// The point the block's X, Y and Z words name (in the distance mode in force), which
+    /// axes they name and where its Z word is.
+    fn axis_target(
+        &self,
+        letters: &mut Letters,
+        line: usize,
+    ) -> (Vector<3>, [bool; 3], Option<Place>) {
+        let mut end = self.position;
+        let mut named = [false; 3];
+        let mut z_place = None;
+        for (k, letter) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+            if let Some(w) = letters.take(letter) {
+                let v = w.value * self.scale;
+                end[k] = if self.absolute { v } else { end[k] + v };
+                named[k] = true;
+                if k == 2 {
+                    z_place = Some(Place {
+                        line,
+                        column: w.column,
+                    });
+                }
+            }
+        }
+        (end, named, z_place)
+    }
+
+    /// Seconds per unit of a dwell's P: LinuxCNC's seconds, Fanuc's milliseconds.
+    fn dwell_unit(&self) -> f64 {
+        match self.options.dialect {
+            Dialect::LinuxCnc => 1.0,
+            Dialect::Fanuc => 1e-3,
+        }
+    }
+
+    /// The speed of a feed move now.
+    fn speed(&self) -> Speed {
+        self.feed.map_or(Speed::Default, Speed::Feed)
+    }
+
+    /// The block's move in the motion mode in force.
+    fn motion(
+        &mut self,
+        letters: &mut Letters,
+        motion: Option<(Option<Mode>, usize)>,
+        line: usize,
+    ) -> Result<(), PathError> {
+        let names_axes = ['X', 'Y', 'Z'].iter().any(|&l| letters.has(l));
+        let motion_column = motion.map_or(1, |(_, c)| c);
+        let arc_centre = letters.has('I') || letters.has('J');
+        let Some(mode) = self.motion else {
+            if let Some(column) = ['X', 'Y', 'Z'].iter().find_map(|&l| letters.column(l)) {
+                return Err(self.error(
+                    line,
+                    column,
+                    "axis words without a motion code (G0, G1, G2, G3, a cycle) in force",
+                ));
+            }
+            return Ok(());
+        };
+        if let Mode::Drilling(kind) = mode {
+            return self.drill(kind, letters, motion.is_some(), line, motion_column);
+        }
+        let arc = matches!(mode, Mode::Clockwise | Mode::CounterClockwise);
+        // Fanuc's, Haas's and Siemens's full circle: I or J without X and Y (LinuxCNC
+        // refuses it, so reading it conflicts with nothing).
+        if !(names_axes || arc && arc_centre) {
+            if let Some(column) = letters.column('R').filter(|_| arc) {
+                return Err(self.error(
+                    line,
+                    column,
+                    "an arc given by R must end elsewhere than it starts (a full circle takes \
+                     I and J)",
+                ));
+            }
+            return Ok(());
+        }
+        let (end, _, z_place) = self.axis_target(letters, line);
         let speed = match mode {
             Mode::Rapid => Speed::Rapid,
-            _ => self.feed.map_or(Speed::Default, Speed::Feed),
+            _ => self.speed(),
         };
-        let shape = match mode {
-            Mode::Rapid | Mode::Linear => {
-                if let Some((_, column)) = arc_words.or(p.filter(|_| !p_used)) {
-                    return Err(self.error(line, column, "I, J, R and P belong to arcs"));
-                }
-                if end_point == self.position && end_z == self.z {
-                    return Ok(!end);
-                }
-                Motion::Line
+        let shape = if arc {
+            let circle = self.circle(letters, line, motion_column)?;
+            let start = Vector2::new(self.position[0], self.position[1]);
+            let to = Vector2::new(end[0], end[1]);
+            let resolution = 10f64.powi(-(self.decimals.max(MIN_DECIMALS) as i32)) * self.scale;
+            let allowance = arc_words::allowance(self.scale != 1.0, resolution);
+            let arc = arc_words::arc(start, to, circle, mode == Mode::Clockwise, allowance)
+                .map_err(|m| self.error(line, motion_column, m))?;
+            Motion::Arc(arc)
+        } else {
+            if end == self.position {
+                return Ok(());
             }
-            Mode::Clockwise | Mode::CounterClockwise => {
-                let motion_column = motion.map_or(1, |(_, c)| c);
-                if let Some((turns, column)) = p.filter(|_| !p_used) {
-                    if turns != 1.0 {
-                        return Err(self.error(
+            Motion::Line
+        };
+        self.push(shape, speed, end, line, z_place);
+        Ok(())
+    }
+
+    /// The circle of a G2/G3 block: I and J (K must be 0: the XY plane's), or R; P, the
+    /// turns, must be 1.
+    fn circle(
+        &self,
+        letters: &mut Letters,
+        line: usize,
+        motion_column: usize,
+    ) -> Result<Circle, PathError> {
+        if let Some(k) = letters.take('K') {
+            if k.value != 0.0 {
+                return Err(self.error(
+                    line,
+                    k.column,
+                    "a G17 arc's K must be 0 (a helix needs the third axis: run the program \
+                     on the five-axis machine, PathInterpolator5X)",
+                ));
+            }
+        }
+        if let Some(p) = letters.take('P') {
+            if p.value != 1.0 {
+                return Err(self.error(
+                    line,
+                    p.column,
+                    "arcs of more than one turn (P) are not supported",
+                ));
+            }
+        }
+        let (i, j, r) = (letters.take('I'), letters.take('J'), letters.take('R'));
+        match (i, j, r) {
+            (None, None, None) => {
+                Err(self.error(line, motion_column, "an arc needs I and J, or R"))
+            }
+            (Some(w), _, Some(_)) | (_, Some(w), Some(_)) => {
+                Err(self.error(line, w.column, "an arc takes I and J, or R, not both"))
+            }
+            (None, None, Some(r)) => Ok(Circle::Radius(r.value * self.scale)),
+            (i, j, None) => {
+                let offset = |w: Option<Word>, k: usize| -> Result<f64, PathError> {
+                    match (w, self.arc_absolute) {
+                        (Some(w), true) => Ok(w.value * self.scale),
+                        (Some(w), false) => Ok(self.position[k] + w.value * self.scale),
+                        (None, false) => Ok(self.position[k]),
+                        (None, true) => Err(self.error(
                             line,
-                            column,
-                            "arcs of more than one turn (P) are not supported",
-                        ));
-                    }
-                }
-                let circle = match (centre, radius) {
-                    ([None, None], None) => {
-                        return Err(self.error(line, motion_column, "an arc needs I and J, or R"))
-                    }
-                    ([Some((_, column)), _] | [_, Some((_, column))], Some(_)) => {
-                        return Err(self.error(
-                            line,
-                            column,
-                            "an arc takes I and J, or R, not both",
-                        ))
-                    }
-                    (_, Some((r, _))) => Circle::Radius(r * self.scale),
-                    ([i, j], None) => {
-                        let offset =
-                            |w: Option<(f64, usize)>, k: usize| -> Result<f64, PathError> {
-                                match (w, self.arc_absolute) {
-                                    (Some((v, _)), true) => Ok(v * self.scale),
-                                    (Some((v, _)), false) => Ok(self.position[k] + v * self.scale),
-                                    (None, false) => Ok(self.position[k]),
-                                    (None, true) => Err(self.error(
-                                        line,
-                                        motion_column,
-                                        "with G90.1 an arc needs both I and J",
-                                    )),
-                                }
-                            };
-                        Circle::Centre(Vector2::new(offset(i, 0)?, offset(j, 1)?))
+                            motion_column,
+                            "with G90.1 an arc needs both I and J",
+                        )),
                     }
                 };
-                let clockwise = mode == Mode::Clockwise;
-                let arc = arc_words::arc(self.position, end_point, circle, clockwise)
-                    .map_err(|m| self.error(line, motion_column, m))?;
-                Motion::Arc(arc)
+                Ok(Circle::Centre(Vector2::new(offset(i, 0)?, offset(j, 1)?)))
             }
+        }
+    }
+
+    /// A block in a drilling cycle's mode: its words update the cycle, and X or Y drill
+    /// a hole there (so does the cycle's own block without them: at the tool's XY).
+    fn drill(
+        &mut self,
+        kind: CycleKind,
+        letters: &mut Letters,
+        starts: bool,
+        line: usize,
+        column: usize,
+    ) -> Result<(), PathError> {
+        if !self.absolute {
+            return Err(self.error(
+                line,
+                column,
+                "drilling cycles in incremental mode (G91) are not supported: write them in G90",
+            ));
+        }
+        let value = |w: Option<Word>| w.map(|w| (w.value * self.scale, w.column));
+        let depth = value(letters.take('Z'));
+        let retract = value(letters.take('R'));
+        let dwell = letters
+            .take('P')
+            .map(|w| (w.value * self.dwell_unit(), w.column));
+        let peck = value(letters.take('Q'));
+        if let Some(l) = letters.take('L').or_else(|| letters.take('K')) {
+            if l.value != 1.0 {
+                return Err(self.error(line, l.column, "a cycle's repeats (L, K) must be 1"));
+            }
+        }
+        let names_xy = letters.has('X') || letters.has('Y');
+        // A series of cycles keeps its sticky words and where Z was when it began.
+        let mut cycle = match self.cycle {
+            Some(c) => c.with_kind(kind),
+            None => Cycle::new(kind, self.position[2]),
         };
+        cycle
+            .update(depth, retract, dwell, peck)
+            .map_err(|(column, m)| self.error(line, column, m))?;
+        self.cycle = Some(cycle);
+        if !(names_xy || starts || depth.is_some()) {
+            return Ok(());
+        }
+        let (hole, _, _) = self.axis_target(letters, line);
+        let moves = cycle
+            .hole(
+                self.position,
+                Vector2::new(hole[0], hole[1]),
+                self.retract_to_start,
+            )
+            .map_err(|m| self.error(line, column, m))?;
+        for step in moves {
+            let speed = match step.speed {
+                drilling::StepSpeed::Rapid => Speed::Rapid,
+                drilling::StepSpeed::Feed => self.speed(),
+            };
+            let z_place = (step.end[2] != self.position[2]).then_some(Place { line, column });
+            self.push(step.motion, speed, step.end, line, z_place);
+        }
+        Ok(())
+    }
+
+    /// Appends a move from the tip to `end`.
+    fn push(
+        &mut self,
+        motion: Motion,
+        speed: Speed,
+        end: Vector<3>,
+        line: usize,
+        z_place: Option<Place>,
+    ) {
+        if matches!(motion, Motion::Line) && end == self.position {
+            return;
+        }
         self.moves.push(PartMove {
-            motion: shape,
+            motion,
             speed,
-            end: Vector::<3>::new(end_point[0], end_point[1], end_z),
+            end,
             tool_axis: None,
             corner: self.corner,
             place: Place { line, column: 1 },
             z_place,
         });
-        self.position = end_point;
-        self.z = end_z;
-        Ok(!end)
+        self.position = end;
     }
+}
+
+/// The fewest decimals the arc rule assumes a program's coordinates were rounded to (a
+/// program written with fewer, by hand, is taken as exact to 0.001 units).
+const MIN_DECIMALS: u32 = 3;
+
+/// The lines of `text`, ended by LF, CRLF or a lone CR.
+fn lines(text: &str) -> impl Iterator<Item = &str> {
+    let mut rest = text;
+    std::iter::from_fn(move || {
+        if rest.is_empty() {
+            return None;
+        }
+        let end = rest.find(['\n', '\r']).unwrap_or(rest.len());
+        let line = &rest[..end];
+        let skip = if rest[end..].starts_with("\r\n") {
+            2
+        } else {
+            usize::from(end < rest.len())
+        };
+        rest = &rest[end + skip..];
+        Some(line)
+    })
 }
 
 /// The 1-based column of a word's value signed twice (`X+-1.5`) outside comments, which
@@ -425,10 +895,10 @@ fn two_signs(text: &str) -> Option<usize> {
     }
     None
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math;
     use crate::path::planar::{Program, Shape};
     use crate::path::Curve;
     use std::f64::consts::PI;
@@ -486,8 +956,11 @@ mod tests {
             "G21 G40 G49 G80 G94\nG54\nT1 M6\nS12000 M3 M8\nG0 Z5\nG0 X10 Y10\nG1 Z-1 F100\n\
              G1 X20 F600\nG2 X30 Y10 I5 J0\nG0 Z5\nG0 X0 Y0\nM5 M9\nM2\n",
         );
-        assert_eq!(p.warnings.len(), 11, "{:#?}", p.warnings);
-        assert!(p.warnings.iter().any(|w| w.starts_with("t.ngc:5: Z-only")));
+        // G40, G49, G94, G54, T, M6, S, M3-M5, M7-M9 (G80 is a motion code; a Z-only
+        // move is a standstill: the retract after the arc, 6 mm at rapid).
+        assert_eq!(p.warnings.len(), 9, "{:#?}", p.warnings);
+        let standstill = p.moves()[1].standstill;
+        assert_eq!((standstill.at_rapid, standstill.seconds), (6.0, 0.0));
         // A skipped word is named where it stands.
         assert!(
             p.warnings[0].starts_with("t.ngc:1:5: G40 "),
@@ -533,7 +1006,10 @@ mod tests {
     #[test]
     fn wrong_programs_are_refused_with_their_line_and_column() {
         for (text, want) in [
-            ("G1 X1\nG18\n", "t.ngc:2:1: only the XY plane"),
+            (
+                "G1 X1\nG18\n",
+                "t.ngc:2:1: G18 arcs are in a plane with the third axis",
+            ),
             ("G1 X1 A3\n", "t.ngc:1:7: the word A"),
             ("X1\n", "t.ngc:1:1: axis words without a motion"),
             (
@@ -554,9 +1030,7 @@ mod tests {
             ("G1 X[1+2]\n", "t.ngc:1:5: G-code syntax"),
             ("#1 = 2\n", "t.ngc:1:1: G-code syntax"),
             ("G1 X1e3\n", "t.ngc:1:6: the word E"),
-            ("G4 P1\n", "t.ngc:1:1: G4 is not supported"),
-            ("G1 X1\nM0\n", "t.ngc:2:1: M0 is not supported"),
-            ("G1 X1 I2\n", "t.ngc:1:7: I, J, R and P belong to arcs"),
+            ("G1 X1 I2\n", "t.ngc:1:7: the word I belongs to an arc"),
             ("G1 X1 Y2 G\n", "t.ngc:1:10: a letter without a number"),
             ("G21\nG0 X1\n", "t.ngc: the program has no XY motion"),
             (
@@ -572,5 +1046,267 @@ mod tests {
             let e = refused(text);
             assert!(e.starts_with(want), "{text:?}: {e}");
         }
+    }
+
+    fn part(text: &str, options: &GcodeOptions) -> PartProgram {
+        parse_gcode(text, "t.ngc", options).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    fn dwells(p: &PartProgram) -> Vec<f64> {
+        p.moves
+            .iter()
+            .filter_map(|m| match m.motion {
+                Motion::Dwell(t) => Some(t),
+                _ => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_byte_order_mark_and_every_line_end_read_alike() {
+        let body = [
+            "(profile)",
+            "G21 G90",
+            "G1 X10 F600",
+            "G2 X20 I5",
+            "G1 Y5",
+            "M30",
+        ];
+        let unix = Program::parse_gcode(&body.join("\n"), "t.ngc").unwrap();
+        for (bom, end) in [("\u{feff}", "\r\n"), ("", "\r"), ("\u{feff}", "\n")] {
+            let text = format!("{bom}{}{end}", body.join(end));
+            let p = Program::parse_gcode(&text, "t.ngc").unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(p.moves(), unix.moves(), "{end:?}");
+        }
+        // Lines are counted at a lone CR too.
+        let e = refused("G1 X1\rG1 A1\r");
+        assert!(e.starts_with("t.ngc:2:4: the word A"), "{e}");
+    }
+
+    #[test]
+    fn program_numbers_tool_length_offsets_and_k0_on_xy_arcs_are_read() {
+        // FreeCAD writes K with I and J; Fanuc posts an O number and G43 H.
+        let p = read(
+            "O1001 (PART)\nG90 G17 G21\nT2 M6\nG0 G43 Z15. H2\nG0 X5 Y0\nG1 Z-1 F100\n\
+             G2 X-5 Y0 I-5 J0 K0 F600\nG3 X5 Y0 I5.0 J0.0 K0.0\nM30\n",
+        );
+        assert_eq!(p.moves().len(), 2);
+        assert!((p.length() - 10.0 * PI).abs() < 1e-12);
+        assert!(p.warnings.iter().any(|w| w.contains("G43 H")));
+        let e = refused("G1 X5\nG2 X-5 I-5 K1\n");
+        assert!(e.starts_with("t.ngc:2:12: a G17 arc's K must be 0"), "{e}");
+    }
+
+    #[test]
+    fn dwells_by_dialect_and_stops() {
+        let text = "G1 X1 F60\nG4 P2.5\nG04 X1.5\nG4 U0.5\nM0\nM1\nG1 X2\nM01\n";
+        let linuxcnc = part(text, &GcodeOptions::default());
+        assert_eq!(dwells(&linuxcnc), [2.5, 1.5, 0.5, 0.0]);
+        let fanuc = GcodeOptions {
+            dialect: Dialect::Fanuc,
+            optional_stop: true,
+            ..GcodeOptions::default()
+        };
+        // Fanuc's P is in milliseconds; the optional stop is on: M1 stops too.
+        assert_eq!(
+            dwells(&part(text, &fanuc)),
+            [0.0025, 1.5, 0.5, 0.0, 0.0, 0.0]
+        );
+        assert!(linuxcnc
+            .warnings
+            .iter()
+            .any(|w| w.message.contains("M1 (optional stop")));
+        for (text, want) in [
+            ("G4\n", "t.ngc:1:1: G4 needs its time"),
+            ("G4 P1 X2\n", "t.ngc:1:1: G4 takes one time"),
+            ("G4 P-1\n", "t.ngc:1:4: a dwell's time must be >= 0"),
+            ("G4 G1 X1 P1\n", "t.ngc:1:4: G4 takes a block of its own"),
+            ("G4 P1 Y2\n", "t.ngc:1:7: the word Y has no use"),
+        ] {
+            let e = refused(text);
+            assert!(e.starts_with(want), "{text:?}: {e}");
+        }
+    }
+
+    #[test]
+    fn home_moves_go_through_their_point_and_machine_coordinates_count_from_home() {
+        let options = GcodeOptions {
+            home: Vector::<3>::new(-100.0, -50.0, 80.0),
+            ..GcodeOptions::default()
+        };
+        let end = |p: &PartProgram| p.moves.last().map(|m| m.end).unwrap();
+        // Fanuc's retract: incremental G28 Z0 sends Z home alone.
+        let p = part("G0 X10 Y20 Z5\nG28 G91 Z0.\nG90\n", &options);
+        assert_eq!(end(&p), Vector::<3>::new(10.0, 20.0, 80.0));
+        assert!(p.moves.iter().all(|m| m.speed == Speed::Rapid));
+        // Through (30, 20, 5) (Y is not named: it stays), then X home.
+        let p = part("G0 X10 Y20 Z5\nG28 X30\n", &options);
+        let ends: Vec<_> = p.moves.iter().map(|m| m.end).collect();
+        assert_eq!(
+            ends[1..],
+            [
+                Vector::<3>::new(30.0, 20.0, 5.0),
+                Vector::<3>::new(-100.0, 20.0, 5.0)
+            ]
+        );
+        // G30 alone: every axis home; G53 G0 Z0: to home's Z.
+        assert_eq!(end(&part("G0 X1 Y1\nG30\n", &options)), options.home);
+        let p = part("G0 X1 Y1 Z1\nG53 G0 Z0\nG53 X2\n", &options);
+        assert_eq!(end(&p), Vector::<3>::new(-98.0, 1.0, 80.0));
+        assert!(refused("G2 X2 I1\nG53 X0\n").contains("G53 moves with G0 or G1 only"));
+        assert!(refused("G28 G1 X1\n").contains("no motion code"));
+    }
+
+    #[test]
+    fn drilling_cycles_between_profiles() {
+        let text = "G90 G21\nG0 Z10\nG0 X0 Y0\nG1 Z-1 F120\nG1 X10\nG0 Z10\n\
+                    G98 G81 X20 Y0 Z-3 R2 F60\nX30\nG99 G82 X40 P0.5\nG83 X50 Z-4 Q1.5\nG80\n\
+                    G0 X60 Y0\nG1 Z-1 F120\nG1 Y10\nM30\n";
+        let p = part(text, &GcodeOptions::default());
+        let holes: Vec<_> = p
+            .moves
+            .iter()
+            .filter(|m| m.motion == Motion::Line && (m.end[2] == -3.0 || m.end[2] == -4.0))
+            .map(|m| (m.end[0], m.speed))
+            .collect();
+        assert_eq!(
+            holes,
+            [
+                (20.0, Speed::Feed(1.0)),
+                (30.0, Speed::Feed(1.0)),
+                (40.0, Speed::Feed(1.0)),
+                (50.0, Speed::Feed(1.0))
+            ]
+        );
+        assert_eq!(dwells(&p), [0.5]);
+        // G98 back to Z10 after the first two holes, G99 to R after the others.
+        let tops: Vec<_> = p
+            .moves
+            .windows(2)
+            .filter(|w| w[0].end[2] < -2.0 && w[1].speed == Speed::Rapid)
+            .filter(|w| w[1].motion == Motion::Line)
+            .map(|w| w[1].end[2])
+            .collect();
+        // (G83's last two pecks start below −2: out to R after each.)
+        assert_eq!(tops, [10.0, 10.0, 2.0, 2.0, 2.0]);
+        // On the table: the holes are exact stops for the cycles' time, and the profiles
+        // around them are read.
+        let table = Program::from_part_program(&p).unwrap();
+        let at_hole = |x: f64| {
+            table
+                .moves()
+                .iter()
+                .find(|m| m.shape.curve().point(1.0) == Vector2::new(x, 0.0))
+                .map(|m| (m.corner, m.standstill))
+                .unwrap()
+        };
+        let (corner, first) = at_hole(20.0);
+        assert_eq!(corner, Corner::ExactStop);
+        // Rapid 8 down to R, 5 mm at F60 (5 s), rapid 13 back up.
+        assert_eq!((first.seconds, first.at_rapid), (5.0, 8.0 + 13.0));
+        let (_, g82) = at_hole(40.0);
+        assert_eq!((g82.seconds, g82.at_rapid), (5.0 + 0.5, 8.0 + 5.0));
+        assert!(table.moves().last().unwrap().shape.curve().point(1.0) == Vector2::new(60.0, 10.0));
+        for (text, want) in [
+            ("G0 Z5\nG81 X1 Z-1\n", "t.ngc:2:1: a drilling cycle needs R"),
+            (
+                "G0 Z5\nG83 X1 Z-1 R1\n",
+                "t.ngc:2:1: a peck cycle (G73, G83) needs Q",
+            ),
+            (
+                "G91 G81 X1 Z-1 R1\n",
+                "t.ngc:1:5: drilling cycles in incremental mode",
+            ),
+            ("G81 X1 Z1 R0 L2\n", "t.ngc:1:14: a cycle's repeats"),
+            (
+                "G81 X1 Z-1 R1\nG80 X2\n",
+                "t.ngc:2:5: axis words without a motion code",
+            ),
+        ] {
+            let e = refused(text);
+            assert!(e.starts_with(want), "{text:?}: {e}");
+        }
+    }
+
+    #[test]
+    fn a_full_circle_without_x_and_y_in_every_dialect() {
+        for dialect in [Dialect::LinuxCnc, Dialect::Fanuc] {
+            let options = GcodeOptions {
+                dialect,
+                ..GcodeOptions::default()
+            };
+            let p = Program::parse_gcode_with("G1 X5 Y0 F600\nG2 I-5\nJ5 G3\n", "t.ngc", &options)
+                .unwrap();
+            let Shape::Arc(a) = &p.moves()[1].shape else {
+                panic!()
+            };
+            assert_eq!((a.sweep(), a.center()), (-2.0 * PI, Vector2::zeros()));
+            let Shape::Arc(b) = &p.moves()[2].shape else {
+                panic!()
+            };
+            assert_eq!((b.sweep(), b.center()), (2.0 * PI, Vector2::new(5.0, 5.0)));
+        }
+        assert!(refused("G1 X5\nG2 R5\n").contains("full circle takes I and J"));
+    }
+
+    #[test]
+    fn the_third_axis_is_refused_with_its_line_and_the_five_axis_machine_advised() {
+        for (text, want) in [
+            ("G1 X1\nG19 G2 Y1 Z1 J1\n", "t.ngc:2:1: G19 arcs"),
+            (
+                "G1 X1 F60\nG1 X2 Y1 Z-1\n",
+                "t.ngc:2:10: a move of X or Y together with Z",
+            ),
+            (
+                "G0 X1\nG3 X1 Y0 I1 Z-1 F60\n",
+                "t.ngc:2:13: a move of X or Y together with Z",
+            ),
+        ] {
+            let e = refused(text);
+            assert!(
+                e.starts_with(want) && e.contains("five-axis machine"),
+                "{text:?}: {e}"
+            );
+        }
+    }
+
+    #[test]
+    fn arcs_rounded_as_posts_round_them_are_read_and_ends_truly_off_are_refused() {
+        // Arcs of radius 0.1 to 50 mm at many angles, their ends and centres rounded to
+        // 3 and to 4 decimals as a post writes them.
+        for decimals in [3, 4] {
+            let round = |v: f64| format!("{v:.decimals$}");
+            let mut text = String::from("G21 G90\nG0 X0 Y0\n");
+            let mut position = Vector2::zeros();
+            let mut count = 0;
+            for (k, radius) in [0.1, 0.14, 0.3, 1.0, 5.0, 50.0].into_iter().enumerate() {
+                for step in 0..24 {
+                    let a0 = 0.37 * (step as f64) + k as f64;
+                    let sweep = [0.05, 0.4, 1.3, 3.0, 6.0][step % 5]
+                        * if step % 2 == 0 { 1.0 } else { -1.0 };
+                    let centre = position - Vector2::new(math::cos(a0), math::sin(a0)) * radius;
+                    let end = centre
+                        + Vector2::new(math::cos(a0 + sweep), math::sin(a0 + sweep)) * radius;
+                    let (x, y) = (round(end[0]), round(end[1]));
+                    let (i, j) = (
+                        round(centre[0] - position[0]),
+                        round(centre[1] - position[1]),
+                    );
+                    let g = if sweep > 0.0 { "G3" } else { "G2" };
+                    text += &format!("{g} X{x} Y{y} I{i} J{j} F600\n");
+                    position = Vector2::new(x.parse().unwrap(), y.parse().unwrap());
+                    count += 1;
+                }
+            }
+            let p =
+                Program::parse_gcode(&text, "t.ngc").unwrap_or_else(|e| panic!("{decimals}: {e}"));
+            assert_eq!(p.moves().len(), count);
+        }
+        // A 2 mm arc whose end is 0.05 mm off its circle (no rounding explains it).
+        let e = refused("G1 X2 F60\nG3 X0 Y2.05 I-2 J0\n");
+        assert!(
+            e.starts_with("t.ngc:2:1: the arc's end is not on its circle"),
+            "{e}"
+        );
     }
 }

@@ -9,6 +9,7 @@
 
 mod arc_words;
 pub mod cl_data;
+mod drilling;
 pub mod gcode;
 
 use std::fmt;
@@ -48,6 +49,9 @@ pub enum Motion {
     Line,
     /// A circular arc in the XY plane (G2, G3 under G17), its z unchanged.
     Arc(CircularArc),
+    /// The tool stands where it is for this many seconds (G4, a drilling cycle's dwell);
+    /// 0: a stop (M0, M1) and nothing more. Its `end` is where it stands.
+    Dwell(f64),
 }
 
 /// Where in its file something was read: 1-based line and column, 0 when not known.
@@ -125,6 +129,7 @@ impl PartProgram {
         let mut axis = Vector::<3>::z();
         self.moves
             .iter()
+            .filter(|m| !matches!(m.motion, Motion::Dwell(_)))
             .map(|m| {
                 axis = m.tool_axis.unwrap_or(axis);
                 Pose { tip: m.end, axis }
@@ -132,9 +137,13 @@ impl PartProgram {
             .collect()
     }
 
-    /// The line every move was read from, in order.
+    /// The line every move of [`poses`](Self::poses) was read from, in order.
     pub fn lines(&self) -> Vec<usize> {
-        self.moves.iter().map(|m| m.place.line).collect()
+        self.moves
+            .iter()
+            .filter(|m| !matches!(m.motion, Motion::Dwell(_)))
+            .map(|m| m.place.line)
+            .collect()
     }
 
     /// The warnings as text, `file:line[:column]: message` each.

@@ -338,18 +338,18 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
     let (controller_5x, controller_5x_bytes) = five_axis(&contour_ccc_5x::INFO);
     let (interpolator_5x, interpolator_5x_bytes) = five_axis(&path_interpolator_5x::INFO);
 
-    // The models' current layout versions: ContourCCC2D 5 (the acceleration feed-forward;
-    // 4: the feed-forward gain; 3: the
+    // The models' current layout versions: ContourCCC2D 6 (a program's moves carry their
+    // standstill; 5: the acceleration feed-forward; 4: the feed-forward gain; 3: the
     // program estimator keeps its last two feet; 2: the controller became N-axis),
     // XYServoPlant 3 (each axis gained its effects and the table behind the play; 2: the
-    // lead became a transmission), PathInterpolator2D 2 (the
-    // planned reference joined the constant-feed one), ContourCCC5X 4 (the feed-forward
+    // lead became a transmission), PathInterpolator2D 3 (a program's moves carry their
+    // standstill; 2: the planned reference joined the constant-feed one), ContourCCC5X 4 (the feed-forward
     // gains, the guard's averaged speeds and commands), PathInterpolator5X 4 (the sample
     // before the current one, for vref and aref).
     for (i, bytes, model, version) in [
-        (&controller, &controller_bytes, "ContourCCC2D", 5u16),
+        (&controller, &controller_bytes, "ContourCCC2D", 6u16),
         (&plant_instance, &plant_bytes, "XYServoPlant", 3),
-        (&interpolator, &interpolator_bytes, "PathInterpolator2D", 2),
+        (&interpolator, &interpolator_bytes, "PathInterpolator2D", 3),
         (&controller_5x, &controller_5x_bytes, "ContourCCC5X", 4),
         (
             &interpolator_5x,
@@ -372,6 +372,18 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
                 "the {model} state has internal layout version 0, this build reads layout \
                  version {version} only: it was saved by an older build of contour-fmu and \
                  cannot be restored"
+            ),
+        );
+        // The layout just before this one (a state saved by the last release).
+        let before = version - 1;
+        refused(
+            i,
+            bytes,
+            |e| e.model[..2].copy_from_slice(&before.to_le_bytes()),
+            &format!(
+                "the {model} state has internal layout version {before}, this build reads \
+                 layout version {version} only: it was saved by an older build of \
+                 contour-fmu and cannot be restored"
             ),
         );
         // The envelope of the states before per-model layouts (format 1).

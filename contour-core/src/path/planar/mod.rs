@@ -15,7 +15,7 @@ mod reference;
 pub use blending::{blended, MIN_BLEND_TURN};
 pub use corner_blend::CornerBlend;
 pub use plan::{planned_geometry, XyCursor, XyLimits, XyPlan, XyPoint};
-pub use program::{Move, Program, Shape};
+pub use program::{Move, Program, Shape, Standstill};
 pub use reference::XyReference;
 
 use serde::{Deserialize, Serialize};
@@ -23,6 +23,7 @@ use serde::{Deserialize, Serialize};
 use super::nurbs_file::load_nurbs;
 use super::{CircularArc, Curve, CurvePoint, Line, Nurbs, PathError};
 use crate::geometry::Vector2;
+use crate::part_program::gcode::GcodeOptions;
 use crate::part_program::{file_kind, FileKind};
 
 /// Any path the XY table's interpolator and FMUs can follow.
@@ -43,6 +44,15 @@ impl Path {
     /// or, failing that, from a G-code program (by its name's ending) or a NURBS JSON file
     /// (relative names resolved against `base_dir`).
     pub fn from_spec(spec: &str, base_dir: Option<&std::path::Path>) -> Result<Path, PathError> {
+        Path::from_spec_with(spec, base_dir, &GcodeOptions::default())
+    }
+
+    /// [`from_spec`](Self::from_spec) with a G-code program read with `options`.
+    pub fn from_spec_with(
+        spec: &str,
+        base_dir: Option<&std::path::Path>,
+        options: &GcodeOptions,
+    ) -> Result<Path, PathError> {
         match builtin::by_name(spec) {
             Ok(p) => Ok(p),
             Err(PathError::UnknownName(_)) => {
@@ -54,7 +64,7 @@ impl Path {
                 // Something that looks like a file gets the file's own error (naming it).
                 let looks_like_file = spec.ends_with(".json") || spec.contains(['/', '\\']);
                 match file_kind(fs) {
-                    Some(FileKind::GCode) => Program::load(&full).map(Path::Program),
+                    Some(FileKind::GCode) => Program::load_with(&full, options).map(Path::Program),
                     _ if full.is_file() || looks_like_file => load_nurbs(&full).map(Path::Nurbs),
                     _ => Err(PathError::UnknownName(spec.to_string())),
                 }

@@ -21,7 +21,7 @@ use crate::geometry::{self, Vector2};
 use crate::math;
 use crate::part_program::{Corner, Speed};
 use crate::path::piece_profile::{plan_piece, reachable, Phase, PieceLimits};
-use crate::path::planar::{blended, Move, Path, Program, Shape, MIN_BLEND_TURN};
+use crate::path::planar::{blended, Move, Path, Program, Shape, Standstill, MIN_BLEND_TURN};
 use crate::path::{Curve, PathError};
 
 /// What the plan obeys.
@@ -98,6 +98,8 @@ struct PlanPiece {
     tangent: [Vector2; 2],
     /// An exact stop at its end.
     stops: bool,
+    /// How long the table stands there, s.
+    standstill: f64,
     /// Where it comes from, for messages.
     origin: Origin,
 }
@@ -126,6 +128,7 @@ pub fn planned_geometry(path: &Path, tolerance: f64) -> Result<Path, PathError> 
             speed: Speed::Default,
             corner: Corner::ExactStop,
             line: 1,
+            standstill: Standstill::default(),
         }])
         .map(Path::Program)
     };
@@ -214,6 +217,7 @@ fn program_pieces(program: &Program, limits: &XyLimits) -> Vec<PlanPiece> {
                 rate_max,
                 tangent: [m.shape.end_tangent(0), m.shape.end_tangent(1)],
                 stops: m.corner == Corner::ExactStop,
+                standstill: m.standstill.duration(limits.feed, limits.rapid),
                 origin: Origin::Line(m.line),
             }
         })
@@ -233,6 +237,7 @@ fn nurbs_pieces(cut: &NurbsPieces, limits: &XyLimits) -> Vec<PlanPiece> {
             rate_max: p.rate_max,
             tangent: p.tangent,
             stops: false,
+            standstill: 0.0,
             origin: Origin::Parameter(p.u[0]),
         })
         .collect()
@@ -339,6 +344,18 @@ impl XyPlan {
                 &mut phases,
             )
             .map_err(|e| PathError::invalid(format!("{}: {e}", plan_pieces[j].origin)))?;
+            let standstill = plan_pieces[j].standstill;
+            if standstill > 0.0 {
+                // At rest at the piece's end for that long: a phase without motion.
+                phases.push(Phase {
+                    time,
+                    s: plan_pieces[j].start + lengths[j],
+                    speed: 0.0,
+                    accel: 0.0,
+                    jerk: 0.0,
+                });
+                time += standstill;
+            }
         }
         if !(time.is_finite() && time > 0.0) {
             return Err(PathError::invalid(format!(

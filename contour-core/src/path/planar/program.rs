@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use super::CornerBlend;
 use crate::geometry::{self, Vector2};
-use crate::part_program::gcode::{load_gcode, parse_gcode};
+use crate::part_program::gcode::{load_gcode, parse_gcode, GcodeOptions};
 use crate::part_program::{Corner, Motion, PartProgram, Place, Speed, Warning};
 use crate::path::{clamp_param, CircularArc, Curve, CurvePoint, Line, PathError};
 
@@ -72,6 +72,47 @@ pub struct Move {
     pub corner: Corner,
     /// 1-based line of the program that made the move.
     pub line: usize,
+    /// How long the table stands at the move's end (an exact stop then).
+    pub standstill: Standstill,
+}
+
+/// The time the table stands still at a move's end, while the program dwells or moves
+/// Z alone: seconds the program gives, plus Z travel at the interpolator's `feed` (moves
+/// before the first F) and at its `rapid`, which are known only when it plans.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Standstill {
+    /// Dwells, and Z travel at a programmed feed, s.
+    pub seconds: f64,
+    /// Z travel at the `feed` parameter, mm.
+    pub at_feed: f64,
+    /// Z travel at `rapid`, mm.
+    pub at_rapid: f64,
+}
+
+impl Standstill {
+    /// The time it lasts with the interpolator's `feed` and `rapid` (mm/s), s.
+    pub fn duration(&self, feed: f64, rapid: f64) -> f64 {
+        self.seconds + self.at_feed / feed + self.at_rapid / rapid
+    }
+
+    /// Adds Z travel of `distance` mm at `speed`.
+    fn add_travel(&mut self, distance: f64, speed: Speed) {
+        match speed {
+            Speed::Feed(f) => self.seconds += distance / f,
+            Speed::Default => self.at_feed += distance,
+            Speed::Rapid => self.at_rapid += distance,
+        }
+    }
+
+    /// Checks bytes from elsewhere: every part finite and >= 0.
+    fn validate(&self) -> Result<(), String> {
+        let parts = [self.seconds, self.at_feed, self.at_rapid];
+        if parts.iter().all(|v| v.is_finite() && *v >= 0.0) {
+            Ok(())
+        } else {
+            Err(format!("standstill {self:?} is invalid"))
+        }
+    }
 }
 
 /// The moves of a program end to end, with their starts along the path. It serialises
@@ -125,21 +166,41 @@ impl Program {
         })
     }
 
-    /// The XY program of the G-code file `file`.
+    /// The XY program of the G-code file `file`, read as LinuxCNC does.
     pub fn load(file: impl AsRef<std::path::Path>) -> Result<Self, PathError> {
-        Program::from_part_program(&load_gcode(file)?)
+        Program::load_with(file, &GcodeOptions::default())
     }
 
-    /// The XY program of the G-code text `text`; `name` is used in messages.
+    /// The XY program of the G-code file `file`, read with `options`.
+    pub fn load_with(
+        file: impl AsRef<std::path::Path>,
+        options: &GcodeOptions,
+    ) -> Result<Self, PathError> {
+        Program::from_part_program(&load_gcode(file, options)?)
+    }
+
+    /// The XY program of the G-code text `text`, read as LinuxCNC does; `name` is used in
+    /// messages.
     pub fn parse_gcode(text: &str, name: &str) -> Result<Self, PathError> {
-        Program::from_part_program(&parse_gcode(text, name)?)
+        Program::parse_gcode_with(text, name, &GcodeOptions::default())
+    }
+
+    /// The XY program of the G-code text `text`, read with `options`.
+    pub fn parse_gcode_with(
+        text: &str,
+        name: &str,
+        options: &GcodeOptions,
+    ) -> Result<Self, PathError> {
+        Program::from_part_program(&parse_gcode(text, name, options)?)
     }
 
     /// The XY part of `part`, with its reader's warnings and what the table leaves out:
-    /// rapids before the first cut only position the tool (the path starts at the cut); a
-    /// rapid's Z is left to the rapid; a Z-only move is an exact stop of the table. A
-    /// move of X or Y together with Z at a feed (a ramp or a helix) is refused at its Z
-    /// word: its feed is along the 3D path, which the table cannot follow.
+    /// rapids before the first cut (the first feed move, in Z too) only position the
+    /// tool, so the path starts at the first XY move after it; a rapid's Z is left to the
+    /// rapid; where Z moves alone or the program dwells or stops, the table stands at an
+    /// exact stop for that time ([`Standstill`]; before the path's first move it is not
+    /// part of the path). A move of X or Y together with Z at a feed (a ramp or a helix)
+    /// is refused at its Z word: it needs the third axis.
     pub fn from_part_program(part: &PartProgram) -> Result<Self, PathError> {
         let mut skipped = BTreeSet::new();
         let mut warnings = part.warning_lines();
@@ -165,10 +226,24 @@ impl Program {
         let mut z = part.start[2];
         let mut moves: Vec<Move> = Vec::new();
         let mut cutting = false;
+        // The table stands at the end of the last move (an exact stop there).
+        let stand = |moves: &mut Vec<Move>, add: &dyn Fn(&mut Standstill)| {
+            if let Some(last) = moves.last_mut() {
+                last.corner = Corner::ExactStop;
+                add(&mut last.standstill);
+            }
+        };
         for m in &part.moves {
             let line = m.place.line;
+            if let Motion::Dwell(seconds) = m.motion {
+                stand(&mut moves, &|s| s.seconds += seconds);
+                continue;
+            }
             let end = Vector2::new(m.end[0], m.end[1]);
             let arc = matches!(m.motion, Motion::Arc(_));
+            if m.speed != Speed::Rapid {
+                cutting = true;
+            }
             if m.end[2] != z {
                 if m.speed != Speed::Rapid && (end != position || arc) {
                     let at = m.z_place.unwrap_or(m.place);
@@ -176,21 +251,20 @@ impl Program {
                         file: part.file.clone(),
                         line: at.line,
                         column: at.column.max(1),
-                        message: "a move of X or Y together with Z (a ramp or a helix): its \
-                                  feed is along the 3D path, which the XY table cannot \
-                                  follow; move Z in a block of its own"
-                            .into(),
+                        message: "a move of X or Y together with Z (a ramp or a helix) needs \
+                                  the third axis, which the XY table does not have (its feed \
+                                  is along the 3D path): run the program on the five-axis \
+                                  machine (PathInterpolator5X), or move Z in a block of its \
+                                  own"
+                        .into(),
                     });
                 }
                 if end != position {
                     // A rapid goes there at the machine's rapid whatever Z does.
                     skip("Z in rapids (their XY part is followed)", line);
                 } else {
-                    // The table stands still while Z moves: an exact stop in XY.
-                    skip("Z-only moves (the table stops while Z moves)", line);
-                    if let Some(last) = moves.last_mut() {
-                        last.corner = Corner::ExactStop;
-                    }
+                    let distance = (m.end[2] - z).abs();
+                    stand(&mut moves, &|s| s.add_travel(distance, m.speed));
                 }
                 z = m.end[2];
             }
@@ -206,10 +280,9 @@ impl Program {
                     })?)
                 }
                 Motion::Arc(a) => Shape::Arc(a.clone()),
+                Motion::Dwell(_) => continue,
             };
-            if m.speed != Speed::Rapid {
-                cutting = true;
-            } else if !cutting {
+            if !cutting {
                 // Rapids before the first cut only position the tool: the path starts
                 // at the cut.
                 position = end;
@@ -220,6 +293,7 @@ impl Program {
                 speed: m.speed,
                 corner: m.corner,
                 line,
+                standstill: Standstill::default(),
             });
             position = end;
         }
@@ -310,6 +384,9 @@ impl TryFrom<ProgramData> for Program {
                 Shape::Blend(b) => b.validate(),
             };
             checked.map_err(|e| format!("move of line {}: {e}", m.line))?;
+            m.standstill
+                .validate()
+                .map_err(|e| format!("move of line {}: {e}", m.line))?;
             let speed_ok = match m.speed {
                 Speed::Feed(f) => f.is_finite() && f > 0.0,
                 Speed::Rapid | Speed::Default => true,
@@ -370,6 +447,7 @@ mod tests {
             speed: Speed::Feed(10.0),
             corner: Corner::ExactStop,
             line,
+            standstill: Standstill::default(),
         }
     }
 
