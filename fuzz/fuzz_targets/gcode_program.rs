@@ -1,14 +1,15 @@
-//! The G-code program reader on arbitrary text (`parse_program`, as PathInterpolator2D
-//! reads a `.ngc` file; lossily UTF-8, as a file would be refused otherwise before
-//! parsing). What reads is then used as the models use it: evaluated at awkward path
+//! The G-code program reader on arbitrary text (as PathInterpolator2D reads a `.ngc`
+//! file; lossily UTF-8, as a file would be refused otherwise before parsing), with the
+//! reader's options (dialect, optional stop, home) taken from the first byte. What reads is then used as the models use it: evaluated at awkward path
 //! positions, mirrored, measured against by the exact distance from points near and far,
 //! round-tripped through the FMU state's encoding and followed by the interpolator for a
 //! few samples. Nothing may panic; every loop in there is bounded.
 #![no_main]
 
 use contour_core::contour::planar::TrueErrorIndex;
-use contour_core::geometry::Vector2;
-use contour_core::path::planar::{Path, Program};
+use contour_core::geometry::{Vector, Vector2};
+use contour_core::part_program::gcode::{Dialect, GcodeOptions};
+use contour_core::path::planar::{Path, Program, XyLimits, XyReference};
 use contour_core::path::{Curve, Interpolator};
 use contour_fmu_fuzz::install_panic_hook;
 use libfuzzer_sys::fuzz_target;
@@ -16,8 +17,16 @@ use libfuzzer_sys::fuzz_target;
 const SAMPLES: usize = 32;
 
 fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
-    let text = String::from_utf8_lossy(data);
-    let Ok(program) = Program::parse_gcode(&text, "fuzz.ngc") else {
+    let Some((&first, rest)) = data.split_first() else {
+        return;
+    };
+    let options = GcodeOptions {
+        dialect: if first & 1 == 0 { Dialect::LinuxCnc } else { Dialect::Fanuc },
+        optional_stop: first & 2 != 0,
+        home: Vector::<3>::new(-f64::from(first >> 2), 10.0, 50.0),
+    };
+    let text = String::from_utf8_lossy(rest);
+    let Ok(program) = Program::parse_gcode_with(&text, "fuzz.ngc", &options) else {
         return;
     };
     let length = program.length();
@@ -27,6 +36,22 @@ fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
     let bytes = postcard::to_stdvec(&program).expect("a program serialises");
     let back: Program = postcard::from_bytes(&bytes).expect("a saved program reads back");
     assert_eq!(back.moves(), program.moves());
+    // Planned, with its standstills: a few samples, and the end.
+    let limits = XyLimits {
+        feed: 10.0,
+        rapid: 100.0,
+        accel: 1000.0,
+        jerk: 1e5,
+        tolerance: 0.01,
+        ts: 1e-3,
+    };
+    if program.moves().len() <= 64 {
+        if let Ok(mut reference) = XyReference::new(Path::Program(program.clone()), limits) {
+            for _ in 0..SAMPLES {
+                let _ = reference.step();
+            }
+        }
+    }
     let path = Path::Program(program);
     let _ = path.mirrored();
     let index = TrueErrorIndex::new(&path);
