@@ -132,21 +132,19 @@ pub fn path(
     environment: &Environment,
 ) -> Result<Path, String> {
     let spec = spec.trim();
+    let options = reader.options(values)?;
     match spec.to_ascii_lowercase().as_str() {
         "line" => line_arc_parameters::line(values, geometry).map(Path::Line),
         "arc" => line_arc_parameters::arc(values, geometry).map(Path::Arc),
-        _ => Path::from_spec_with(
-            spec,
-            environment.resource_dir.as_deref(),
-            &reader.options(values)?,
-        )
-        .map_err(|e| {
-            let e = e.to_string();
-            format!(
-                "parameter 'path': {e}{}",
-                resource_hint(spec, environment, &e)
-            )
-        }),
+        _ => {
+            Path::from_spec_with(spec, environment.resource_dir.as_deref(), &options).map_err(|e| {
+                let e = e.to_string();
+                format!(
+                    "parameter 'path': {e}{}",
+                    resource_hint(spec, environment, &e)
+                )
+            })
+        }
     }
 }
 

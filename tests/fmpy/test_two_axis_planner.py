@@ -224,3 +224,27 @@ def test_a_nurbs_file_runs_planned_within_the_limits_with_the_exact_estimate(fmu
         assert np.abs(np.abs(got) - want).max() < 1e-9, name
         runs[name] = want
     assert runs["ccc"].max() < 0.5 * runs["no ccc"].max(), (runs["ccc"].max(), runs["no ccc"].max())
+
+
+def test_dwells_stops_and_home_moves_take_the_time_ruckig_gives_their_pieces(fmu_dir, tmp_path):
+    # The reader's parameters through the FMU: a dwell of P (seconds in the LinuxCNC
+    # dialect, milliseconds in Fanuc's), M1 with the optional stop off and on, G28 to
+    # home.x. Each straight piece from rest to rest takes Ruckig's time; a stop or a
+    # dwell adds its own; collinear pieces without a stop run as one.
+    a, j, feed, rapid = 2000.0, 1e5, 10.0, 100.0
+    piece = {length: ruckig_duration(length, feed, a, j) for length in (10.0, 20.0)}
+    program = tmp_path / "dwell.ngc"
+    program.write_text("G21 G90\nG1 X10 F600\nG4 P250\nG1 X20\nM30\n")
+    limits = dict(path=str(program), accel=a, jerk=j, rapid=rapid)
+    linuxcnc = planned_duration(fmu_dir, **limits)
+    fanuc = planned_duration(fmu_dir, dialect=2, **limits)
+    assert linuxcnc == pytest.approx(2 * piece[10.0] + 250.0, abs=1e-9)
+    assert fanuc == pytest.approx(2 * piece[10.0] + 0.25, abs=1e-9)
+    program.write_text("G21 G90\nG1 X10 F600\nM1\nG1 X20\nM30\n")
+    assert planned_duration(fmu_dir, **limits) == pytest.approx(piece[20.0], abs=1e-6)
+    assert planned_duration(fmu_dir, optionalStop=True, **limits) == pytest.approx(
+        2 * piece[10.0], abs=1e-9)
+    program.write_text("G21 G90\nG1 X10 F600\nG28\nM30\n")
+    home = ruckig_duration(15.0, rapid, a, j)
+    assert planned_duration(fmu_dir, home__x=-5.0, **limits) == pytest.approx(
+        piece[10.0] + home, abs=1e-9)

@@ -585,7 +585,7 @@ fn state_bytes_of(model: &'static ModelInfo) -> Vec<u8> {
 // Path files
 
 fn write_path_files() {
-    let files: [(&str, &str); 17] = [
+    let files: [(&str, &str); 18] = [
         (
             "syntax.json",
             "{\n  \"degree\": 1,\n  \"knots\": [0, 0,, 1, 1],\n  \"control_points\": [[0, 0], [3, 4]]\n}\n",
@@ -629,6 +629,7 @@ fn write_path_files() {
         ("off_circle.ngc", "G1 X10 F600\nG2 X0 Y10 I0 J5\n"),
         ("helix.ngc", "G0 Z5\nG1 X10 F600\nG1 X20 Z-1\n"),
         ("expression.ngc", "G21\nG1 X[1+2] F600\n"),
+        ("drill.ngc", "G21\nG0 Z5\nG1 X10 F600\nG81 X20 Z-2 F100\n"),
     ];
     std::fs::create_dir_all(folder()).unwrap();
     for (name, text) in files {
