@@ -23,6 +23,7 @@ use contour_core::contour::five_axis::run_evaluation::{
 };
 use contour_core::geometry::{self, Vector};
 use contour_core::kinematics::{Joints, Pose, TableTiltingAc};
+use contour_core::part_program::gcode::GcodeOptions;
 
 use measured::{Kind, Samples};
 use planar_run::PlanarOptions;
@@ -45,7 +46,8 @@ usage: contour-eval --path PART.cl|PART.apt|PART.json|tilted_helix|figure_eight
                     [--max-skip K] [--angle-weight 0.1] [--window W]
                     [--reference straight|smooth]
        contour-eval --path PART.ngc|NURBS.json|line|arc|circle|infinity|trident
-                    --measured RUN.csv --out ERR.csv [--tolerance P] [--plot ERR.png]
+                    --measured RUN.csv --out ERR.csv [--tolerance P] [--home X,Y,Z]
+                    [--plot ERR.png]
        contour-eval --circle CX,CY,R --measured RUN.csv [--reverse RUN.csv]
                     [--from T0] [--to T1] [--out DEV.csv] [--plot BALLBAR.png]
                     [--magnification M] [--figures FIG.json]
@@ -84,6 +86,9 @@ along the path so that a pass that comes back near itself is not confused.
   --tolerance  P, mm: the corners of bare G64 (and of the start) blended within P as
                PathInterpolator2D plans them (its 'tolerance'); default 0: only the
                program's own G64 P corners are blended
+  --home       X,Y,Z, mm: the machine's home in the program's coordinates, where its
+               G28/G30 go and what G53 counts from (PathInterpolator2D's 'home.*');
+               default 0,0,0
 
 Circular test (ISO 230-4) of XY runs around the nominal circle CX,CY,R (mm): the
 least-squares circle, the circular deviation G, the radial deviation F (min, max) of each
@@ -122,6 +127,8 @@ struct Options {
     window: Option<usize>,
     /// --tolerance as given (XY runs only).
     tolerance: Option<f64>,
+    /// --home as given (XY runs only).
+    home: Option<Vector<3>>,
     /// The five-axis-only options given, in order.
     five_axis_only: Vec<String>,
 }
@@ -149,6 +156,21 @@ pub(crate) fn pair(text: &str, what: &str) -> Result<(f64, f64), String> {
     }
 }
 
+/// "X,Y,Z" as three finite numbers.
+fn triple(text: &str, what: &str) -> Result<Vector<3>, String> {
+    let values: Vec<f64> = text
+        .split(',')
+        .map(|v| v.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
+        .collect::<Option<_>>()
+        .ok_or_else(|| format!("{what} '{text}': not three finite numbers"))?;
+    match values.as_slice() {
+        [x, y, z] => Ok(Vector::<3>::new(*x, *y, *z)),
+        _ => Err(format!(
+            "{what} needs three comma-separated numbers, got '{text}'"
+        )),
+    }
+}
+
 fn parse(args: &[String]) -> Result<Option<Options>, String> {
     let defaults = RunSettings::default();
     let (mut path, mut measured, mut out) = (None, None, None);
@@ -163,6 +185,7 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
         max_skip: None,
         window: None,
         tolerance: None,
+        home: None,
         five_axis_only: Vec::new(),
     };
     let mut it = args.iter();
@@ -189,6 +212,7 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
         match flag.as_str() {
             "--path" => path = Some(value.clone()),
             "--tolerance" => o.tolerance = Some(number("--tolerance")?),
+            "--home" => o.home = Some(triple(value, "--home")?),
             "--measured" => measured = Some(PathBuf::from(value)),
             "--out" => out = Some(PathBuf::from(value)),
             "--out-reference" => o.out_reference = Some(PathBuf::from(value)),
@@ -279,7 +303,11 @@ fn run(o: Options) -> Result<(), Failure> {
     // Options of the other kind are a mistake, not something to ignore.
     let other = match kind {
         Kind::Planar => o.five_axis_only.first().cloned(),
-        Kind::FiveAxis => o.tolerance.map(|_| "--tolerance".to_string()),
+        Kind::FiveAxis => o
+            .tolerance
+            .map(|_| "--tolerance")
+            .or(o.home.map(|_| "--home"))
+            .map(str::to_string),
     };
     if let Some(flag) = other {
         return Err(Failure::Input(format!(
@@ -287,7 +315,11 @@ fn run(o: Options) -> Result<(), Failure> {
             kind.columns()
         )));
     }
-    let reference = reference::load(&o.path, kind, &name).map_err(Failure::Input)?;
+    let gcode = GcodeOptions {
+        home: o.home.unwrap_or_else(Vector::<3>::zeros),
+        ..GcodeOptions::default()
+    };
+    let reference = reference::load(&o.path, kind, &name, &gcode).map_err(Failure::Input)?;
     match (reference, measured.samples) {
         (Reference::Planar(path), Samples::Planar(points)) => {
             let options = PlanarOptions {

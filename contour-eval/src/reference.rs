@@ -5,6 +5,7 @@
 //! columns say; a path of the other kind is refused, naming both.
 
 use contour_core::kinematics::Pose;
+use contour_core::part_program::gcode::GcodeOptions;
 use contour_core::part_program::{self, FileKind};
 use contour_core::path::five_axis::{load_poses, ToolPath, BUILTIN_TOOL_PATHS};
 use contour_core::path::planar::{builtin, Path};
@@ -62,8 +63,8 @@ fn mismatch(spec: &str, path: Kind, measured: &str, columns: Kind) -> String {
     )
 }
 
-fn planar(spec: &str) -> Result<Path, String> {
-    Path::from_spec(spec, None).map_err(|e| e.to_string())
+fn planar(spec: &str, gcode: &GcodeOptions) -> Result<Path, String> {
+    Path::from_spec_with(spec, None, gcode).map_err(|e| e.to_string())
 }
 
 fn five_axis(spec: &str) -> Result<Reference, String> {
@@ -73,8 +74,14 @@ fn five_axis(spec: &str) -> Result<Reference, String> {
 }
 
 /// The reference `spec` names, read for a run of `columns` (the file `measured`, named
-/// in messages). Errors are the readers' own, or a mismatch naming both kinds.
-pub fn load(spec: &str, columns: Kind, measured: &str) -> Result<Reference, String> {
+/// in messages; a G-code program read with `gcode`). Errors are the readers' own, or a
+/// mismatch naming both kinds.
+pub fn load(
+    spec: &str,
+    columns: Kind,
+    measured: &str,
+    gcode: &GcodeOptions,
+) -> Result<Reference, String> {
     let by_name = builtin_kind(spec, columns, &builtin::NAMES, &BUILTIN_TOOL_PATHS);
     if let Some(kind) = by_name.or_else(|| file_kind(spec)) {
         if kind != columns {
@@ -84,7 +91,7 @@ pub fn load(spec: &str, columns: Kind, measured: &str) -> Result<Reference, Stri
     // A JSON file the run's kind cannot read may be one of the other kind.
     let json = part_program::file_kind(std::path::Path::new(spec)) == Some(FileKind::Json);
     match columns {
-        Kind::Planar => planar(spec).map(Reference::Planar).map_err(|e| {
+        Kind::Planar => planar(spec, gcode).map(Reference::Planar).map_err(|e| {
             if json && ToolPath::load(spec).is_ok() {
                 mismatch(spec, Kind::FiveAxis, measured, columns)
             } else {
@@ -92,7 +99,7 @@ pub fn load(spec: &str, columns: Kind, measured: &str) -> Result<Reference, Stri
             }
         }),
         Kind::FiveAxis => five_axis(spec).map_err(|e| {
-            if json && planar(spec).is_ok() {
+            if json && planar(spec, gcode).is_ok() {
                 mismatch(spec, Kind::Planar, measured, columns)
             } else {
                 e

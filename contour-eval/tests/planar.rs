@@ -797,3 +797,26 @@ fn bad_xy_inputs_fail_naming_file_and_line_and_write_nothing() {
     assert!(plot.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_home_return_is_measured_against_the_home_that_is_given() {
+    // X0 → X10, then G28 back at rapid to home, the tool on the way there: with --home
+    // −5,−3,0 on the path throughout; without it the program returns to its origin, and
+    // the tool at home is |(−5, −3)| from the program's end.
+    let dir = scratch("home");
+    let part = dir.join("home.ngc");
+    std::fs::write(&part, "G1 X10 F600\nG28\n").unwrap();
+    let mut points: Vec<P2> = (0..=100).map(|k| [0.1 * k as f64, 0.0]).collect();
+    for k in 1..=150 {
+        let t = k as f64 / 150.0;
+        points.push([10.0 - 15.0 * t, -3.0 * t]);
+    }
+    let (home, _) = evaluate(&dir, s(&part), &points, &["--home", "-5,-3,0"]);
+    for (k, row) in home.iter().enumerate() {
+        assert!(row.contour.abs() < 1e-9, "sample {k}: {}", row.contour);
+    }
+    let (origin, _) = evaluate(&dir, s(&part), &points, &[]);
+    let last = origin.last().unwrap();
+    assert!((last.contour.abs() - 34f64.sqrt()).abs() < 1e-9, "{}", last.contour);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
