@@ -817,6 +817,10 @@ fn a_home_return_is_measured_against_the_home_that_is_given() {
     }
     let (origin, _) = evaluate(&dir, s(&part), &points, &[]);
     let last = origin.last().unwrap();
-    assert!((last.contour.abs() - 34f64.sqrt()).abs() < 1e-9, "{}", last.contour);
+    assert!(
+        (last.contour.abs() - 34f64.sqrt()).abs() < 1e-9,
+        "{}",
+        last.contour
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -108,6 +108,8 @@ enum OneBlock {
     Home,
     /// G53: the axis words in machine coordinates (from [`GcodeOptions::home`]).
     MachineCoordinates,
+    /// G92: the tip is where the axis words say (the coordinates' zero moves).
+    SetPosition,
 }
 
 /// One word of a block: its letter, value, 1-based column and the decimals it was
@@ -163,6 +165,10 @@ struct Reader<'a> {
     corner: Corner,
     /// The tip, mm: the program's origin until programmed.
     position: Vector<3>,
+    /// Where the coordinates' zero is, mm: the program's origin until G92 moves it.
+    origin: Vector<3>,
+    /// G9 in the block: its move ends in an exact stop.
+    stop_here: bool,
     moves: Vec<PartMove>,
     skipped: BTreeSet<&'static str>,
     warnings: Vec<Warning>,
@@ -183,6 +189,8 @@ impl<'a> Reader<'a> {
             feed: None,
             corner: Corner::BlendDefault,
             position: Vector::<3>::zeros(),
+            origin: Vector::<3>::zeros(),
+            stop_here: false,
             moves: Vec::new(),
             skipped: BTreeSet::new(),
             warnings: Vec::new(),
@@ -359,6 +367,10 @@ impl<'a> Reader<'a> {
                 40 => set_one_block(&mut one_block, OneBlock::Dwell)?,
                 280 | 300 => set_one_block(&mut one_block, OneBlock::Home)?,
                 530 => set_one_block(&mut one_block, OneBlock::MachineCoordinates)?,
+                920 => set_one_block(&mut one_block, OneBlock::SetPosition)?,
+                // G92.1, G92.2: the G92 offsets cleared (suspended: nothing restores them).
+                921 | 922 => self.origin = Vector::<3>::zeros(),
+                90 => self.stop_here = true,
                 170 => {}
                 180 | 190 => {
                     return Err(self.error(
@@ -476,6 +488,9 @@ impl<'a> Reader<'a> {
             Some((OneBlock::MachineCoordinates, column)) => {
                 self.machine_move(&mut letters, line, column)?;
             }
+            Some((OneBlock::SetPosition, column)) => {
+                self.set_position(&mut letters, motion, line, column)?;
+            }
             None => self.motion(&mut letters, motion, line)?,
         }
         if let Some(w) = letters.left_over() {
@@ -491,6 +506,7 @@ impl<'a> Reader<'a> {
         if stop {
             self.push(Motion::Dwell(0.0), Speed::Rapid, self.position, line, None);
         }
+        self.stop_here = false;
         Ok(!end)
     }
 
@@ -579,6 +595,30 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
+    /// G92: the coordinates' zero moves so that the tip is where the axis words say.
+    fn set_position(
+        &mut self,
+        letters: &mut Letters,
+        motion: Option<(Option<Mode>, usize)>,
+        line: usize,
+        column: usize,
+    ) -> Result<(), PathError> {
+        if let Some((_, c)) = motion {
+            return Err(self.error(line, c, "G92 takes no motion code in its block"));
+        }
+        let mut named = false;
+        for (k, letter) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+            if let Some(w) = letters.take(letter) {
+                self.origin[k] = self.position[k] - w.value * self.scale;
+                named = true;
+            }
+        }
+        if !named {
+            return Err(self.error(line, column, "G92 needs an axis word"));
+        }
+        Ok(())
+    }
+
     /// G53 with G0 or G1: the axis words are machine coordinates, counted from home.
     fn machine_move(
         &mut self,
@@ -623,7 +663,11 @@ impl<'a> Reader<'a> {
         for (k, letter) in ['X', 'Y', 'Z'].into_iter().enumerate() {
             if let Some(w) = letters.take(letter) {
                 let v = w.value * self.scale;
-                end[k] = if self.absolute { v } else { end[k] + v };
+                end[k] = if self.absolute {
+                    self.origin[k] + v
+                } else {
+                    end[k] + v
+                };
                 named[k] = true;
                 if k == 2 {
                     z_place = Some(Place {
@@ -749,7 +793,7 @@ impl<'a> Reader<'a> {
             (i, j, None) => {
                 let offset = |w: Option<Word>, k: usize| -> Result<f64, PathError> {
                     match (w, self.arc_absolute) {
-                        (Some(w), true) => Ok(w.value * self.scale),
+                        (Some(w), true) => Ok(self.origin[k] + w.value * self.scale),
                         (Some(w), false) => Ok(self.position[k] + w.value * self.scale),
                         (None, false) => Ok(self.position[k]),
                         (None, true) => Err(self.error(
@@ -781,13 +825,13 @@ impl<'a> Reader<'a> {
                 "drilling cycles in incremental mode (G91) are not supported: write them in G90",
             ));
         }
-        let value = |w: Option<Word>| w.map(|w| (w.value * self.scale, w.column));
-        let depth = value(letters.take('Z'));
-        let retract = value(letters.take('R'));
+        let z = |w: Option<Word>| w.map(|w| (self.origin[2] + w.value * self.scale, w.column));
+        let depth = z(letters.take('Z'));
+        let retract = z(letters.take('R'));
         let dwell = letters
             .take('P')
             .map(|w| (w.value * self.dwell_unit(), w.column));
-        let peck = value(letters.take('Q'));
+        let peck = letters.take('Q').map(|w| (w.value * self.scale, w.column));
         if let Some(l) = letters.take('L').or_else(|| letters.take('K')) {
             if l.value != 1.0 {
                 return Err(self.error(line, l.column, "a cycle's repeats (L, K) must be 1"));
@@ -837,12 +881,17 @@ impl<'a> Reader<'a> {
         if matches!(motion, Motion::Line) && end == self.position {
             return;
         }
+        let corner = if std::mem::take(&mut self.stop_here) {
+            Corner::ExactStop
+        } else {
+            self.corner
+        };
         self.moves.push(PartMove {
             motion,
             speed,
             end,
             tool_axis: None,
-            corner: self.corner,
+            corner,
             place: Place { line, column: 1 },
             z_place,
         });
@@ -1307,6 +1356,34 @@ mod tests {
         assert!(
             e.starts_with("t.ngc:2:1: the arc's end is not on its circle"),
             "{e}"
+        );
+    }
+
+    #[test]
+    fn g92_moves_the_coordinates_zero_and_g9_stops_one_move() {
+        // CamBam's older posts set zero with G92 at the start; here after a move.
+        let p = read("G0 X10 Y10\nG92 X0 Y0\nG1 X5 F600\nG90.1 G2 X10 Y0 I7.5 J0\nG92.1\nG1 X30\n");
+        let ends: Vec<Vector2> = p
+            .moves()
+            .iter()
+            .map(|m| m.shape.curve().point(1.0))
+            .collect();
+        let want = [(15.0, 10.0), (20.0, 10.0), (30.0, 10.0)].map(|(x, y)| Vector2::new(x, y));
+        assert_eq!(ends, want);
+        let Shape::Arc(a) = &p.moves()[1].shape else {
+            panic!()
+        };
+        assert!((a.center() - Vector2::new(17.5, 10.0)).amax() < 1e-12);
+        assert!(refused("G92\n").starts_with("t.ngc:1:1: G92 needs an axis word"));
+        let p = read("G64\nG1 X10 F600\nG9 G1 Y10\nG1 X0\n");
+        let corners: Vec<Corner> = p.moves().iter().map(|m| m.corner).collect();
+        assert_eq!(
+            corners,
+            [
+                Corner::BlendDefault,
+                Corner::ExactStop,
+                Corner::BlendDefault
+            ]
         );
     }
 }
