@@ -170,7 +170,7 @@ struct Reader<'a> {
     /// G9 in the block: its move ends in an exact stop.
     stop_here: bool,
     moves: Vec<PartMove>,
-    skipped: BTreeSet<&'static str>,
+    skipped: BTreeSet<String>,
     warnings: Vec<Warning>,
 }
 
@@ -207,8 +207,8 @@ impl<'a> Reader<'a> {
     }
 
     /// Notes a skipped kind of word, with one warning per kind.
-    fn skip(&mut self, kind: &'static str, line: usize, column: usize) {
-        if self.skipped.insert(kind) {
+    fn skip(&mut self, kind: &str, line: usize, column: usize) {
+        if self.skipped.insert(kind.to_string()) {
             self.warnings.push(Warning {
                 file: self.name.to_string(),
                 place: Place { line, column },
@@ -432,6 +432,7 @@ impl<'a> Reader<'a> {
         }
         let mut stop = false;
         let mut end = false;
+        let mut machine_function = false;
         for &(code, column) in &m_codes {
             match code {
                 0 => stop = true,
@@ -446,12 +447,28 @@ impl<'a> Reader<'a> {
                 30..=50 => self.skip("M3-M5 (spindle)", line, column),
                 60 => self.skip("M6 (tool change)", line, column),
                 70..=90 => self.skip("M7-M9 (coolant)", line, column),
-                _ => {
+                // Subprogram calls and returns, program repeats and the modal-state
+                // save and restore change which moves run or how they read.
+                470 | 700..=730 | 980 | 990 => {
                     return Err(self.error(
                         line,
                         column,
-                        format!("M{} is not supported", code as f64 / 10.0),
+                        format!(
+                            "M{} is not supported: it changes which blocks run or the modes \
+                             they are read in; expand the program in the CAM post",
+                            code as f64 / 10.0
+                        ),
                     ))
+                }
+                // Every other M code is a machine function (I/O, vacuum, probing
+                // set-up, waiting for the planner): the axes do not move for it.
+                _ => {
+                    machine_function = true;
+                    self.skip(
+                        &format!("M{} (a machine function)", code as f64 / 10.0),
+                        line,
+                        column,
+                    );
                 }
             }
         }
@@ -492,6 +509,12 @@ impl<'a> Reader<'a> {
                 self.set_position(&mut letters, motion, line, column)?;
             }
             None => self.motion(&mut letters, motion, line)?,
+        }
+        if machine_function {
+            // What the motion left of P, Q and L are the machine function's arguments.
+            for letter in ['P', 'Q', 'L'] {
+                letters.take(letter);
+            }
         }
         if let Some(w) = letters.left_over() {
             let message = match w.letter {
@@ -1000,6 +1023,34 @@ mod tests {
     }
 
     #[test]
+    fn machine_m_codes_are_skipped_with_one_warning_per_code() {
+        // Makera's Fusion post: M400 (wait for the planner), M851/M852 (probe set-up),
+        // M62 (an output): none moves the axes; the path is the one without them.
+        let with = parse_gcode(
+            "G21 G90\nM400\nM851 S100\nG0 X1 Y1\nG1 X5 F600\nM62 P1\nM400\nG1 Y4\nM852\n",
+            "m.nc",
+            &GcodeOptions::default(),
+        )
+        .unwrap();
+        let without = parse_gcode(
+            "G21 G90\nG0 X1 Y1\nG1 X5 F600\nG1 Y4\n",
+            "m.nc",
+            &GcodeOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(with.poses(), without.poses());
+        let warnings = with.warning_lines();
+        for (code, line) in [("M400", 2), ("M851", 3), ("M62", 6), ("M852", 9)] {
+            let found: Vec<_> = warnings
+                .iter()
+                .filter(|w| w.contains(&format!("{code} (a machine function)")))
+                .collect();
+            assert_eq!(found.len(), 1, "{code}: {warnings:?}");
+            assert!(found[0].starts_with(&format!("m.nc:{line}:")), "{found:?}");
+        }
+    }
+
+    #[test]
     fn the_cam_preamble_is_skipped_with_one_warning_per_kind() {
         let p = read(
             "G21 G40 G49 G80 G94\nG54\nT1 M6\nS12000 M3 M8\nG0 Z5\nG0 X10 Y10\nG1 Z-1 F100\n\
@@ -1075,6 +1126,9 @@ mod tests {
             ),
             ("G1 X10\nG3 Y5\n", "t.ngc:2:1: an arc needs I and J, or R"),
             ("G1 X1 F0\n", "t.ngc:1:7: feed F0 must be > 0"),
+            ("G1 X1\nM98 P100\n", "t.ngc:2:1: M98 is not supported"),
+            ("G1 X1\nM99\n", "t.ngc:2:1: M99 is not supported"),
+            ("G1 X1\nM72\n", "t.ngc:2:1: M72 is not supported"),
             ("G1 X1 G0 Y1\n", "t.ngc:1:7: two motion codes"),
             ("G1 X[1+2]\n", "t.ngc:1:5: G-code syntax"),
             ("#1 = 2\n", "t.ngc:1:1: G-code syntax"),

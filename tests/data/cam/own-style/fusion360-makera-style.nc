@@ -1,0 +1,45 @@
+%
+(Fusion CAM style, written by the contour-control team: a 2D contour and a slot,)
+(rounded corners r 1.588 and 0.5 mm, coordinates to 3 decimals, machine M codes)
+G90 G94
+G17
+G21
+M6 T6
+M400
+M851 S100
+S15000 M3
+G54
+G0 X35.912 Y25.
+Z15.
+G1 Z5. F800.
+Z-2.5 F150.
+Y14. F800.
+G3 X37.499 Y12.412 I1.587 J0.
+G1 X62.5
+G3 X64.088 Y14. I0. J1.587
+G1 Y36.
+G3 X62.5 Y37.587 I-1.587 J0.
+G1 X37.499
+G3 X35.912 Y36. I0. J-1.587
+G1 Y25.
+Z15. F800.
+G0 X45.825 Y25.
+Z15.
+G1 Z5. F800.
+Z-1.2 F150.
+Y23.15 F500.
+G3 X46.325 Y22.65 I0.5 J0.
+G1 X53.675
+G3 X54.175 Y23.15 I0. J0.5
+G1 Y26.85
+G3 X53.675 Y27.35 I-0.5 J0.
+G1 X46.325
+G3 X45.825 Y26.85 I0. J-0.5
+G1 Y25.
+Z15. F800.
+M5
+M400
+M852
+G28
+M30
+%
