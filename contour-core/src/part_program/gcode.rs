@@ -247,20 +247,39 @@ impl<'a> Reader<'a> {
     }
 
     /// The words of one line, letters upper-cased.
-    fn words(&self, text: &str, line: usize) -> Result<Vec<Word>, PathError> {
-        if let Some(column) = two_signs(text) {
-            return Err(self.error(line, column, "a number takes one sign, not '+-'"));
+    fn words(&self, original: &str, line: usize) -> Result<Vec<Word>, PathError> {
+        let (text, columns) = plain(original);
+        // The column in `original` of a 1-based column of `text`.
+        let at = |column: usize| columns[column.clamp(1, columns.len()) - 1];
+        if let Some(column) = two_signs(&text) {
+            return Err(self.error(line, at(column), "a number takes one sign, not '+-'"));
         }
-        let snippet = snippet_parser(text).map_err(|e| {
+        if let Some(i) = outside_comments(&text, |b| matches!(b, b'#' | b'[')) {
+            return Err(self.error(
+                line,
+                at(i + 1),
+                "G-code syntax: '#' parameters and '[…]' expressions are not supported; have \
+                 the CAM post write plain numbers",
+            ));
+        }
+        if original.trim_start().starts_with('%') {
+            return Err(self.error(
+                line,
+                at(1),
+                "G-code syntax: a '%' line marks the program's start or end and holds nothing \
+                 else",
+            ));
+        }
+        let snippet = snippet_parser(&text).map_err(|e| {
             self.error(
                 line,
-                e.location.column,
+                at(e.location.column),
                 format!("G-code syntax: expected {}", e.expected),
             )
         })?;
         let mut words = Vec::new();
         for field in snippet.iter_fields() {
-            let column = field.span().0 + 1;
+            let column = at(field.span().0 + 1);
             let Field { letters, value } = Field::from(field);
             let mut chars = letters.chars();
             let (Some(letter), None) = (chars.next(), chars.next()) else {
@@ -286,7 +305,7 @@ impl<'a> Reader<'a> {
             });
         }
         if let Some(flag) = snippet.iter_flags().next() {
-            return Err(self.error(line, flag.span().0 + 1, "a letter without a number"));
+            return Err(self.error(line, at(flag.span().0 + 1), "a letter without a number"));
         }
         Ok(words)
     }
@@ -947,6 +966,62 @@ fn lines(text: &str) -> impl Iterator<Item = &str> {
 
 /// The 1-based column of a word's value signed twice (`X+-1.5`) outside comments, which
 /// the `g-code` crate's parser (0.6.0) meets with `unreachable!` instead of an error.
+/// A line as the syntax crate reads it: plain ASCII, with the 1-based column in the
+/// original line of each of its bytes (and one past the end). Comments may hold any
+/// character (a German or Portuguese post's header), so theirs become '_'; outside them a
+/// character that is not ASCII becomes '?', which the crate then refuses at its column. A
+/// space between a word's letter and its number (`X 45.`, as Inkscape's plug-ins write) is
+/// dropped: RS-274 ignores spaces there.
+fn plain(line: &str) -> (String, Vec<usize>) {
+    let chars: Vec<char> = line.chars().collect();
+    let mut text = String::with_capacity(chars.len());
+    let mut columns = Vec::with_capacity(chars.len() + 1);
+    let (mut in_parens, mut in_rest) = (false, false);
+    for (i, &c) in chars.iter().enumerate() {
+        let comment = in_parens || in_rest;
+        if !comment && matches!(c, ' ' | '\t') {
+            let after_letter = text.ends_with(|l: char| l.is_ascii_alphabetic());
+            let number_next = chars[i..]
+                .iter()
+                .find(|n| !matches!(n, ' ' | '\t'))
+                .is_some_and(|n| n.is_ascii_digit() || matches!(n, '+' | '-' | '.'));
+            if after_letter && number_next {
+                continue;
+            }
+        }
+        let shown = match (c.is_ascii(), comment) {
+            (true, _) => c,
+            (false, true) => '_',
+            (false, false) => '?',
+        };
+        match c {
+            '(' if !comment => in_parens = true,
+            ')' if in_parens => in_parens = false,
+            ';' if !comment => in_rest = true,
+            _ => {}
+        }
+        text.push(shown);
+        columns.push(i + 1);
+    }
+    columns.push(chars.len() + 1);
+    (text, columns)
+}
+
+/// The first byte of an ASCII line, outside its comments, that `wanted` picks.
+fn outside_comments(text: &str, wanted: impl Fn(u8) -> bool) -> Option<usize> {
+    let mut in_parens = false;
+    for (i, b) in text.bytes().enumerate() {
+        match b {
+            b'(' if !in_parens => in_parens = true,
+            b')' if in_parens => in_parens = false,
+            b';' if !in_parens => return None,
+            _ if !in_parens && wanted(b) => return Some(i),
+            _ => {}
+        }
+    }
+    None
+}
+
 fn two_signs(text: &str) -> Option<usize> {
     let bytes = text.as_bytes();
     let mut depth = 0usize;
@@ -1020,6 +1095,42 @@ mod tests {
         let want = 25.4 + 12.7 + 12.7 * PI / 2.0 + 12.7 + 25.4;
         assert!((p.length() - want).abs() < 1e-12, "{}", p.length());
         assert!(p.warnings.is_empty(), "{:?}", p.warnings);
+    }
+
+    #[test]
+    fn comments_in_any_language_and_spaces_inside_words() {
+        // A Portuguese and a German header (UTF-8), Inkscape's "X 45." and a tab: read as
+        // LinuxCNC reads them; a word's column still counts the characters before it.
+        let text = "( Plano de segurança = 5 )\n(Fräsen/Balsaholz)\nG21 G90\nG0 X 0 Y\t0\n\
+                    G1 X 45. F300. (Überfahrt ä)\nG1 Y 10 ; fim ç\n";
+        let read = parse_gcode(text, "p.nc", &GcodeOptions::default()).unwrap();
+        let plain = parse_gcode(
+            "G21 G90\nG0 X0 Y0\nG1 X45. F300.\nG1 Y10\n",
+            "p.nc",
+            &GcodeOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(read.poses(), plain.poses());
+        let cases = [
+            // Outside a comment a character that is not ASCII is refused where it stands.
+            ("G1 Xé5\n", "p.nc:1:5: G-code syntax"),
+            ("(ü) G1 X1 Y2 Q\n", "p.nc:1:14: a letter without a number"),
+            ("G1 X#1\n", "p.nc:1:5: G-code syntax: '#' parameters"),
+            (
+                "(#1 is fine here)\n#1 = 2\n",
+                "p.nc:2:1: G-code syntax: '#' parameters",
+            ),
+            (
+                "% vfd enable\nG1 X1\n",
+                "p.nc:1:1: G-code syntax: a '%' line",
+            ),
+        ];
+        for (text, expected) in cases {
+            let e = parse_gcode(text, "p.nc", &GcodeOptions::default())
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with(expected), "{text:?}: {e}");
+        }
     }
 
     #[test]
