@@ -11,7 +11,7 @@
 //! Argument order is the C one: `atan2(y, x)`, `hypot(a, b)`, `pow(x, y)`; `sincos(x)`
 //! returns `(sin, cos)` like `f64::sin_cos`, `expm1` is `f64::exp_m1` and `log` is `f64::ln`.
 
-pub use libm::{asin, atan2, cbrt, cos, cosh, exp, expm1, log, pow, sin, sincos, tan};
+pub use libm::{acos, asin, atan2, cbrt, cos, cosh, exp, expm1, log, pow, sin, sincos, tan};
 
 /// `libm::hypot`, kept out of line: inlined, it made `geometry::norm` too large to inline
 /// into the five-axis planner's loops (planning 100 k poses took 1.24× as long; out of

@@ -1,4 +1,4 @@
-//! The APT CL reader (`parse_cl`, as PathInterpolator5X reads a .cl/.apt file) on
+//! The APT CL reader (`parse_cl`, as PathInterpolator5X reads a CL file) on
 //! arbitrary text (lossily UTF-8: a file that is not is refused before parsing). What
 //! parses becomes a tool path (`ToolPath::from_poses`), is evaluated at awkward
 //! parameters and followed for a few samples through the inverse kinematics, as the

@@ -33,8 +33,9 @@ variable_table! {
     PATH: Str = Variable::parameter(
         "path",
         Start::String("tilted_helix"),
-        "tilted_helix or figure_eight (built-in), or a file: APT CL data (.cl, .apt: \
-         GOTO/x,y,z,i,j,k records) or a two-curve JSON file (.json); absolute, or relative \
+        "tilted_helix or figure_eight (built-in), or a file: APT CL data (.cl, .apt, NX .cls, \
+         CATIA .aptsource, Creo .ncl: GOTO/x,y,z,i,j,k records) or a two-curve JSON file \
+         (.json); absolute, or relative \
          to the FMU's resources folder, which holds the example CL part blade.cl",
     );
     FEED: Real = Variable::parameter(

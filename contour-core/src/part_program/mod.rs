@@ -157,7 +157,8 @@ impl PartProgram {
 pub enum FileKind {
     /// G-code (`.ngc`, `.nc`, `.gcode`, `.tap`).
     GCode,
-    /// APT cutter-location data (`.cl`, `.apt`).
+    /// APT cutter-location data (`.cl`, `.apt`, NX's `.cls`, CATIA's `.aptsource`, Creo's
+    /// `.ncl`).
     ClData,
     /// A JSON path: a planar NURBS curve or a five-axis curve pair.
     Json,
@@ -166,7 +167,7 @@ pub enum FileKind {
 /// The endings read as G-code.
 pub const GCODE_EXTENSIONS: [&str; 4] = ["ngc", "nc", "gcode", "tap"];
 /// The endings read as CL data.
-pub const CL_EXTENSIONS: [&str; 2] = ["cl", "apt"];
+pub const CL_EXTENSIONS: [&str; 5] = ["cl", "apt", "cls", "aptsource", "ncl"];
 
 /// What the file named `file` holds by its ending, `None` for another ending or none.
 /// The one place that decides it: the FMUs, the simulator and the tools all ask here.
@@ -195,6 +196,9 @@ mod tests {
         assert_eq!(kind("p.tap"), Some(FileKind::GCode));
         assert_eq!(kind("blade.cl"), Some(FileKind::ClData));
         assert_eq!(kind("C:\\cam\\blade.APT"), Some(FileKind::ClData));
+        assert_eq!(kind("impeller.cls"), Some(FileKind::ClData));
+        assert_eq!(kind("Part1.aptsource"), Some(FileKind::ClData));
+        assert_eq!(kind("op10.NCL"), Some(FileKind::ClData));
         assert_eq!(kind("curve.Json"), Some(FileKind::Json));
         assert_eq!(kind("trident"), None);
         assert_eq!(kind("notes.txt"), None);

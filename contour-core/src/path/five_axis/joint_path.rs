@@ -281,20 +281,12 @@ impl Planner<'_> {
         c >= self.joints.min[4] && c <= self.joints.max[4]
     }
 
-    /// Whether C's travel is short enough for a turn more or less to matter.
-    fn c_limited(&self) -> bool {
-        self.joints.max[4] - self.joints.min[4] < 1e3 * 2.0 * PI
-    }
-
-    /// The C values at the start of an off-cone run near `near`: the nearest turn, and
-    /// the next ones when the travel is limited.
+    /// The C values at the start of an off-cone run near `near`: the nearest turn and
+    /// the next ones. The travel may rule the nearest out; and where the azimuth swings
+    /// far inside the cone before it, C following it arrives a turn from the nearest.
     fn c_candidates(&self, base: f64, near: f64) -> Vec<f64> {
         let nearest = unwrap_near(base, near);
-        if self.c_limited() {
-            vec![nearest, nearest - 2.0 * PI, nearest + 2.0 * PI]
-        } else {
-            vec![nearest]
-        }
+        vec![nearest, nearest - 2.0 * PI, nearest + 2.0 * PI]
     }
 
     /// Whether a run off the cone can be driven on this branch from `c_start`: the first
@@ -365,36 +357,70 @@ impl Planner<'_> {
         let positive_ok = self.joints.max[3] > 0.0;
         let sin_budget = math::sin(self.budget);
         let count = run.end - run.start + 1;
-        // First the band nodes (None: free).
-        let mut c: Vec<Option<f64>> = Vec::with_capacity(count);
-        let mut centre: Option<(f64, bool)> = None;
-        for node in &nodes[run.start..=run.end] {
-            let sin_tilt = math::sin(node.tilt);
-            let target = linear(node.s);
-            if sin_tilt <= sin_budget {
-                centre = None;
-                c.push(None);
+        // First the band nodes (None: free). Along each stretch of them the band's centre
+        // follows the azimuth continuously, on one branch: the branch and the turn (2πk)
+        // whose centre lies nearest the target at both ends of the stretch. (Chosen at
+        // its first node alone, a stretch whose azimuth swings far before C leaves the
+        // cone took the branch that suits its start, and left the cone half a turn from
+        // where C goes next.)
+        let mut c: Vec<Option<f64>> = vec![None; count];
+        let in_band = |node: &Node| math::sin(node.tilt) > sin_budget;
+        let mut k = 0;
+        while k < count {
+            if !in_band(&nodes[run.start + k]) {
+                k += 1;
                 continue;
             }
-            let half_width = math::asin(BAND_SHARE * sin_budget / sin_tilt);
-            let (mid, flipped) = match centre {
-                Some((mid, flipped)) => {
-                    let base = node.azimuth + if flipped { PI } else { 0.0 };
-                    (unwrap_near(base, mid), flipped)
-                }
-                None => {
-                    let up = unwrap_near(node.azimuth, target);
-                    let down = unwrap_near(node.azimuth + PI, target);
-                    let up_better = (up - target).abs() <= (down - target).abs();
-                    if (up_better && positive_ok) || !negative_ok {
-                        (up, false)
-                    } else {
-                        (down, true)
-                    }
-                }
+            let first = k;
+            let mut track = vec![nodes[run.start + k].azimuth];
+            k += 1;
+            while k < count && in_band(&nodes[run.start + k]) {
+                let previous = track[track.len() - 1];
+                track.push(unwrap_near(nodes[run.start + k].azimuth, previous));
+                k += 1;
+            }
+            let (t_first, t_last) = (
+                linear(nodes[run.start + first].s),
+                linear(nodes[run.start + k - 1].s),
+            );
+            let (a, b) = (track[0], track[track.len() - 1]);
+            // The shift of the branch's track (a whole number of turns) that brings its
+            // ends nearest the targets, and how far they then are. An end of the path
+            // (no C beside the run there) sets no target.
+            let weights = match (c_in, c_out) {
+                (None, None) => (1.0, 0.0),
+                _ => (
+                    f64::from(u8::from(c_in.is_some())),
+                    f64::from(u8::from(c_out.is_some())),
+                ),
             };
-            centre = Some((mid, flipped));
-            c.push(Some(target.clamp(mid - half_width, mid + half_width)));
+            let fit = |flip: f64| {
+                let tau = std::f64::consts::TAU;
+                [t_first - a - flip, t_last - b - flip]
+                    .into_iter()
+                    .map(|d| flip + (d / tau).round() * tau)
+                    .map(|shift| {
+                        let miss = weights.0 * (a + shift - t_first).abs()
+                            + weights.1 * (b + shift - t_last).abs();
+                        (miss, shift)
+                    })
+                    .fold(
+                        (f64::INFINITY, 0.0),
+                        |best, x| if x.0 < best.0 { x } else { best },
+                    )
+            };
+            let (up, down) = (fit(0.0), fit(PI));
+            let shift = if (up.0 <= down.0 && positive_ok) || !negative_ok {
+                up.1
+            } else {
+                down.1
+            };
+            for (m, azimuth) in track.iter().enumerate() {
+                let node = &nodes[run.start + first + m];
+                let half_width = math::asin(BAND_SHARE * sin_budget / math::sin(node.tilt));
+                let mid = azimuth + shift;
+                c[first + m] = Some(linear(node.s).clamp(mid - half_width, mid + half_width));
+            }
         }
         // Then the free stretches: straight across from the values beside them.
         let mut k = 0;

@@ -167,7 +167,8 @@ struct ToolPathFile {
 /// Names of the built-in five-axis paths.
 pub const BUILTIN_TOOL_PATHS: [&str; 2] = ["tilted_helix", "figure_eight"];
 
-/// How a five-axis reference is named: a CL file (`.cl`, `.apt`), a two-curve JSON file
+/// How a five-axis reference is named: a CL file (`.cl`, `.apt`, `.cls`, `.aptsource`,
+/// `.ncl`), a two-curve JSON file
 /// (`.json`), or a built-in.
 enum Source<'a> {
     Cl(&'a str),
@@ -236,14 +237,15 @@ impl ToolPath {
                 Ok(EIGHT.get_or_init(ToolPath::figure_eight).clone())
             }
             _ => Err(PathError::invalid(format!(
-                "unknown five-axis path {name:?}: expected a .cl/.apt or .json file, or a \
+                "unknown five-axis path {name:?}: expected a CL file (.cl, .apt, .cls, .aptsource, \
+                 .ncl) or a .json file, or a \
                  built-in ({})",
                 BUILTIN_TOOL_PATHS.join(", ")
             ))),
         }
     }
 
-    /// The reference named `spec`: a CL file (`.cl`, `.apt`: APT GOTO records), a
+    /// The reference named `spec`: a CL file (`.cl`, `.apt`, `.cls`, `.aptsource`, `.ncl`), a
     /// two-curve JSON file (`.json`), or a built-in name; with the CL reader's warnings.
     pub fn load(spec: &str) -> Result<(ToolPath, Vec<String>), PathError> {
         match source(spec) {
