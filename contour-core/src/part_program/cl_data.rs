@@ -16,7 +16,7 @@
 //!   (xc,yc,zc) and radius r about the axis (i,j,k), counter-clockwise about it (the
 //!   right-hand rule, as NX and CATIA write it); it becomes chords whose sag is at most
 //!   [`ClOptions::arc_sag`]. Both ends must lie on the circle within max(0.01 mm, 0.1 % of
-//!   r).
+//!   r); r is at most 10 m.
 //! - `MSYS/x0,y0,z0,xi,xj,xk,yi,yj,yk` (NX): the frame the following records are written
 //!   in (origin, X and Y axes in the part's coordinates). The first one is the frame of
 //!   the whole reference; the records after a later, different one are carried into it.
@@ -64,6 +64,9 @@ const BARE_WORDS: [&str; 13] = [
     "GOHOME",
     "REWIND",
 ];
+/// The largest `CIRCLE` radius read, mm: 10 m, beyond any machine's table; at the
+/// default sag a full turn of it is 10 000 chords.
+const MAX_RADIUS: f64 = 1e4;
 /// The most moves a file becomes, `CIRCLE` chords included (2²⁴, the sampling budget of
 /// a five-axis curve pair): a huge circle at a tiny sag is refused, not allocated.
 const MAX_MOVES: usize = 1 << 24;
@@ -320,8 +323,11 @@ impl<'a> Reader<'a> {
                     geometry::unit(&self.in_part_frame_vector(&Vector::<3>::new(n[3], n[4], n[5])))
                         .ok_or_else(|| self.fail(line, "CIRCLE: the axis i,j,k is zero".into()))?;
                 let radius = n[6] * self.scale;
-                if radius <= 0.0 {
-                    return Err(self.fail(line, format!("CIRCLE: the radius {} is not > 0", n[6])));
+                if !(radius > 0.0 && radius <= MAX_RADIUS) {
+                    return Err(self.fail(
+                        line,
+                        format!("CIRCLE: the radius {radius} mm is not in (0, {MAX_RADIUS}] mm"),
+                    ));
                 }
                 self.circle = Some(Circle {
                     centre,
@@ -974,7 +980,7 @@ mod tests {
             (
                 "GOTO/1e11,0,0\nCIRCLE/0,0,0,0,0,1,1e11\nGOTO/1e11,0,0\n",
                 2,
-                "more than 16777216 moves",
+                "not in (0, 10000] mm",
             ),
             (
                 "MSYS/0,0,0,1,0,0,1,0,0\nGOTO/0,0,0\n",
