@@ -228,7 +228,8 @@ impl<'a> Reader<'a> {
 
     /// One warning per kind of skipped record.
     fn skip(&mut self, kind: &str, line: usize) {
-        if self.skipped.insert(kind.to_string()) {
+        // A String only for a kind not seen yet: a program repeats its kinds.
+        if !self.skipped.contains(kind) && self.skipped.insert(kind.to_owned()) {
             self.warn(
                 line,
                 format!(
