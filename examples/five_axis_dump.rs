@@ -160,8 +160,12 @@ fn closed_loop(path: &str, mode: &str, feed: f64, unplanned: bool) -> Value {
         "fuzzy" => CccMode::Fuzzy,
         other => fail(format!("MODE must be off, fixed or fuzzy (got {other})")),
     };
-    let (tool_path, _) = ToolPath::load(path).unwrap_or_else(|e| fail(e));
+    // A CL file's FEDRATs and RAPIDs as the interpolator FMU reads them (its `rapid`
+    // parameter's default: 100 mm/s).
+    let (tool_path, feeds, _) =
+        ToolPath::load_with_feeds(path, feed, 100.0).unwrap_or_else(|e| fail(e));
     let mut config = FiveAxisSimConfig::new(tool_path, feed).with_mode(mode);
+    config.feeds = feeds;
     if unplanned {
         config = config.unplanned();
     }

@@ -48,7 +48,7 @@ fn a_near_vertical_pass_with_the_azimuth_swinging_is_planned_within_the_travel()
         let poses = program.poses();
         // Inches read as inches.
         assert!((poses[1].tip[0] - 25.4 * step).abs() < 1e-9);
-        let path = plan_joints(&poses, &machine, &joints, &limits, 0.1, &|i| {
+        let path = plan_joints(&poses, &[], &machine, &joints, &limits, 0.1, &|i| {
             format!("near_pole.cls: GOTO {}", i + 1)
         })
         .unwrap_or_else(|e| panic!("step {step} swing {swing} period {period}: {e}"));

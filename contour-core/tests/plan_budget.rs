@@ -12,6 +12,7 @@ fn figure_eight(limits: PathLimits) -> FiveAxisInputs {
     FiveAxisInputs {
         path: ToolPath::builtin("figure_eight").expect("a built-in"),
         builtin: Some("figure_eight".into()),
+        feeds: Vec::new(),
         machine: TableTiltingAc::default(),
         joints: JointLimits::DEFAULT,
         limits,

@@ -253,23 +253,59 @@ fn a_dome_raster_over_its_apex() {
     check_all(&dome_raster(2), &joints, &limits, "dome");
 }
 
-#[test]
-fn a_path_beyond_the_a_travel_is_refused_naming_the_pose() {
-    let mut joints = JointLimits::default();
-    joints.max[3] = 20f64.to_radians();
-    joints.min[3] = -20f64.to_radians();
-    let e = FiveAxisPlan::new(
-        &tilting_pass(0.0),
+/// Why a plan of `poses` at 50 mm/s within `joints` is refused.
+fn refusal(poses: &[Pose], joints: &JointLimits) -> String {
+    FiveAxisPlan::new(
+        poses,
         TableTiltingAc::default(),
-        &joints,
+        joints,
         &PathLimits::at_feed(50.0),
         TS,
         &name,
     )
     .unwrap_err()
-    .to_string();
+    .to_string()
+}
+
+#[test]
+fn a_path_beyond_the_a_travel_is_refused_naming_the_pose() {
+    let mut joints = JointLimits::default();
+    joints.max[3] = 20f64.to_radians();
+    joints.min[3] = -20f64.to_radians();
+    let e = refusal(&tilting_pass(0.0), &joints);
     // 30° → −30° in 0.5° steps: pose 20 is the first beyond 20°... from the start, pose 0 is.
     assert!(e.contains("pose 0"), "{e}");
+    // The joint, the value it needs and its travel.
+    assert!(
+        e.contains("A would have to be 30.000° (or -30.000° on the other branch), outside its travel -20.000° … 20.000°"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_path_beyond_a_limited_c_travel_is_refused_naming_c_and_its_travel() {
+    // A pass round the part at 30° tilt, the axis leaning outward: C follows the
+    // azimuth through a whole turn, and a C limited to ±90° cannot.
+    let mut joints = JointLimits::default();
+    joints.min[4] = -90f64.to_radians();
+    joints.max[4] = 90f64.to_radians();
+    let round: Vec<Pose> = (0..=360)
+        .map(|i| {
+            let angle = (i as f64).to_radians();
+            let (s, c) = (math::sin(angle), math::cos(angle));
+            let tilt = 30f64.to_radians();
+            Pose {
+                tip: V3::new(40.0 * c, 40.0 * s, 0.0),
+                axis: V3::new(math::sin(tilt) * c, math::sin(tilt) * s, math::cos(tilt)),
+            }
+        })
+        .collect();
+    let e = refusal(&round, &joints);
+    assert!(
+        e.contains("no turn of it keeps C within its travel -90.000° … 90.000°"),
+        "{e}"
+    );
+    assert!(e.contains("tool axis 30.000° from the C axis"), "{e}");
 }
 
 #[test]

@@ -19,7 +19,8 @@ use crate::framework::variables::{Start, Values, Variable};
 use contour_core::limits::PathLimits;
 use contour_core::part_program::{cl_data, file_kind, FileKind};
 use contour_core::path::five_axis::{
-    FiveAxisInputs, FiveAxisReference, SavedFiveAxisReference, ToolPath, BUILTIN_TOOL_PATHS,
+    program_feeds, FeedChange, FiveAxisInputs, FiveAxisReference, SavedFiveAxisReference, ToolPath,
+    BUILTIN_TOOL_PATHS,
 };
 
 variable_table! {
@@ -41,7 +42,8 @@ variable_table! {
     FEED: Real = Variable::parameter(
         "feed",
         Start::Real(50.0),
-        "Tool-tip feed rate along the path (> 0): the greatest, where the plan allows it",
+        "Tool-tip feed rate along the path (> 0): the greatest, where the plan allows it; \
+         a CL file's FEDRAT wins from its first one on",
     )
     .unit("mm/s");
     TS: Real = Variable::parameter(
@@ -106,6 +108,13 @@ variable_table! {
     .unit("rad");
     VREF: Reals<5> = axis_block(&XYZAC, &[REFERENCE_VELOCITY_OUT]);
     AREF: Reals<5> = axis_block(&XYZAC, &[REFERENCE_ACCELERATION_OUT]);
+    // Last, so that the value references of the variables before it stay as they were.
+    RAPID: Real = Variable::parameter(
+        "rapid",
+        Start::Real(100.0),
+        "Tool-tip speed of a CL file's RAPID moves with a plan (> 0)",
+    )
+    .unit("mm/s");
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -194,13 +203,15 @@ const YZ_KNOWNS: [usize; 5] = [
 const KNOWN_COUNT: usize = 8 + kinematics_parameters::COUNT + joint_limits_parameters::COUNT;
 const _: () =
     assert!(PATH.vr() + KNOWN_COUNT == LIMITS.at(joint_limits_parameters::COUNT - 1).vr() + 1);
-const ALL_KNOWNS: [usize; KNOWN_COUNT] = {
-    let mut all = [0; KNOWN_COUNT];
+/// …and `rapid`, which came later.
+const ALL_KNOWNS: [usize; KNOWN_COUNT + 1] = {
+    let mut all = [0; KNOWN_COUNT + 1];
     let mut i = 0;
     while i < KNOWN_COUNT {
         all[i] = PATH.vr() + i;
         i += 1;
     }
+    all[KNOWN_COUNT] = RAPID.vr();
     all
 };
 
@@ -209,9 +220,10 @@ const ALL_KNOWNS: [usize; KNOWN_COUNT] = {
 /// built-in by name (see `JointReference`'s saved form). Version 3: the reference is
 /// constant-feed or planned (a plan saved as its inputs and the place on it). Version 4:
 /// the reference keeps the previous sample's joints (`vref.*`'s central difference).
+/// Version 5: a plan's inputs carry the program's speeds move by move.
 const LAYOUT: StateLayout = StateLayout {
     model: "PathInterpolator5X",
-    version: 4,
+    version: 5,
 };
 
 #[derive(Clone, serde::Serialize)]
@@ -269,11 +281,19 @@ pub struct PathInterpolator5X {
 struct Programmed {
     path: ToolPath,
     builtin: Option<String>,
+    /// A CL file's speeds move by move.
+    feeds: Vec<FeedChange>,
     lines: Option<(String, Vec<usize>)>,
     warnings: Vec<String>,
 }
 
-fn programmed(spec: &str, environment: &Environment) -> Result<Programmed, String> {
+/// `speeds`: the `feed` and `rapid` parameters, a CL file's speeds before its first
+/// `FEDRAT` and at `RAPID`.
+fn programmed(
+    spec: &str,
+    speeds: (f64, f64),
+    environment: &Environment,
+) -> Result<Programmed, String> {
     let spec = spec.trim();
     let message = |e: contour_core::path::PathError| format!("parameter 'path': {e}");
     let file = Path::new(spec);
@@ -283,6 +303,7 @@ fn programmed(spec: &str, environment: &Environment) -> Result<Programmed, Strin
         return Ok(Programmed {
             path: ToolPath::builtin(spec).map_err(message)?,
             builtin: Some(spec.to_owned()),
+            feeds: Vec::new(),
             lines: None,
             warnings: Vec::new(),
         });
@@ -298,10 +319,20 @@ fn programmed(spec: &str, environment: &Environment) -> Result<Programmed, Strin
     if file_kind(file) == Some(FileKind::ClData) {
         // Read here rather than through ToolPath::load: the plan names CL lines.
         let program = cl_data::load_cl(&full).map_err(|e| hint(message(e)))?;
-        let path = ToolPath::from_poses(&program.poses()).map_err(message)?;
+        let poses = program.poses();
+        if let Some(i) = poses.windows(2).position(|w| w[0].tip == w[1].tip) {
+            let line = program.lines()[i + 1];
+            return Err(format!(
+                "parameter 'path': {spec}:{line}: the tool turns on the spot (its tip stays \
+                 where the record before left it): a CL path here needs every move to move \
+                 the tip"
+            ));
+        }
+        let path = ToolPath::from_poses(&poses).map_err(message)?;
         return Ok(Programmed {
             path,
             builtin: None,
+            feeds: program_feeds(&program, speeds.0, speeds.1),
             lines: Some((spec.to_owned(), program.lines())),
             warnings: program.warning_lines(),
         });
@@ -310,6 +341,7 @@ fn programmed(spec: &str, environment: &Environment) -> Result<Programmed, Strin
     Ok(Programmed {
         path,
         builtin: None,
+        feeds: Vec::new(),
         lines: None,
         warnings,
     })
@@ -334,7 +366,12 @@ impl Model for PathInterpolator5X {
             pole_cone: POLE_CONE.get(values),
         };
         limits.check().map_err(|e| format!("plan: {e}"))?;
-        let programmed = programmed(PATH.get(values), &self.environment)?;
+        let rapid = RAPID.get(values);
+        if rapid <= 0.0 {
+            return Err(format!("parameter 'rapid' must be > 0 (got {rapid})"));
+        }
+        let programmed = programmed(PATH.get(values), (feed, rapid), &self.environment)?;
+        let unplanned_speeds = limits.accel == 0.0 && !programmed.feeds.is_empty();
         let lines = &programmed.lines;
         let name = |i: usize| match lines {
             Some((file, lines)) => match lines.get(i) {
@@ -346,6 +383,7 @@ impl Model for PathInterpolator5X {
         let inputs = FiveAxisInputs {
             path: programmed.path,
             builtin: programmed.builtin,
+            feeds: programmed.feeds,
             machine,
             joints,
             limits,
@@ -364,6 +402,13 @@ impl Model for PathInterpolator5X {
             .into_iter()
             .map(|w| format!("parameter 'path': {w}"))
             .collect();
+        if unplanned_speeds {
+            self.warnings.push(
+                "parameter 'path': with accel = 0 the tip runs at the constant 'feed' (the \
+                 file's FEDRAT and RAPID speeds are not planned: set 'accel' > 0)"
+                    .to_string(),
+            );
+        }
         self.state = Some(State {
             reference,
             clock: SampleClock::new(start_time, ts),

@@ -372,6 +372,7 @@ fn a_five_axis_reference_and_its_derivatives_sample_without_allocating() {
         let inputs = FiveAxisInputs {
             path: ToolPath::builtin("tilted_helix").unwrap(),
             builtin: Some("tilted_helix".into()),
+            feeds: Vec::new(),
             machine: TableTiltingAc::ORIGIN,
             joints: JointLimits::DEFAULT,
             limits,

@@ -133,6 +133,8 @@ def test_a_path_beyond_the_a_travel_is_refused_naming_the_cl_line(fmu_dir, tmp_p
     messages = " ".join(s.log.errors())
     # The first GOTO (line 2) tilts 120°: beyond A.max = 110° and A.min = −35°.
     assert "steep.cl:2" in messages, messages
+    assert "A would have to be 120.000°" in messages, messages
+    assert "outside its travel -35.000° … 110.000°" in messages, messages
     s.close()
 
 

@@ -359,6 +359,94 @@ def test_a_cl_file_in_the_fmus_resources_folder_is_found_by_its_relative_name(in
     assert np.allclose(interpolator.reals(REF), [3, 2, 3, 0, 0], atol=1e-9)
 
 
+NX_SPEEDS = """TOOL PATH/OP010,TOOL,EM_10
+TLDATA/MILL,10.0000,0.0000,75.0000,0.0000,0.0000
+PAINT/COLOR,211
+GOTO/0.0000,0.0000,0.0000,0.0000000,0.0000000,1.0000000
+GOTO/20.0000,0.0000,0.0000,0.0000000,0.0000000,1.0000000
+FEDRAT/MMPM,600.0000
+GOTO/60.0000,0.0000,0.0000,0.0000000,0.0000000,1.0000000
+PAINT/COLOR,186
+RAPID
+GOTO/60.0000,0.0000,60.0000,0.0000000,0.0000000,1.0000000
+GOTO/100.0000,0.0000,60.0000,0.0000000,0.0000000,1.0000000
+END-OF-PATH
+"""
+
+
+def run_tip(interpolator, seconds):
+    """Steps the interpolator 1 ms at a time until done (at most `seconds`); the tip's
+    speed between samples (the tool stays vertical, so X, Y, Z are the tip)."""
+    i = interpolator
+    tips = [i.reals(REF)[:3]]
+    for k in range(int(seconds * 1000)):
+        i.fmu.doStep(currentCommunicationPoint=k * 1e-3, communicationStepSize=1e-3)
+        tips.append(i.reals(REF)[:3])
+        if i.fmu.getBoolean([i.vr["done"]])[0]:
+            break
+    tips = np.array(tips)
+    return tips, np.linalg.norm(np.diff(tips, axis=0), axis=1) / 1e-3
+
+
+def test_a_cl_files_feeds_win_over_the_feed_parameter_and_its_rapids_run_at_rapid(
+        interpolator, tmp_path):
+    part = tmp_path / "speeds.cls"
+    part.write_text(NX_SPEEDS)
+    # 20 mm at the `feed` parameter (before the first FEDRAT), 40 mm at 600 mm/min,
+    # 60 mm at `rapid`, 40 mm at 600 mm/min again (a RAPID holds for one GOTO).
+    interpolator.set(path=str(part), feed=40.0, rapid=120.0)
+    interpolator.fmu.exitInitializationMode()
+    duration = interpolator.reals(["plannedDuration"])[0]
+    tips, speed = run_tip(interpolator, 20.0)
+    assert np.allclose(tips[-1], [100, 0, 60], atol=1e-9)
+    first = tips[1:, 0] < 19.0
+    feed = (tips[1:, 0] > 21.0) & (tips[1:, 2] < 1e-9) & (tips[1:, 0] < 59.0)
+    rapid = (tips[1:, 2] > 1.0) & (tips[1:, 2] < 59.0)
+    back = tips[1:, 0] > 61.0
+    assert 39.0 < speed[first].max() <= 40.0 * (1 + 1e-6)
+    # The jerk filter carries a speed change over its 25 ms: 40 mm/s runs 1 mm into the
+    # 10 mm/s move.
+    assert 9.9 < speed[feed & (tips[1:, 0] > 22.0)].max() <= 10.0 * (1 + 1e-6)
+    assert 119.0 < speed[rapid].max() <= 120.0 * (1 + 1e-6)
+    assert 9.9 < speed[back].max() <= 10.0 * (1 + 1e-6)
+    # No faster than every move at its own speed.
+    assert duration >= 20 / 40 + 40 / 10 + 60 / 120 + 40 / 10
+
+    # The rapid at half the speed: its 60 mm take 0.5 s longer at speed, 0.03 s less
+    # accelerating to it.
+    interpolator.fmu.reset()
+    interpolator.fmu.setupExperiment(startTime=0.0)
+    interpolator.fmu.enterInitializationMode()
+    interpolator.set(path=str(part), feed=40.0, rapid=60.0)
+    interpolator.fmu.exitInitializationMode()
+    slower = interpolator.reals(["plannedDuration"])[0]
+    assert 0.42 < slower - duration < 0.52, (slower, duration)
+
+
+def test_without_a_plan_a_cl_files_speeds_are_not_followed_and_it_says_so(interpolator, tmp_path):
+    part = tmp_path / "speeds.cls"
+    part.write_text(NX_SPEEDS)
+    interpolator.fmu.setDebugLogging(True, ["logStatusWarning"])
+    interpolator.set(path=str(part), feed=40.0, accel=0.0)
+    interpolator.fmu.exitInitializationMode()
+    assert any("FEDRAT and RAPID" in m for m in interpolator.log.warnings()), \
+        interpolator.log.messages
+    _, speed = run_tip(interpolator, 10.0)
+    assert np.allclose(speed[5:-5], 40.0, rtol=1e-6)
+
+
+def test_a_cl_tool_turning_on_the_spot_is_refused_with_its_line(interpolator, tmp_path):
+    part = tmp_path / "turn.cls"
+    part.write_text("GOTO/0,0,0,0,0,1\nGOTO/0,0,0,0,0,1\nGOTO/10,0,0,0,0,1\n"
+                    "GOTO/10,0,0,0,0.6,0.8\nGOTO/20,0,0,0,0.6,0.8\n")
+    interpolator.set(path=str(part))
+    with pytest.raises(FMICallException):
+        interpolator.fmu.exitInitializationMode()
+    # Line 2 repeats line 1 and is left out; line 4 turns the tool where line 3 left it.
+    assert any(f"{part}:4" in m and "turns on the spot" in m
+               for m in interpolator.log.errors()), interpolator.log.errors()
+
+
 def test_cross_check_files_reproduce_through_simulate_fmu(fmu_dir, tmp_path):
     before, after = five_axis_closed_loop(fmu_dir, path="tilted_helix", stop=0.3)
     write_cross_check(tmp_path, "ContourCCC5X", before, after, five_axis_demo.CROSS_CHECK_INPUTS,

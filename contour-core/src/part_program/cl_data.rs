@@ -26,6 +26,8 @@
 //!   and any other record that does not move the tool: skipped with one warning per kind.
 //!   Lines that are no record at all (a listing's header): skipped with one warning.
 //!
+//! A `GOTO` to the pose the tool is already at moves nothing and is left out.
+//!
 //! Refused with the file and line: a malformed `GOTO` (wrong count, not a number,
 //! non-finite, a zero axis), `CYCLE` (drilling cycles: their moves are the controller's),
 //! `CUTCOM` on (compensation), a `CIRCLE` not followed by a `GOTO` on it, a feed per turn
@@ -489,6 +491,12 @@ impl<'a> Reader<'a> {
         } else {
             self.feed.map_or(Speed::Default, Speed::Feed)
         };
+        // A GOTO to the pose the tool is at (CAM systems repeat points) moves nothing.
+        if let Some(last) = self.data.moves.last() {
+            if last.end == tip && last.tool_axis == Some(self.axis) {
+                return;
+            }
+        }
         self.data.moves.push(PartMove {
             motion: Motion::Line,
             speed,
@@ -743,6 +751,21 @@ mod tests {
             data.warning_lines(),
             ["blade.cl:7: tool axis of length 2 normalised"]
         );
+    }
+
+    #[test]
+    fn a_goto_to_where_the_tool_is_moves_nothing() {
+        let data = parse_cl(
+            "GOTO/1,2,3,0,0,1\nGOTO/1,2,3,0,0,1\nRAPID\nGOTO/1,2,3\nGOTO/4,2,3\n\
+             GOTO/4,2,3,0,0.6,0.8\n",
+            "r.cls",
+        )
+        .unwrap();
+        let lines: Vec<usize> = data.moves.iter().map(|m| m.place.line).collect();
+        // The repeats (lines 2 and 4) are left out, the RAPID spent on its own repeat; a
+        // turn on the spot (line 6) is a move of the tool axis.
+        assert_eq!(lines, [1, 5, 6]);
+        assert!(data.moves.iter().all(|m| m.speed == Speed::Default));
     }
 
     #[test]

@@ -28,7 +28,7 @@ use crate::control::{CccMode, FiveAxisConfig, FiveAxisController, Hold};
 use crate::geometry::{self, angle_between, Vector};
 use crate::kinematics::Joints;
 use crate::limits::{JointLimits, PathLimits};
-use crate::path::five_axis::{FiveAxisInputs, FiveAxisReference, Planner, ToolPath};
+use crate::path::five_axis::{FeedChange, FiveAxisInputs, FiveAxisReference, Planner, ToolPath};
 use crate::path::{Curve, PathError};
 use crate::plant::{ServoAxes, ServoAxesParams};
 
@@ -44,6 +44,9 @@ pub struct FiveAxisSimConfig {
     pub path: ToolPath,
     /// The built-in's name when the path is one (plans of it are shared by name).
     pub builtin: Option<String>,
+    /// A CL file's speeds move by move (see [`ToolPath::load_with_feeds`]); none:
+    /// `path_limits.feed` throughout.
+    pub feeds: Vec<FeedChange>,
     /// The tip's feed and, with `accel` > 0, the plan's limits and tolerances (see
     /// [`FiveAxisReference`]).
     pub path_limits: PathLimits,
@@ -69,6 +72,7 @@ impl FiveAxisSimConfig {
         FiveAxisSimConfig {
             path,
             builtin: None,
+            feeds: Vec::new(),
             path_limits: PathLimits::at_feed(feed),
             joint_limits: JointLimits::default(),
             controller: FiveAxisConfig::DEFAULT,
@@ -217,6 +221,7 @@ pub fn simulate_five_axis(
     let inputs = FiveAxisInputs {
         path: config.path.clone(),
         builtin: config.builtin.clone(),
+        feeds: config.feeds.clone(),
         machine: config.controller.machine,
         joints: config.joint_limits,
         limits: config.path_limits,

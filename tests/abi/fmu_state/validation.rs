@@ -344,8 +344,9 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
     // XYServoPlant 3 (each axis gained its effects and the table behind the play; 2: the
     // lead became a transmission), PathInterpolator2D 3 (a program's moves carry their
     // standstill; 2: the planned reference joined the constant-feed one), ContourCCC5X 4 (the feed-forward
-    // gains, the guard's averaged speeds and commands), PathInterpolator5X 4 (the sample
-    // before the current one, for vref and aref).
+    // gains, the guard's averaged speeds and commands), PathInterpolator5X 5 (a plan's
+    // inputs carry a CL file's speeds; 4: the sample before the current one, for vref and
+    // aref).
     for (i, bytes, model, version) in [
         (&controller, &controller_bytes, "ContourCCC2D", 6u16),
         (&plant_instance, &plant_bytes, "XYServoPlant", 3),
@@ -355,7 +356,7 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
             &interpolator_5x,
             &interpolator_5x_bytes,
             "PathInterpolator5X",
-            4,
+            5,
         ),
     ] {
         let (_, envelope) = open_state(bytes);

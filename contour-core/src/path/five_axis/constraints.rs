@@ -198,7 +198,9 @@ impl<'a> Constraints<'a> {
 
     /// The largest speed at node `n` (mm/s) its limits allow at zero path acceleration.
     fn top_speed_at(&self, n: usize) -> f64 {
-        let mut top = self.limits.feed;
+        // The node is on both pieces beside it.
+        let feed = &self.path.feed;
+        let mut top = feed[n].min(feed[n.saturating_sub(1)]);
         // The slopes on both sides: the speed is the same at the node.
         let slope = self.bends(n, 0.0).slope;
         for i in 0..5 {

@@ -15,6 +15,7 @@
 //! interpolated in s from where it enters the cone to where it leaves and clamped into
 //! the band it occupies, so it turns where the band lets it.
 
+use super::programmed_feed::{feed_of_move, FeedChange};
 use crate::geometry::{self, slerp, Vector};
 use crate::kinematics::{axis_angles, unwrap_near, Joints, Pose, TableTiltingAc};
 use crate::limits::{JointLimits, PathLimits};
@@ -30,6 +31,9 @@ const C_STEP: f64 = 2e-2;
 /// The most nodes a path may have (the planner's memory: about 150 bytes each, 1.3 GB at
 /// the budget; a 100 000-point CL raster of 25 m has 630 000).
 pub const NODE_BUDGET: usize = 1 << 23;
+/// The length along s a tool turning on the spot moves per radian of its turn, mm: far
+/// below any tip move a CAM system writes, so only such turns see it.
+const TURN_LENGTH: f64 = 1e-3;
 /// The share of its band C is held in near the pole (see `through_cone`).
 const BAND_SHARE: f64 = 0.9;
 /// Rounds of refinement inside the cones before the plan gives up.
@@ -48,6 +52,9 @@ pub struct JointPath {
     pub source: Vec<f64>,
     /// Angle between the planned and the programmed tool axis at each node, rad.
     pub deviation: Vec<f64>,
+    /// The programmed speed of the piece from each node to the next (the last node: its
+    /// piece before), mm/s.
+    pub feed: Vec<f64>,
 }
 
 /// One node's programmed pose with its place and angles.
@@ -100,7 +107,8 @@ fn skip_limits(path: &PathLimits) -> (f64, f64) {
 /// `spacing`; where they are denser (a sampled curve, a CL file at microns), only those
 /// the straight move between their neighbours would leave by more than `limits` (tip mm,
 /// axis rad): planning time then follows the path's length, not its point count.
-fn kept(poses: &[Pose], spacing: f64, limits: (f64, f64)) -> Vec<usize> {
+/// A pose in `breaks` (where the programmed speed changes) is always kept.
+fn kept(poses: &[Pose], spacing: f64, limits: (f64, f64), breaks: &[usize]) -> Vec<usize> {
     // Whether the straight move from pose a to pose b stands for every pose between.
     let fits = |a: usize, b: usize| {
         let (pa, pb) = (&poses[a], &poses[b]);
@@ -123,7 +131,7 @@ fn kept(poses: &[Pose], spacing: f64, limits: (f64, f64)) -> Vec<usize> {
     let mut anchor = 0;
     while anchor < last {
         let mut end = anchor + 1;
-        while end < last && fits(anchor, end + 1) {
+        while end < last && breaks.binary_search(&end).is_err() && fits(anchor, end + 1) {
             end += 1;
         }
         out.push(end);
@@ -137,6 +145,7 @@ fn kept(poses: &[Pose], spacing: f64, limits: (f64, f64)) -> Vec<usize> {
 /// within `fine` rad of the cone, steps of an eighth of the plan's orientation budget.
 fn nodes(
     all: &[Pose],
+    breaks: &[usize],
     spacing: f64,
     skip: (f64, f64),
     cone: f64,
@@ -154,7 +163,7 @@ fn nodes(
              the {NODE_BUDGET} planning nodes a path may have"
         )));
     }
-    let keep = kept(all, spacing, skip);
+    let keep = kept(all, spacing, skip, breaks);
     let poses: Vec<Pose> = keep.iter().map(|&k| all[k]).collect();
     let mut out = Vec::with_capacity(poses.len());
     let node = |pose: Pose, source: f64, s: f64| {
@@ -170,8 +179,14 @@ fn nodes(
     out.push(node(poses[0], 0.0, 0.0));
     for (i, w) in poses.windows(2).enumerate() {
         let (a, b) = (&w[0], &w[1]);
-        let length = geometry::dist(&a.tip, &b.tip);
         let turn = geometry::angle_between(&a.axis, &b.axis);
+        // A pose written twice adds nothing; a tool turning on the spot (a retract's
+        // tilt, a CAM system's repeated point) moves along s by its turn at
+        // `TURN_LENGTH` mm a radian, so the feed plan has a length to run it on.
+        let length = geometry::dist(&a.tip, &b.tip).max(TURN_LENGTH * turn);
+        if length == 0.0 {
+            continue;
+        }
         let (ta, ga) = axis_angles(&a.axis);
         let (tb, gb) = axis_angles(&b.axis);
         let near_pole = ta.min(tb) < cone + turn;
@@ -509,9 +524,11 @@ impl Planner<'_> {
 /// Chooses the joints along `poses` (see the module's text) for `machine` within
 /// `joints`' travel and `path`'s tolerances, with nodes at most `spacing` mm apart;
 /// `name` names a programmed pose in messages ("CL line 12"). A path that no choice
-/// keeps within the travel is refused, naming the first pose none can reach.
+/// keeps within the travel is refused, naming the first pose none can reach. Each piece
+/// carries its move's programmed speed (`feeds`; `path.feed` before the first change).
 pub fn plan_joints(
     poses: &[Pose],
+    feeds: &[FeedChange],
     machine: &TableTiltingAc,
     joints: &JointLimits,
     path: &PathLimits,
@@ -529,10 +546,23 @@ pub fn plan_joints(
     };
     // An eighth of the budget per node near the pole resolves where the band opens.
     let fine = (budget / 8.0).max(1e-6);
-    let mut nodes = nodes(poses, spacing, skip_limits(path), path.pole_cone, fine)?;
+    // The pose before each change ends the last move at the old speed.
+    let breaks: Vec<usize> = feeds.iter().map(|c| c.from - 1).collect();
+    let mut nodes = nodes(
+        poses,
+        &breaks,
+        spacing,
+        skip_limits(path),
+        path.pole_cone,
+        fine,
+    )?;
     for _ in 0..REFINE_ROUNDS {
         match choose(&planner, &nodes, name) {
-            Ok(rotary) => return Ok(assemble(machine, &nodes, &rotary)),
+            Ok(rotary) => {
+                let mut joint_path = assemble(machine, &nodes, &rotary);
+                joint_path.feed = piece_feeds(&joint_path.source, feeds, path.feed);
+                return Ok(joint_path);
+            }
             Err(Choice::Refine(mut at)) => {
                 at.sort_unstable();
                 at.dedup();
@@ -554,12 +584,41 @@ enum Choice {
     Refused(PathError),
 }
 
-fn unreachable(nodes: &[Node], n: usize, name: &dyn Fn(usize) -> String, why: &str) -> Choice {
-    let pose = nodes[n].source.round() as usize;
+/// The refusal at node `n`: the pose, what failed, and the joint that cannot follow with
+/// the value it would need and its travel (degrees, as a machine's limits are written).
+fn unreachable(
+    planner: &Planner,
+    nodes: &[Node],
+    n: usize,
+    name: &dyn Fn(usize) -> String,
+    why: &str,
+) -> Choice {
+    let node = &nodes[n];
+    let pose = node.source.round() as usize;
+    let (min, max) = (planner.joints.min, planner.joints.max);
+    let degrees = |x: f64| x.to_degrees();
+    let joint = if !planner.a_ok(node.tilt) && !planner.a_ok(-node.tilt) {
+        format!(
+            "A would have to be {:.3}° (or {:.3}° on the other branch), outside its travel \
+             {:.3}° … {:.3}°",
+            degrees(node.tilt),
+            degrees(-node.tilt),
+            degrees(min[3]),
+            degrees(max[3])
+        )
+    } else {
+        format!(
+            "C must follow the tool axis's azimuth ({:.3}° here) and no turn of it keeps C \
+             within its travel {:.3}° … {:.3}°",
+            degrees(node.azimuth),
+            degrees(min[4]),
+            degrees(max[4])
+        )
+    };
     Choice::Refused(PathError::invalid(format!(
-        "{}: {why} (tool axis {:.4} rad from the C axis)",
+        "{}: {why}: {joint} (tool axis {:.3}° from the C axis)",
         name(pose),
-        nodes[n].tilt
+        degrees(node.tilt)
     )))
 }
 
@@ -580,6 +639,7 @@ fn choose(
             .map_err(|f| match f {
                 ConeFailure::Refine(at) => Choice::Refine(at),
                 ConeFailure::Impossible => unreachable(
+                    planner,
                     nodes,
                     0,
                     name,
@@ -672,6 +732,7 @@ fn choose(
             }
             let n = first_violation.unwrap_or(if r > 0 { runs[r - 1].start } else { run.start });
             return Err(unreachable(
+                planner,
                 nodes,
                 n,
                 name,
@@ -708,6 +769,7 @@ fn choose(
     let Some((mut index, _)) = best else {
         let n = trailing.map_or(last_run.end, |t| t.start);
         return Err(unreachable(
+            planner,
             nodes,
             n,
             name,
@@ -752,6 +814,7 @@ fn choose(
             .map_err(|failure| match failure {
                 ConeFailure::Refine(at) if !at.is_empty() => Choice::Refine(at),
                 _ => unreachable(
+                    planner,
                     nodes,
                     run.start,
                     name,
@@ -770,6 +833,7 @@ fn assemble(machine: &TableTiltingAc, nodes: &[Node], rotary: &[(f64, f64)]) -> 
         poses: Vec::with_capacity(nodes.len()),
         source: Vec::with_capacity(nodes.len()),
         deviation: Vec::with_capacity(nodes.len()),
+        feed: Vec::new(),
     };
     for (node, &(a, c)) in nodes.iter().zip(rotary) {
         let planned = Vector::<3>::new(
@@ -785,4 +849,20 @@ fn assemble(machine: &TableTiltingAc, nodes: &[Node], rotary: &[(f64, f64)]) -> 
             .push(geometry::angle_between(&planned, &node.pose.axis));
     }
     path
+}
+
+/// The programmed speed of the piece after each node (see [`JointPath::feed`]): the
+/// move its middle lies on. The poses where the speed changes are nodes, so a piece lies
+/// on moves of one speed.
+fn piece_feeds(source: &[f64], feeds: &[FeedChange], default: f64) -> Vec<f64> {
+    let mut out: Vec<f64> = source
+        .windows(2)
+        .map(|w| {
+            let middle = 0.5 * (w[0] + w[1]);
+            feed_of_move(feeds, default, middle.floor() as usize + 1)
+        })
+        .collect();
+    let last = out.last().copied().unwrap_or(default);
+    out.push(last);
+    out
 }

@@ -13,6 +13,7 @@ mod joint_reference;
 mod plan;
 mod planned_reference;
 mod planner;
+mod programmed_feed;
 mod reference;
 mod tool_path;
 
@@ -24,5 +25,6 @@ pub use plan::{
 };
 pub use planned_reference::{PlannedFiveAxisReference, SavedPlannedReference};
 pub use planner::{FiveAxisInputs, Planner};
+pub use programmed_feed::{check_feeds, feed_of_move, greatest_feed, program_feeds, FeedChange};
 pub use reference::{FiveAxisReference, ReferenceSample, SavedFiveAxisReference};
 pub use tool_path::{load_poses, ToolPath, ToolPathData, BUILTIN_TOOL_PATHS};

@@ -21,6 +21,7 @@ use std::cell::Cell;
 use super::constraints::{tip_turn, Constraints};
 use super::jerk_filter::JerkFilter;
 use super::joint_path::{plan_joints, JointPath};
+use super::programmed_feed::{check_feeds, greatest_feed, FeedChange};
 use crate::geometry::{self, Vector};
 use crate::kinematics::{Joints, Pose, TableTiltingAc};
 use crate::limits::{JointLimits, PathLimits};
@@ -130,13 +131,22 @@ impl FiveAxisPlan {
         ts: f64,
         name: &dyn Fn(usize) -> String,
     ) -> Result<FiveAxisPlan, PathError> {
-        Self::within_budget(poses, machine, joints, limits, ts, name, SAMPLE_BUDGET)
+        Self::within_budget(
+            (poses, &[]),
+            machine,
+            joints,
+            limits,
+            ts,
+            name,
+            SAMPLE_BUDGET,
+        )
     }
 
-    /// [`FiveAxisPlan::new`] refusing a plan of more than `budget` samples (see
-    /// [`SAMPLE_BUDGET`]).
+    /// [`FiveAxisPlan::new`] with the program's speeds move by move (`feeds`, see
+    /// [`FeedChange`]; `limits.feed` before the first), refusing a plan of more than
+    /// `budget` samples (see [`SAMPLE_BUDGET`]).
     pub fn within_budget(
-        poses: &[Pose],
+        (poses, feeds): (&[Pose], &[FeedChange]),
         machine: TableTiltingAc,
         joints: &JointLimits,
         limits: &PathLimits,
@@ -154,11 +164,13 @@ impl FiveAxisPlan {
                 "sample period {ts} s must be > 0"
             )));
         }
+        check_feeds(feeds, poses.len())?;
         // Fine enough for the braking distances the feed planner integrates.
-        let braking = limits.feed * limits.feed / (2.0 * limits.accel);
+        let fastest = greatest_feed(feeds, limits.feed);
+        let braking = fastest * fastest / (2.0 * limits.accel);
         let spacing = (braking / 10.0)
             .clamp(5e-3, 0.5)
-            .min(limits.feed * ts)
+            .min(fastest * ts)
             .max(1e-4);
         // At the feed throughout the path would take this many samples at least: refuse
         // before any work what the budget cannot hold.
@@ -166,15 +178,14 @@ impl FiveAxisPlan {
             .windows(2)
             .map(|w| geometry::dist(&w[0].tip, &w[1].tip))
             .sum();
-        let least = length / (limits.feed * ts);
+        let least = length / (fastest * ts);
         if least.is_nan() || least > budget as f64 {
             return Err(PathError::invalid(format!(
-                "the path is {length:.6e} mm long: at {} mm/s that is more than the {} \
-                 samples a plan may have",
-                limits.feed, budget
+                "the path is {length:.6e} mm long: at {fastest} mm/s that is more than the \
+                 {budget} samples a plan may have"
             )));
         }
-        let path = plan_joints(poses, &machine, joints, limits, spacing, name)?;
+        let path = plan_joints(poses, feeds, &machine, joints, limits, spacing, name)?;
         // Planning costs a few tens of microseconds per node and round: a path with far
         // more nodes than the samples it may have is refused too (a fuzzed path of tiny
         // moves that the joints' refinement multiplies).
@@ -435,7 +446,13 @@ impl FiveAxisPlan {
         for n in start..=end {
             let (a, b) = (poses[n].tip, poses[n + 1].tip);
             let d = b - a;
-            let t = ((pose.tip - a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+            // A piece where the tool turns on the spot: its one point.
+            let length2 = d.norm_squared();
+            let t = if length2 > 0.0 {
+                ((pose.tip - a).dot(&d) / length2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             let distance = geometry::dist(&(a + d * t), &pose.tip);
             if distance < best.1 {
                 best = (n, distance, t);
@@ -444,6 +461,22 @@ impl FiveAxisPlan {
         let (n, distance, t) = best;
         let axis = geometry::slerp(&poses[n].axis, &poses[n + 1].axis, t).unwrap_or(poses[n].axis);
         (n, distance, geometry::angle_between(&axis, &pose.axis))
+    }
+
+    /// The programmed speed a filtered sample at speed `v` is held to: its foot's piece's
+    /// (`foot`), or where that is exceeded the greatest of the pieces its raw samples
+    /// came from (`first..=last`), since the filter carries a speed change over its
+    /// window as a controller's filter after interpolation does.
+    fn feed_near(&self, foot: usize, first: usize, last: usize, v: f64) -> f64 {
+        let feed = &self.path.feed;
+        let here = feed[foot.min(feed.len() - 1)];
+        if v <= here {
+            return here;
+        }
+        let last = (last + 1).min(feed.len() - 1);
+        feed[first.min(last)..=last]
+            .iter()
+            .fold(here, |m, &f| m.max(f))
     }
 
     /// The node in `first..=last` where the tip's path turns most.
@@ -505,8 +538,9 @@ impl FiveAxisPlan {
                 }
                 let v = geometry::dist(&tip, &p1) / ts;
                 let a = geometry::norm(&(tip - p1 * 2.0 + p2)) / (ts * ts);
-                if v > limits.feed * (1.0 + 1e-6) {
-                    speed_factor = speed_factor.min((limits.feed / v).powi(2));
+                let feed = self.feed_near(cursor.foot, intervals[0], cursor.interval, v);
+                if v > feed * (1.0 + 1e-6) {
+                    speed_factor = speed_factor.min((feed / v).powi(2));
                 }
                 if a > limits.accel * (1.0 + 1e-6) + 1e-3 {
                     let r = limits.accel / a;

@@ -164,6 +164,7 @@ impl SavedPlannedReference {
             RestoredInputs::Builtin(name, machine, joints, limits, ts) => FiveAxisInputs {
                 path: ToolPath::builtin(&name).map_err(|e| e.to_string())?,
                 builtin: Some(name),
+                feeds: Vec::new(),
                 machine,
                 joints,
                 limits,

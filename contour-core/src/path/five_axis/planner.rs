@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, Weak};
 
 use super::plan::{FiveAxisPlan, SAMPLE_BUDGET};
-use super::ToolPath;
+use super::{FeedChange, ToolPath};
 use crate::kinematics::TableTiltingAc;
 use crate::limits::{JointLimits, PathLimits};
 use crate::path::PathError;
@@ -22,6 +22,9 @@ pub struct FiveAxisInputs {
     pub path: ToolPath,
     /// The built-in's name when the path is one.
     pub builtin: Option<String>,
+    /// The program's speeds move by move (a CL file's `FEDRAT`s and `RAPID`s); none:
+    /// `limits.feed` throughout.
+    pub feeds: Vec<FeedChange>,
     /// The machine's geometry.
     pub machine: TableTiltingAc,
     /// The joints' limits.
@@ -100,7 +103,7 @@ impl Planner {
         }
         let poses = inputs.path.poses(PLAN_CHORD)?;
         let plan = Arc::new(FiveAxisPlan::within_budget(
-            &poses,
+            (&poses, &inputs.feeds),
             inputs.machine,
             &inputs.joints,
             &inputs.limits,
@@ -140,7 +143,13 @@ fn fingerprint(inputs: &FiveAxisInputs) -> u64 {
             .unwrap_or_default()
             .hash(&mut hasher),
     }
-    let rest = (&inputs.machine, &inputs.joints, &inputs.limits, inputs.ts);
+    let rest = (
+        &inputs.machine,
+        &inputs.joints,
+        &inputs.limits,
+        inputs.ts,
+        &inputs.feeds,
+    );
     postcard::to_stdvec(&rest)
         .unwrap_or_default()
         .hash(&mut hasher);

@@ -246,6 +246,7 @@ mod tests {
         FiveAxisInputs {
             path: ToolPath::builtin("tilted_helix").unwrap(),
             builtin: Some("tilted_helix".into()),
+            feeds: Vec::new(),
             machine: TableTiltingAc::ORIGIN,
             joints: JointLimits::DEFAULT,
             limits,

@@ -8,6 +8,7 @@ use std::sync::{Arc, OnceLock};
 
 use serde::{Deserialize, Serialize};
 
+use super::programmed_feed::{program_feeds, FeedChange};
 use crate::geometry::{self, slerp, Vector};
 use crate::kinematics::Pose;
 use crate::part_program::cl_data::load_cl;
@@ -248,19 +249,31 @@ impl ToolPath {
     /// The reference named `spec`: a CL file (`.cl`, `.apt`, `.cls`, `.aptsource`, `.ncl`), a
     /// two-curve JSON file (`.json`), or a built-in name; with the CL reader's warnings.
     pub fn load(spec: &str) -> Result<(ToolPath, Vec<String>), PathError> {
+        let (path, _, warnings) = Self::load_with_feeds(spec, 1.0, 1.0)?;
+        Ok((path, warnings))
+    }
+
+    /// [`ToolPath::load`] with a CL file's speeds move by move ([`program_feeds`]: `feed`
+    /// before its first `FEDRAT`, `rapid` at `RAPID`); none for another path.
+    pub fn load_with_feeds(
+        spec: &str,
+        feed: f64,
+        rapid: f64,
+    ) -> Result<(ToolPath, Vec<FeedChange>, Vec<String>), PathError> {
         match source(spec) {
             Source::Cl(file) => {
                 let program = load_cl(file)?;
                 Ok((
                     ToolPath::from_poses(&program.poses())?,
+                    program_feeds(&program, feed, rapid),
                     program.warning_lines(),
                 ))
             }
             Source::Json(file) => {
                 let (name, text) = read_path_file(file.as_ref())?;
-                Ok((ToolPath::parse_json(&text, &name)?, Vec::new()))
+                Ok((ToolPath::parse_json(&text, &name)?, Vec::new(), Vec::new()))
             }
-            Source::Builtin(name) => Ok((ToolPath::builtin(name)?, Vec::new())),
+            Source::Builtin(name) => Ok((ToolPath::builtin(name)?, Vec::new(), Vec::new())),
         }
     }
 

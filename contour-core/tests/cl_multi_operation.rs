@@ -1,0 +1,296 @@
+//! A fifteen-operation CL file as NX writes it (an information listing's header, `TOOL
+//! PATH`, `TLDATA`, `MSYS`, `PAINT`, `SPINDL` records, `FEDRAT`s, `RAPID`s between the
+//! operations, `CIRCLE` corners, tilts from 0° to 90°, a raster over a dome's apex and a
+//! pass beside vertical; `cam_examples::nx_multi_operation_cls`), planned as the
+//! five-axis interpolator plans it with the file's own speeds. The reference is judged
+//! against the test's own reading of the file: every sample within the tolerances of the
+//! CL path, within the joints' limits, no faster than the move it is on, and its duration
+//! between bounds the test derives from the file.
+
+use std::time::Instant;
+
+use contour_core::geometry::{self, Vector};
+use contour_core::kinematics::{Pose, TableTiltingAc};
+use contour_core::limits::{JointLimits, PathLimits};
+use contour_core::math;
+use contour_core::part_program::cl_data::parse_cl;
+use contour_core::path::five_axis::{
+    cam_examples, program_feeds, FiveAxisInputs, FiveAxisReference, Planner, ToolPath,
+};
+
+const TS: f64 = 1e-3;
+/// The interpolator's `feed` and `rapid` parameters, mm/s: the file's FEDRATs win.
+const FEED: f64 = 50.0;
+const RAPID: f64 = 100.0;
+
+/// One straight piece of the CL path as this test reads the file.
+#[derive(Clone, Copy)]
+struct Piece {
+    from: Pose,
+    to: Pose,
+    /// mm/s.
+    feed: f64,
+}
+
+/// A record's numbers (its words, `MMPM`, left out).
+fn numbers(record: &str) -> Vec<f64> {
+    let (_, args) = record.split_once('/').unwrap();
+    args.split(',')
+        .filter_map(|x| x.trim().parse::<f64>().ok())
+        .collect()
+}
+
+/// The file's moves as straight pieces, each `CIRCLE` as chords of at most 0.1 µm sag,
+/// counter-clockwise about its axis; the speed of each (FEDRAT in mm/min, `RAPID` for
+/// the next GOTO only, `FEED` before the first FEDRAT).
+fn read(text: &str) -> Vec<Piece> {
+    let mut pieces = Vec::new();
+    let (mut feed, mut rapid) = (FEED, false);
+    let mut at: Option<Pose> = None;
+    let mut circle: Option<(Vector<3>, Vector<3>, f64)> = None;
+    for line in text.lines() {
+        if line.starts_with("FEDRAT/MMPM,") {
+            feed = numbers(line)[0] / 60.0;
+        } else if line == "RAPID" {
+            rapid = true;
+        } else if line.starts_with("CIRCLE/") {
+            let n = numbers(line);
+            circle = Some((
+                Vector::<3>::new(n[0], n[1], n[2]),
+                geometry::unit(&Vector::<3>::new(n[3], n[4], n[5])).unwrap(),
+                n[6],
+            ));
+        } else if line.starts_with("GOTO/") {
+            let n = numbers(line);
+            let to = Pose {
+                tip: Vector::<3>::new(n[0], n[1], n[2]),
+                axis: geometry::unit(&Vector::<3>::new(n[3], n[4], n[5])).unwrap(),
+            };
+            let speed = if std::mem::take(&mut rapid) {
+                RAPID
+            } else {
+                feed
+            };
+            if let Some(from) = at {
+                match circle.take() {
+                    Some((centre, axis, r)) => {
+                        // Angles about the axis from the start to the end, counter-clockwise.
+                        let u = geometry::unit(&(from.tip - centre)).unwrap();
+                        let v = axis.cross(&u);
+                        let e = to.tip - centre;
+                        let mut sweep = math::atan2(e.dot(&v), e.dot(&u));
+                        if sweep <= 1e-9 {
+                            sweep += 2.0 * std::f64::consts::PI;
+                        }
+                        let chords = (sweep / (2.0 * math::acos(1.0 - 1e-7 / r))).ceil() as usize;
+                        let mut last = from;
+                        for k in 1..=chords {
+                            let angle = sweep * k as f64 / chords as f64;
+                            let tip = if k == chords {
+                                to.tip
+                            } else {
+                                centre + (u * math::cos(angle) + v * math::sin(angle)) * r
+                            };
+                            let next = Pose { tip, axis: to.axis };
+                            pieces.push(Piece {
+                                from: last,
+                                to: next,
+                                feed: speed,
+                            });
+                            last = next;
+                        }
+                    }
+                    None => pieces.push(Piece {
+                        from,
+                        to,
+                        feed: speed,
+                    }),
+                }
+            }
+            at = Some(to);
+        }
+    }
+    pieces
+}
+
+/// The distance of `pose`'s tip from piece `p` and the angle of its axis from the
+/// piece's (slerped) axis there.
+fn off(p: &Piece, pose: &Pose) -> (f64, f64) {
+    let d = p.to.tip - p.from.tip;
+    let length2 = d.norm_squared();
+    let t = if length2 > 0.0 {
+        ((pose.tip - p.from.tip).dot(&d) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let axis = geometry::slerp(&p.from.axis, &p.to.axis, t).unwrap();
+    (
+        geometry::dist(&(p.from.tip + d * t), &pose.tip),
+        geometry::angle_between(&axis, &pose.axis),
+    )
+}
+
+/// The interpolator's plan of `text` (the file's speeds, `FEED` and `RAPID`), and the
+/// time it took.
+fn planned(text: &str, limits: PathLimits) -> (FiveAxisReference, f64) {
+    let start = Instant::now();
+    let program = parse_cl(text, "multi.cls").unwrap();
+    let inputs = FiveAxisInputs {
+        path: ToolPath::from_poses(&program.poses()).unwrap(),
+        builtin: None,
+        feeds: program_feeds(&program, FEED, RAPID),
+        machine: TableTiltingAc::default(),
+        joints: JointLimits::default(),
+        limits,
+        ts: TS,
+    };
+    let lines = program.lines();
+    let name = |i: usize| format!("multi.cls:{}", lines[i]);
+    let reference =
+        FiveAxisReference::new(inputs, &Planner::new(), &name).unwrap_or_else(|e| panic!("{e}"));
+    (reference, start.elapsed().as_secs_f64())
+}
+
+#[test]
+fn the_nx_multi_operation_file_is_read_with_one_warning_per_kind() {
+    let text = cam_examples::nx_multi_operation_cls();
+    let gotos = text.lines().filter(|l| l.starts_with("GOTO/")).count();
+    let operations = text.lines().filter(|l| l.starts_with("TOOL PATH/")).count();
+    assert!(gotos > 10_000, "{gotos} GOTOs");
+    assert_eq!(operations, 15);
+    let program = parse_cl(&text, "multi.cls").unwrap();
+    // Every GOTO a pose, and each CIRCLE's chords besides.
+    assert!(program.poses().len() > gotos);
+    let kinds: Vec<&str> = program
+        .warnings
+        .iter()
+        .map(|w| w.message.split(' ').next().unwrap())
+        .collect();
+    assert_eq!(
+        kinds,
+        ["text", "TOOL", "TLDATA", "PAINT", "LOAD"],
+        "{kinds:?}"
+    );
+    assert_eq!(program.warnings[0].place.line, 1);
+}
+
+#[test]
+fn the_multi_operation_file_is_planned_within_its_speeds_the_limits_and_the_tolerances() {
+    let text = cam_examples::nx_multi_operation_cls();
+    let pieces = read(&text);
+    let limits = PathLimits::at_feed(FEED);
+    let joints = JointLimits::default();
+    let (mut reference, seconds) = planned(&text, limits);
+    let duration = reference.planned_duration().unwrap();
+
+    // Walk the samples, each matched to the nearest piece a little behind or ahead of the
+    // last match (the path comes back near itself: rasters, rapids out and in).
+    let mut samples: Vec<(Pose, [f64; 5], usize)> = Vec::new();
+    let mut near = 0usize;
+    let (mut worst_tip, mut worst_axis) = (0.0f64, 0.0f64);
+    loop {
+        let sample = reference.current();
+        let pose = TableTiltingAc::default().forward(&sample.joints);
+        let (mut best, mut best_off) = (near, (f64::INFINITY, 0.0));
+        let (mut k, mut ahead) = (near.saturating_sub(20), 0.0);
+        while k < pieces.len() && (ahead < 5.0 || k <= near + 2) {
+            let o = off(&pieces[k], &pose);
+            // On a tie the later piece: a move that retraces the one before (out of a
+            // hole) is matched to the move it is on.
+            if o.0 < best_off.0 || (o.0 == best_off.0 && k > near) {
+                (best, best_off) = (k, o);
+            }
+            // How far past the last match the pieces seen reach.
+            if k > near {
+                ahead += geometry::dist(&pieces[k].from.tip, &pieces[k].to.tip)
+                    + 1e-3 * geometry::angle_between(&pieces[k].from.axis, &pieces[k].to.axis);
+            }
+            k += 1;
+        }
+        near = best;
+        worst_tip = worst_tip.max(best_off.0);
+        worst_axis = worst_axis.max(best_off.1);
+        samples.push((pose, sample.joints.into(), best));
+        if sample.done {
+            break;
+        }
+        reference.step().unwrap();
+    }
+    assert_eq!(
+        near,
+        pieces.len() - 1,
+        "the reference ends on the last piece"
+    );
+    assert!(
+        worst_tip <= limits.tolerance * (1.0 + 1e-6),
+        "tip {worst_tip} mm"
+    );
+    assert!(
+        worst_axis <= limits.orientation_tolerance * (1.0 + 1e-6),
+        "axis {worst_axis} rad"
+    );
+
+    // The joints within their limits; the tip no faster than the move it is on, where
+    // every sample within the jerk filter's reach is on moves of that speed.
+    let mut peak_joint = [0.0f64; 5];
+    let mut fastest = std::collections::BTreeMap::<u64, f64>::new();
+    let reach = 40;
+    for k in 2..samples.len() {
+        let q = |j: usize| samples[j].1;
+        for (i, peak) in peak_joint.iter_mut().enumerate() {
+            let v = (q(k)[i] - q(k - 1)[i]) / TS;
+            let a = (q(k)[i] - 2.0 * q(k - 1)[i] + q(k - 2)[i]) / (TS * TS);
+            *peak = peak.max(v.abs() / joints.velocity[i]);
+            assert!(
+                v.abs() <= joints.velocity[i] * (1.0 + 1e-6) + 1e-6,
+                "joint {i} at {v}/s, sample {k}"
+            );
+            assert!(
+                a.abs() <= joints.acceleration[i] * (1.0 + 1e-5) + 1e-2,
+                "joint {i} at {a}/s², sample {k}"
+            );
+            assert!(q(k)[i] >= joints.min[i] && q(k)[i] <= joints.max[i]);
+        }
+        let speed = geometry::dist(&samples[k].0.tip, &samples[k - 1].0.tip) / TS;
+        let feed = pieces[samples[k].2].feed;
+        let window = k.saturating_sub(reach)..(k + reach).min(samples.len());
+        if window.clone().all(|j| pieces[samples[j].2].feed == feed) {
+            assert!(
+                speed <= feed * (1.0 + 1e-6),
+                "sample {k}: {speed} mm/s on a move at {feed}"
+            );
+            let top = fastest.entry((feed * 1e6) as u64).or_insert(0.0);
+            *top = top.max(speed);
+        }
+    }
+    // Each speed of the file is reached somewhere: the file's FEDRATs, not the `feed`
+    // parameter, and the rapids at `rapid`.
+    let feeds: std::collections::BTreeSet<u64> =
+        pieces.iter().map(|p| (p.feed * 1e6) as u64).collect();
+    for f in feeds {
+        let top = fastest.get(&f).copied().unwrap_or(0.0);
+        assert!(
+            top >= 0.95 * f as f64 * 1e-6,
+            "the moves at {} mm/s reach {top}",
+            f as f64 * 1e-6
+        );
+    }
+    assert!(!fastest.contains_key(&((FEED * 1e6) as u64)));
+
+    // No faster than every move at its speed; no slower than stopping at every pose
+    // with a plain trapezoid of the tip's acceleration, the moves that turn the tool at
+    // the rotary axes' speed.
+    let lower: f64 = pieces
+        .iter()
+        .map(|p| geometry::dist(&p.from.tip, &p.to.tip) / p.feed)
+        .sum();
+    assert!(duration >= lower, "{duration} s against {lower} s");
+    println!(
+        "planned in {seconds:.2} s: {} samples ({duration:.1} s, at least {lower:.1} s), tip \
+         within {:.4} mm, axis within {:.3} mrad, joints' peak speeds {:?} of their limits",
+        samples.len(),
+        worst_tip,
+        worst_axis * 1e3,
+        peak_joint.map(|p| (p * 1000.0).round() / 1000.0)
+    );
+}
