@@ -12,6 +12,9 @@
 //!
 //! `five_axis/plan_1k` and `five_axis/plan_100k`: planning the reference of a hemisphere
 //! raster of 1 000 and of 100 000 CL points (docs/design/five-axis.md §5.3b).
+//! `five_axis/plan_nx_15_operations`: reading and planning the fifteen-operation NX-style
+//! CL file of `cam_examples::nx_multi_operation_cls` with its own speeds (§5.3c), as the
+//! interpolator FMU does at initialization (target: under 10 s).
 
 use contour_core::math;
 use std::hint::black_box;
@@ -126,6 +129,28 @@ fn bench_planning(c: &mut Criterion) {
             })
         });
     }
+    let text = contour_core::path::five_axis::cam_examples::nx_multi_operation_cls();
+    group.bench_function("plan_nx_15_operations", |b| {
+        b.iter(|| {
+            use contour_core::part_program::cl_data::parse_cl;
+            use contour_core::path::five_axis::{program_feeds, SAMPLE_BUDGET};
+            let program = parse_cl(black_box(&text), "nx.cls").unwrap();
+            let poses = program.poses();
+            let feeds = program_feeds(&program, 50.0, 100.0);
+            FiveAxisPlan::within_budget(
+                (&poses, &feeds),
+                TableTiltingAc::default(),
+                &JointLimits::default(),
+                &PathLimits::at_feed(50.0),
+                1e-3,
+                &|i| format!("pose {i}"),
+                SAMPLE_BUDGET,
+            )
+            .unwrap()
+            .report()
+            .duration
+        })
+    });
     group.finish();
 }
 

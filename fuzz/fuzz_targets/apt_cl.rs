@@ -2,17 +2,28 @@
 //! arbitrary text (lossily UTF-8: a file that is not is refused before parsing). What
 //! parses becomes a tool path (`ToolPath::from_poses`), is evaluated at awkward
 //! parameters and followed for a few samples through the inverse kinematics, as the
-//! model does. Nothing may panic; every loop in there is bounded.
+//! model does; a short one is also planned with its FEDRATs and RAPIDs within a small
+//! sample budget. Nothing may panic; every loop in there is bounded.
 #![no_main]
 
 use contour_core::kinematics::TableTiltingAc;
+use contour_core::limits::{JointLimits, PathLimits};
 use contour_core::part_program::cl_data::parse_cl;
-use contour_core::path::five_axis::{JointReference, ToolPath};
+use contour_core::path::five_axis::{
+    check_feeds, program_feeds, FiveAxisPlan, JointReference, ToolPath,
+};
 use contour_core::path::Curve;
 use contour_fmu_fuzz::install_panic_hook;
 use libfuzzer_sys::fuzz_target;
 
 const SAMPLES: usize = 32;
+/// The programs planned: at most this many poses and mm of tip path (a plan costs about
+/// 10 µs a node, and nodes are 5 µm apart at the feed below: a longer path would slow
+/// the reading this target is for to a few executions a second), within this many
+/// samples.
+const PLANNED_POSES: usize = 16;
+const PLANNED_LENGTH: f64 = 2.0;
+const PLAN_SAMPLES: u64 = 4_000;
 
 fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
     let text = String::from_utf8_lossy(data);
@@ -25,7 +36,32 @@ fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
     if cl.poses().len() > 100_000 {
         return;
     }
-    let Ok(path) = ToolPath::from_poses(&cl.poses()) else {
+    let poses = cl.poses();
+    let feeds = program_feeds(&cl, 10.0, 100.0);
+    if let Err(e) = check_feeds(&feeds, poses.len()) {
+        // Only a speed that overflowed (a feed per turn times a huge spindle speed).
+        assert!(
+            feeds.iter().any(|f| !f.feed.is_finite()),
+            "the reader's speeds fail their check: {e}"
+        );
+        return;
+    }
+    let length: f64 = poses
+        .windows(2)
+        .map(|w| (w[1].tip - w[0].tip).norm())
+        .sum();
+    if poses.len() <= PLANNED_POSES && length <= PLANNED_LENGTH {
+        let _ = FiveAxisPlan::within_budget(
+            (&poses, &feeds),
+            TableTiltingAc::default(),
+            &JointLimits::default(),
+            &PathLimits::at_feed(10.0),
+            1e-3,
+            &|i| format!("pose {i}"),
+            PLAN_SAMPLES,
+        );
+    }
+    let Ok(path) = ToolPath::from_poses(&poses) else {
         return;
     };
     let ToolPath::Poses { tips, .. } = &path else {
