@@ -128,11 +128,27 @@ fn assert_within(samples: &[PlannedSample], joints: &JointLimits, limits: &PathL
 }
 
 /// The distance of `tip` from the CL polyline and the angle of `axis` from the CL axis at
-/// that point, by brute force over every CL segment.
-fn cl_deviation(cl: &[Pose], pose: &Pose) -> (f64, f64) {
+/// that point, by brute force over every CL segment; where the tool turns on the spot
+/// within `tolerance` of the tip, every axis of the turn (sampled) counts as programmed.
+fn cl_deviation(cl: &[Pose], pose: &Pose, tolerance: f64) -> (f64, f64) {
     let mut best = (f64::INFINITY, 0.0);
+    let mut on_a_turn = f64::INFINITY;
     for w in cl.windows(2) {
         let d = w[1].tip - w[0].tip;
+        if d.norm_squared() == 0.0 {
+            let distance = geometry::dist(&w[0].tip, &pose.tip);
+            let angles = (0..=10_000)
+                .map(|k| geometry::slerp(&w[0].axis, &w[1].axis, k as f64 / 1e4).unwrap())
+                .map(|axis| geometry::angle_between(&axis, &pose.axis));
+            let nearest_axis = angles.fold(f64::INFINITY, f64::min);
+            if distance <= tolerance {
+                on_a_turn = on_a_turn.min(nearest_axis);
+            }
+            if distance < best.0 {
+                best = (distance, geometry::angle_between(&w[0].axis, &pose.axis));
+            }
+            continue;
+        }
         let t = ((pose.tip - w[0].tip).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
         let distance = geometry::dist(&(w[0].tip + d * t), &pose.tip);
         if distance < best.0 {
@@ -140,7 +156,7 @@ fn cl_deviation(cl: &[Pose], pose: &Pose) -> (f64, f64) {
             best = (distance, geometry::angle_between(&axis, &pose.axis));
         }
     }
-    best
+    (best.0, best.1.min(on_a_turn))
 }
 
 fn plan(
@@ -161,7 +177,7 @@ fn check_all(
     assert_within(&s, joints, limits, what);
     let (mut tip, mut axis) = (0.0f64, 0.0f64);
     for sample in &s {
-        let (d, a) = cl_deviation(cl, &sample.pose);
+        let (d, a) = cl_deviation(cl, &sample.pose, limits.tolerance);
         tip = tip.max(d);
         axis = axis.max(a);
     }
@@ -244,6 +260,46 @@ fn beside_vertical_c_swings_within_its_limits() {
         "beside vertical",
     );
     eprintln!("C travel {}", c_travel(&s));
+}
+
+#[test]
+fn a_tool_turning_on_the_spot_tilts_where_its_tip_stands() {
+    // Along x, a stop at x = 10 where the tool tilts 36.87° about x (A), then on.
+    let axis = V3::new(0.0, 0.6, 0.8);
+    let vertical = V3::new(0.0, 0.0, 1.0);
+    let cl = [
+        Pose {
+            tip: V3::new(0.0, 0.0, 0.0),
+            axis: vertical,
+        },
+        Pose {
+            tip: V3::new(10.0, 0.0, 0.0),
+            axis: vertical,
+        },
+        Pose {
+            tip: V3::new(10.0, 0.0, 0.0),
+            axis,
+        },
+        Pose {
+            tip: V3::new(20.0, 0.0, 0.0),
+            axis,
+        },
+    ];
+    let joints = JointLimits::default();
+    let s = check_all(&cl, &joints, &PathLimits::at_feed(20.0), "turn on the spot");
+    let turning: Vec<&PlannedSample> = s
+        .iter()
+        .filter(|x| x.joints[3].abs() > 1e-3 && x.joints[3].abs() < 0.6435 - 1e-3)
+        .collect();
+    // The turn takes at least what A's speed limit allows, and the tip stands meanwhile.
+    assert!(turning.len() as f64 * TS >= 0.6435 / joints.velocity[3] * 0.99);
+    for x in turning {
+        assert!(
+            (x.pose.tip - V3::new(10.0, 0.0, 0.0)).amax() < 5e-3,
+            "{:?}",
+            x.pose.tip
+        );
+    }
 }
 
 #[test]

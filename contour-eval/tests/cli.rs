@@ -206,7 +206,7 @@ fn a_displaced_helix_gives_its_displacement() {
     let ToolPath::Poses { tips, .. } = ToolPath::tilted_helix() else {
         unreachable!("the helix is sampled")
     };
-    check_reference(&reference, tips.points().len(), &us);
+    check_reference(&reference, tips.len(), &us);
     // A PNG of the designed size: signature, then IHDR width and height.
     let png = std::fs::read(&plot).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
@@ -226,7 +226,7 @@ fn the_same_helix_as_cl_data_gives_the_same_errors() {
     let mut cl = String::from("PARTNO/HELIX\n$$ the tilted helix\nMULTAX\nFEDRAT/MMPM,1200\n");
     let (csv, us) = displaced_helix_csv();
     let needed = us[us.len() - 1] as usize + 50;
-    for (p, o) in tips.points().iter().zip(axes.iter()).take(needed) {
+    for (p, o) in tips.iter().zip(axes.iter()).take(needed) {
         writeln!(
             cl,
             "GOTO/{:.7},{:.7},{:.7},{:.12},{:.12},{:.12}",

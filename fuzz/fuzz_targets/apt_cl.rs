@@ -12,7 +12,6 @@ use contour_core::part_program::cl_data::parse_cl;
 use contour_core::path::five_axis::{
     check_feeds, program_feeds, FiveAxisPlan, JointReference, ToolPath,
 };
-use contour_core::path::Curve;
 use contour_fmu_fuzz::install_panic_hook;
 use libfuzzer_sys::fuzz_target;
 
@@ -67,13 +66,13 @@ fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
     let ToolPath::Poses { tips, .. } = &path else {
         panic!("poses make a pose path");
     };
-    let (a, b) = tips.param_range();
+    let (a, b) = (0.0, (tips.len() - 1) as f64);
     for u in [a, b, 0.5 * (a + b), a - 1.0, b + 1.0, f64::NAN, f64::INFINITY] {
         let _ = path.pose_at(u);
     }
     // The vertices themselves: no sampling for a pose path.
     assert_eq!(path.poses(0.01).map(|p| p.len()), Ok(cl.poses().len()));
-    let feed = (tips.length() / (SAMPLES as f64 * 1e-3)).clamp(1e-3, 1e6);
+    let feed = (length / (SAMPLES as f64 * 1e-3)).clamp(1e-3, 1e6);
     if let Ok(mut reference) = JointReference::new(path, TableTiltingAc::default(), feed, 1e-3) {
         for _ in 0..SAMPLES {
             match reference.step() {

@@ -319,16 +319,7 @@ fn programmed(
     if file_kind(file) == Some(FileKind::ClData) {
         // Read here rather than through ToolPath::load: the plan names CL lines.
         let program = cl_data::load_cl(&full).map_err(|e| hint(message(e)))?;
-        let poses = program.poses();
-        if let Some(i) = poses.windows(2).position(|w| w[0].tip == w[1].tip) {
-            let line = program.lines()[i + 1];
-            return Err(format!(
-                "parameter 'path': {spec}:{line}: the tool turns on the spot (its tip stays \
-                 where the record before left it): a CL path here needs every move to move \
-                 the tip"
-            ));
-        }
-        let path = ToolPath::from_poses(&poses).map_err(message)?;
+        let path = ToolPath::from_poses(&program.poses()).map_err(message)?;
         return Ok(Programmed {
             path,
             builtin: None,

@@ -16,6 +16,7 @@ from contour_fmu.demo import five_axis as five_axis_demo
 from contour_fmu.engines.master import five_axis_closed_loop
 from contour_fmu.output_files import write_cross_check
 from contour_fmu.loops.wiring import FIVE_AXIS_JOINTS
+from contour_fmu.checks.five_axis_truth import forward
 from helpers.fmu_slave import Slave
 
 REPO = Path(__file__).resolve().parents[2]
@@ -435,15 +436,43 @@ def test_without_a_plan_a_cl_files_speeds_are_not_followed_and_it_says_so(interp
     assert np.allclose(speed[5:-5], 40.0, rtol=1e-6)
 
 
-def test_a_cl_tool_turning_on_the_spot_is_refused_with_its_line(interpolator, tmp_path):
-    part = tmp_path / "turn.cls"
-    part.write_text("GOTO/0,0,0,0,0,1\nGOTO/0,0,0,0,0,1\nGOTO/10,0,0,0,0,1\n"
+TURN_ON_THE_SPOT = ("GOTO/0,0,0,0,0,1\nGOTO/0,0,0,0,0,1\nGOTO/10,0,0,0,0,1\n"
                     "GOTO/10,0,0,0,0.6,0.8\nGOTO/20,0,0,0,0.6,0.8\n")
-    interpolator.set(path=str(part))
+
+
+def test_a_cl_tool_turning_on_the_spot_is_planned(interpolator, tmp_path):
+    part = tmp_path / "turn.cls"
+    part.write_text(TURN_ON_THE_SPOT)
+    interpolator.set(path=str(part), feed=20.0)
+    interpolator.fmu.exitInitializationMode()
+    i = interpolator
+    joints = [i.reals(REF)]
+    for k in range(10_000):
+        i.fmu.doStep(currentCommunicationPoint=k * 1e-3, communicationStepSize=1e-3)
+        joints.append(i.reals(REF))
+        if i.fmu.getBoolean([i.vr["done"]])[0]:
+            break
+    tips, axes = forward(np.array(joints))
+    tilt = np.arccos(np.clip(axes[:, 2], -1.0, 1.0))
+    final = math.atan2(0.6, 0.8)
+    # The tool tilts 36.87° (A) while the tip stands at x = 10, within the plan's
+    # tolerance (5 µm, the corners blended); the tip never leaves the line.
+    assert np.max(np.abs(tips[:, 1:])) < 1e-6
+    turning = (tilt > 1e-3) & (tilt < final - 1e-3)
+    assert turning.sum() > 50, "the turn takes time"
+    assert np.max(np.abs(tips[turning, 0] - 10.0)) < 5e-3
+    assert abs(joints[-1][3] - final) < 1e-9
+    assert np.allclose(tips[-1], [20, 0, 0], atol=1e-9)
+
+
+def test_at_constant_feed_a_tool_turning_on_the_spot_is_refused(interpolator, tmp_path):
+    part = tmp_path / "turn.cls"
+    part.write_text(TURN_ON_THE_SPOT)
+    interpolator.set(path=str(part), accel=0.0)
     with pytest.raises(FMICallException):
         interpolator.fmu.exitInitializationMode()
-    # Line 2 repeats line 1 and is left out; line 4 turns the tool where line 3 left it.
-    assert any(f"{part}:4" in m and "turns on the spot" in m
+    # The repeated GOTO (line 2) is left out: poses 1 and 2 are lines 3 and 4.
+    assert any("turns on the spot from pose 1 to pose 2" in m and "accel > 0" in m
                for m in interpolator.log.errors()), interpolator.log.errors()
 
 

@@ -20,6 +20,11 @@ impl<const D: usize> Polyline<D> {
     /// Refuses fewer than two points, non-finite points and repeated consecutive points
     /// (a zero-length piece has no direction).
     pub fn new(points: Vec<Vector<D>>) -> Result<Self, PathError> {
+        Self::shared(points.into())
+    }
+
+    /// [`Polyline::new`] on points shared with their owner (no copy).
+    pub fn shared(points: Arc<[Vector<D>]>) -> Result<Self, PathError> {
         if points.len() < 2 {
             return Err(PathError::invalid(format!(
                 "a polyline needs at least two points, got {}",
@@ -35,9 +40,7 @@ impl<const D: usize> Polyline<D> {
                 i + 1
             )));
         }
-        Ok(Polyline {
-            points: points.into(),
-        })
+        Ok(Polyline { points })
     }
 
     /// The vertices.

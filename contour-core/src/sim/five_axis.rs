@@ -170,7 +170,7 @@ pub struct FiveAxisMetrics {
 pub fn nearest_on_branch(path: &ToolPath, point: &Vector<3>, lo: f64, hi: f64) -> (f64, f64) {
     match path {
         ToolPath::Poses { tips, .. } => {
-            let points = tips.points();
+            let points = &tips[..];
             let last = points.len() - 2;
             let first = (lo.floor().max(0.0) as usize).min(last);
             let end = (hi.ceil().max(0.0) as usize).clamp(first, last);
@@ -178,7 +178,7 @@ pub fn nearest_on_branch(path: &ToolPath, point: &Vector<3>, lo: f64, hi: f64) -
             for i in first..=end {
                 let t = segment_fraction(point, &points[i], &points[i + 1]);
                 let u = (i as f64 + t).clamp(lo, hi);
-                let distance = geometry::dist(&tips.point(u), point);
+                let distance = geometry::dist(&path.pose_at(u).tip, point);
                 if distance < best.0 {
                     best = (distance, u);
                 }

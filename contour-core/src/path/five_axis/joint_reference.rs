@@ -5,7 +5,8 @@
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use super::tool_path::ToolPath;
+use super::tool_path::{tips_length, ToolPath};
+use crate::geometry::Vector;
 use crate::kinematics::{Joints, Pose, TableTiltingAc};
 use crate::path::{Curve, Interpolator, Nurbs, PathError, Polyline, Progress};
 
@@ -48,7 +49,7 @@ pub struct JointReference {
 pub(crate) fn check_length(path: &ToolPath) -> Result<(), PathError> {
     let length = match path {
         ToolPath::Curves { tip, .. } => tip.length(),
-        ToolPath::Poses { tips, .. } => tips.length(),
+        ToolPath::Poses { tips, .. } => tips_length(tips),
     };
     if length.is_finite() {
         Ok(())
@@ -57,6 +58,20 @@ pub(crate) fn check_length(path: &ToolPath) -> Result<(), PathError> {
             "the tip's path is {length} mm long: no feed follows it (a point near ±1e308?)"
         )))
     }
+}
+
+/// The tips as the constant-feed interpolator runs along them: a polyline, which has no
+/// piece where the tool turns on the spot (at constant tip feed such a turn would take no
+/// time); a plan runs those.
+fn constant_feed_tips(tips: &std::sync::Arc<[Vector<3>]>) -> Result<Polyline<3>, PathError> {
+    if let Some(i) = (1..tips.len()).find(|&i| tips[i] == tips[i - 1]) {
+        return Err(PathError::invalid(format!(
+            "the tool turns on the spot from pose {} to pose {i}: the reference at constant \
+             feed (accel = 0) cannot follow that; a plan (accel > 0) can",
+            i - 1
+        )));
+    }
+    Polyline::shared(std::sync::Arc::clone(tips))
 }
 
 impl JointReference {
@@ -74,7 +89,7 @@ impl JointReference {
                 TipInterpolator::Curve(Interpolator::new(tip.clone(), feed, ts)?)
             }
             ToolPath::Poses { tips, .. } => {
-                TipInterpolator::Polyline(Interpolator::new(tips.clone(), feed, ts)?)
+                TipInterpolator::Polyline(Interpolator::new(constant_feed_tips(tips)?, feed, ts)?)
             }
         };
         let mut reference = JointReference {
@@ -144,11 +159,11 @@ impl JointReference {
                 i.point(),
             ),
             (TipInterpolator::Polyline(i), ToolPath::Poses { tips, .. }) => (
-                i.path() == tips,
+                i.path().points() == &tips[..],
                 i.feed(),
                 i.ts(),
                 i.parameter(),
-                tips.param_range(),
+                (0.0, (tips.len() - 1) as f64),
                 i.point(),
             ),
             _ => return Err("the interpolator runs on another kind of path".into()),
@@ -307,7 +322,7 @@ impl JointReference {
                 TipInterpolator::Curve(Interpolator::resume(tip.clone(), p)?)
             }
             (TipProgress::Polyline(p), ToolPath::Poses { tips, .. }) => {
-                TipInterpolator::Polyline(Interpolator::resume(tips.clone(), p)?)
+                TipInterpolator::Polyline(Interpolator::resume(constant_feed_tips(tips)?, p)?)
             }
             _ => {
                 return Err(PathError::invalid(

@@ -85,6 +85,8 @@ pub struct FiveAxisPlan {
     machine: TableTiltingAc,
     ts: f64,
     pub(super) filter: (usize, usize),
+    /// How far the tip may leave the programmed path, mm (see `deviation`).
+    tolerance: f64,
     /// Samples until the reference rests at the path's end.
     pub(super) samples: u64,
     report: FiveAxisPlanReport,
@@ -278,6 +280,7 @@ impl FiveAxisPlan {
                 machine,
                 ts,
                 filter,
+                tolerance: limits.tolerance,
                 report: FiveAxisPlanReport::default(),
             };
             measured = measured.saturating_add(plan.samples);
@@ -434,7 +437,10 @@ impl FiveAxisPlan {
 
     /// The programmed interval nearest `pose`'s tip, searched from `from` up to the raw
     /// sample's interval `ahead` (the filtered tip is behind the raw one), with the tip's
-    /// distance and the axis's angle from the programmed pose at that point.
+    /// distance and the axis's angle from the programmed pose at that point. Where the
+    /// tool turns on the spot, every axis of the turn is programmed at that tip: within
+    /// `tolerance` of it the angle is the least to any of them (the filter blends the
+    /// arrival with the turn, and no speed along the path changes that).
     fn deviation(&self, pose: &Pose, from: usize, ahead: usize) -> (usize, f64, f64) {
         let poses = &self.path.poses;
         let last = poses.len() - 2;
@@ -443,10 +449,10 @@ impl FiveAxisPlan {
             (ahead + 1).max(from).min(last),
         );
         let mut best = (start, f64::INFINITY, 0.0);
+        let mut on_a_turn = f64::INFINITY;
         for n in start..=end {
             let (a, b) = (poses[n].tip, poses[n + 1].tip);
             let d = b - a;
-            // A piece where the tool turns on the spot: its one point.
             let length2 = d.norm_squared();
             let t = if length2 > 0.0 {
                 ((pose.tip - a).dot(&d) / length2).clamp(0.0, 1.0)
@@ -454,13 +460,28 @@ impl FiveAxisPlan {
                 0.0
             };
             let distance = geometry::dist(&(a + d * t), &pose.tip);
+            if length2 == 0.0 && distance <= self.tolerance {
+                let turn = angle_to_arc(&poses[n].axis, &poses[n + 1].axis, &pose.axis);
+                on_a_turn = on_a_turn.min(turn);
+            }
             if distance < best.1 {
                 best = (n, distance, t);
             }
         }
+        // Leaving a turn, the nodes of the turn lie behind the search.
+        let mut n = start;
+        while n > 0
+            && poses[n - 1].tip == poses[n].tip
+            && geometry::dist(&poses[n].tip, &pose.tip) <= self.tolerance
+        {
+            let turn = angle_to_arc(&poses[n - 1].axis, &poses[n].axis, &pose.axis);
+            on_a_turn = on_a_turn.min(turn);
+            n -= 1;
+        }
         let (n, distance, t) = best;
         let axis = geometry::slerp(&poses[n].axis, &poses[n + 1].axis, t).unwrap_or(poses[n].axis);
-        (n, distance, geometry::angle_between(&axis, &pose.axis))
+        let angle = geometry::angle_between(&axis, &pose.axis).min(on_a_turn);
+        (n, distance, angle)
     }
 
     /// The programmed speed a filtered sample at speed `v` is held to: its foot's piece's
@@ -595,5 +616,22 @@ impl FiveAxisPlan {
             self.advance(&mut cursor);
         }
         (report, slow)
+    }
+}
+
+/// The angle from unit `v` to the great-circle arc from unit `a` to unit `b` (not
+/// opposite), rad.
+fn angle_to_arc(a: &Vector<3>, b: &Vector<3>, v: &Vector<3>) -> f64 {
+    let ends = geometry::angle_between(a, v).min(geometry::angle_between(b, v));
+    let Some(normal) = geometry::unit(&a.cross(b)) else {
+        return ends;
+    };
+    // v's projection onto the arc's plane lies within the arc when it is on a's side of
+    // b and on b's side of a; then the angle is v's to the plane.
+    let inside = a.cross(v).dot(&normal) >= 0.0 && v.cross(b).dot(&normal) >= 0.0;
+    if inside {
+        math::asin(v.dot(&normal).abs().min(1.0)).min(ends)
+    } else {
+        ends
     }
 }

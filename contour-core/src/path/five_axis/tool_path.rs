@@ -14,7 +14,7 @@ use crate::kinematics::Pose;
 use crate::part_program::cl_data::load_cl;
 use crate::part_program::{file_kind, FileKind};
 use crate::path::nurbs_file::read_path_file;
-use crate::path::{Curve, Nurbs, NurbsData, PathError, Polyline};
+use crate::path::{clamp_param, Curve, Nurbs, NurbsData, PathError};
 
 /// Samples per turn of the sampled built-ins: chords of at most 3.2 µm, deviating from the
 /// curves they sample by < 0.3 nm; a nearest point on them lies within 0.1 µm of the one on
@@ -42,11 +42,12 @@ pub enum ToolPath {
         /// Distance between the two curves along the tool axis, mm.
         length: f64,
     },
-    /// Poses in order: tips joined by straight moves, axes by slerp. Clones share the
-    /// poses.
+    /// Poses in order: tips joined by straight moves, axes by slerp; a tip may repeat
+    /// where the tool turns on the spot. Parameter u runs from 0 at the first pose to
+    /// n − 1 at the last, pose i at i. Clones share the poses.
     Poses {
         /// The tips, mm.
-        tips: Polyline<3>,
+        tips: Arc<[Vector<3>]>,
         /// The unit tool axes, one per tip.
         axes: Arc<[Vector<3>]>,
     },
@@ -87,7 +88,7 @@ impl From<ToolPath> for ToolPathData {
                 length,
             },
             ToolPath::Poses { tips, axes } => ToolPathData::Poses {
-                tips: tips.points().to_vec(),
+                tips: tips.to_vec(),
                 axes: axes.to_vec(),
             },
         }
@@ -203,6 +204,19 @@ pub fn load_poses(spec: &str, chord: f64) -> Result<(Vec<Pose>, Vec<String>), Pa
     }
 }
 
+/// The piece of a pose path of `count` poses holding parameter `u` (clamped into the
+/// path; NaN at the start), and the fraction along it.
+pub fn locate(count: usize, u: f64) -> (usize, f64) {
+    let u = clamp_param(u, 0.0, (count - 1) as f64);
+    let i = (u.floor() as usize).min(count - 2);
+    (i, u - i as f64)
+}
+
+/// The tip path's length of a pose path, mm.
+pub fn tips_length(tips: &[Vector<3>]) -> f64 {
+    tips.windows(2).map(|w| geometry::dist(&w[0], &w[1])).sum()
+}
+
 /// The pieces a tip curve of `length` mm is first sampled into at chords of at most
 /// `chord` mm: one a chord of its length, refused when the poses would pass `budget`
 /// (also for a length that overflowed to infinity).
@@ -290,7 +304,6 @@ impl ToolPath {
     fn poses_within(&self, chord: f64, budget: usize) -> Result<Vec<Pose>, PathError> {
         match self {
             ToolPath::Poses { tips, axes } => Ok(tips
-                .points()
                 .iter()
                 .zip(axes.iter())
                 .map(|(&tip, &axis)| Pose { tip, axis })
@@ -369,9 +382,19 @@ impl ToolPath {
         })
     }
 
-    /// From poses (at least two, consecutive tips distinct, axes nonzero; normalised).
+    /// From poses (at least two, finite, axes nonzero and normalised; consecutive poses
+    /// differ in the tip or the axis: a tool may turn on the spot).
     pub fn from_poses(poses: &[Pose]) -> Result<Self, PathError> {
-        let tips = Polyline::new(poses.iter().map(|p| p.tip).collect())?;
+        if poses.len() < 2 {
+            return Err(PathError::invalid(format!(
+                "a pose path needs at least two poses, got {}",
+                poses.len()
+            )));
+        }
+        if let Some(i) = poses.iter().position(|p| !geometry::is_finite(&p.tip)) {
+            return Err(PathError::invalid(format!("tip {i} is not finite")));
+        }
+        let tips: Arc<[Vector<3>]> = poses.iter().map(|p| p.tip).collect();
         let axes = poses
             .iter()
             .enumerate()
@@ -390,6 +413,14 @@ impl ToolPath {
                 i + 1
             )));
         }
+        if let Some(i) =
+            (1..poses.len()).find(|&i| tips[i] == tips[i - 1] && axes[i] == axes[i - 1])
+        {
+            return Err(PathError::invalid(format!(
+                "poses {} and {i} are the same: a move must move the tip or turn the tool",
+                i - 1
+            )));
+        }
         Ok(ToolPath::Poses {
             tips,
             axes: axes.into(),
@@ -405,10 +436,10 @@ impl ToolPath {
                 Pose { tip: p, axis }
             }
             ToolPath::Poses { tips, axes } => {
-                let (i, t) = tips.locate(u);
+                let (i, t) = locate(tips.len(), u);
                 let axis = slerp(&axes[i], &axes[i + 1], t).unwrap_or(axes[i]);
                 Pose {
-                    tip: tips.point(u),
+                    tip: tips[i] + (tips[i + 1] - tips[i]) * t,
                     axis,
                 }
             }
@@ -474,6 +505,7 @@ impl ToolPath {
 mod tests {
     use super::*;
     use crate::geometry::angle_between;
+    use crate::kinematics::TableTiltingAc;
 
     type V3 = Vector<3>;
 
@@ -542,8 +574,9 @@ mod tests {
     fn references_are_named_by_file_kind_or_built_in_name() {
         let dir = std::env::temp_dir().join(format!("tool-path-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        // A CL file with a tool turning on the spot: as poses it is kept, as a path to
-        // follow at a tip feed it is refused (the tip does not move).
+        // A CL file with a tool turning on the spot: kept as poses and as a path (a plan
+        // runs the turn); the reference at constant tip feed refuses it (the tip does not
+        // move).
         let cl = dir.join("part.CL");
         std::fs::write(
             &cl,
@@ -554,7 +587,11 @@ mod tests {
         let (poses, warnings) = load_poses(spec, 0.01).unwrap();
         assert_eq!(poses.len(), 4);
         assert_eq!(warnings.len(), 1, "{warnings:?}");
-        assert!(ToolPath::load(spec).is_err());
+        let (path, _) = ToolPath::load(spec).unwrap();
+        let e = super::super::JointReference::new(path, TableTiltingAc::default(), 10.0, 1e-3)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("turns on the spot from pose 1 to pose 2"), "{e}");
         let json = dir.join("tilt.json");
         std::fs::write(
             &json,
