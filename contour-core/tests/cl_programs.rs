@@ -6,6 +6,10 @@
 //! against the test's own reading of the file: every sample within the tolerances of the
 //! CL path, within the joints' limits, no faster than the move it is on, and its duration
 //! between bounds the test derives from the file.
+//!
+//! Public CL files (`tests/data/cl`, their sources and licences in its README; or any
+//! folder through `CL_FILES=dir`) are read and planned the same way and judged against
+//! the reader's poses: the table of the note (`--nocapture`).
 
 use std::time::Instant;
 
@@ -13,9 +17,10 @@ use contour_core::geometry::{self, Vector};
 use contour_core::kinematics::{Pose, TableTiltingAc};
 use contour_core::limits::{JointLimits, PathLimits};
 use contour_core::math;
-use contour_core::part_program::cl_data::parse_cl;
+use contour_core::part_program::cl_data::{load_cl, parse_cl};
+use contour_core::part_program::PartProgram;
 use contour_core::path::five_axis::{
-    cam_examples, program_feeds, FiveAxisInputs, FiveAxisReference, Planner, ToolPath,
+    cam_examples, feed_of_move, program_feeds, FiveAxisInputs, FiveAxisReference, Planner, ToolPath,
 };
 
 const TS: f64 = 1e-3;
@@ -124,67 +129,58 @@ fn off(p: &Piece, pose: &Pose) -> (f64, f64) {
         0.0
     };
     let axis = geometry::slerp(&p.from.axis, &p.to.axis, t).unwrap();
-    (
-        geometry::dist(&(p.from.tip + d * t), &pose.tip),
-        geometry::angle_between(&axis, &pose.axis),
-    )
+    let distance = geometry::dist(&(p.from.tip + d * t), &pose.tip);
+    if length2 == 0.0 && distance <= TURN_REACH {
+        // The tool turns on the spot: every axis of the turn is programmed at this tip
+        // (sampled finely enough for the tolerances, 0.16 mrad at a half turn).
+        let nearest = (0..=10_000)
+            .map(|k| geometry::slerp(&p.from.axis, &p.to.axis, k as f64 / 1e4).unwrap())
+            .map(|axis| geometry::angle_between(&axis, &pose.axis))
+            .fold(f64::INFINITY, f64::min);
+        return (distance, nearest);
+    }
+    (distance, geometry::angle_between(&axis, &pose.axis))
 }
 
-/// The interpolator's plan of `text` (the file's speeds, `FEED` and `RAPID`), and the
-/// time it took.
-fn planned(text: &str, limits: PathLimits) -> (FiveAxisReference, f64) {
-    let start = Instant::now();
-    let program = parse_cl(text, "multi.cls").unwrap();
+/// How near a turn on the spot's tip a planned tip counts as on it: the planner's
+/// tolerance.
+const TURN_REACH: f64 = 5e-3;
+
+/// The interpolator's plan of `program` (the file's speeds, `FEED` and `RAPID`), and
+/// the time it took.
+fn planned(
+    program: &PartProgram,
+    name: &str,
+    limits: PathLimits,
+) -> Result<FiveAxisReference, String> {
     let inputs = FiveAxisInputs {
-        path: ToolPath::from_poses(&program.poses()).unwrap(),
+        path: ToolPath::from_poses(&program.poses()).map_err(|e| e.to_string())?,
         builtin: None,
-        feeds: program_feeds(&program, FEED, RAPID),
+        feeds: program_feeds(program, FEED, RAPID),
         machine: TableTiltingAc::default(),
         joints: JointLimits::default(),
         limits,
         ts: TS,
     };
     let lines = program.lines();
-    let name = |i: usize| format!("multi.cls:{}", lines[i]);
-    let reference =
-        FiveAxisReference::new(inputs, &Planner::new(), &name).unwrap_or_else(|e| panic!("{e}"));
-    (reference, start.elapsed().as_secs_f64())
+    let at = |i: usize| format!("{name}:{}", lines[i]);
+    FiveAxisReference::new(inputs, &Planner::new(), &at).map_err(|e| e.to_string())
 }
 
-#[test]
-fn the_nx_multi_operation_file_is_read_with_one_warning_per_kind() {
-    let text = cam_examples::nx_multi_operation_cls();
-    let gotos = text.lines().filter(|l| l.starts_with("GOTO/")).count();
-    let operations = text.lines().filter(|l| l.starts_with("TOOL PATH/")).count();
-    assert!(gotos > 10_000, "{gotos} GOTOs");
-    assert_eq!(operations, 15);
-    let program = parse_cl(&text, "multi.cls").unwrap();
-    // Every GOTO a pose, and each CIRCLE's chords besides.
-    assert!(program.poses().len() > gotos);
-    let kinds: Vec<&str> = program
-        .warnings
-        .iter()
-        .map(|w| w.message.split(' ').next().unwrap())
-        .collect();
-    assert_eq!(
-        kinds,
-        ["text", "TOOL", "TLDATA", "PAINT", "LOAD"],
-        "{kinds:?}"
-    );
-    assert_eq!(program.warnings[0].place.line, 1);
+/// The samples of a reference followed to its end, each with its pose, joints and the
+/// piece it was matched to.
+struct Followed {
+    samples: Vec<(Pose, [f64; 5], usize)>,
+    /// The largest distance of a tip from its piece, mm.
+    tip: f64,
+    /// The largest angle of an axis from its piece's, rad.
+    axis: f64,
 }
 
-#[test]
-fn the_multi_operation_file_is_planned_within_its_speeds_the_limits_and_the_tolerances() {
-    let text = cam_examples::nx_multi_operation_cls();
-    let pieces = read(&text);
-    let limits = PathLimits::at_feed(FEED);
-    let joints = JointLimits::default();
-    let (mut reference, seconds) = planned(&text, limits);
-    let duration = reference.planned_duration().unwrap();
-
-    // Walk the samples, each matched to the nearest piece a little behind or ahead of the
-    // last match (the path comes back near itself: rasters, rapids out and in).
+/// Walks `reference` to its end, each sample matched to the nearest piece a little behind
+/// or ahead of the last match (the path comes back near itself: rasters, rapids out and
+/// in); asserts that it ends on the last piece.
+fn follow(pieces: &[Piece], reference: &mut FiveAxisReference) -> Followed {
     let mut samples: Vec<(Pose, [f64; 5], usize)> = Vec::new();
     let mut near = 0usize;
     let (mut worst_tip, mut worst_axis) = (0.0f64, 0.0f64);
@@ -221,20 +217,17 @@ fn the_multi_operation_file_is_planned_within_its_speeds_the_limits_and_the_tole
         pieces.len() - 1,
         "the reference ends on the last piece"
     );
-    assert!(
-        worst_tip <= limits.tolerance * (1.0 + 1e-6),
-        "tip {worst_tip} mm"
-    );
-    assert!(
-        worst_axis <= limits.orientation_tolerance * (1.0 + 1e-6),
-        "axis {worst_axis} rad"
-    );
+    Followed {
+        samples,
+        tip: worst_tip,
+        axis: worst_axis,
+    }
+}
 
-    // The joints within their limits; the tip no faster than the move it is on, where
-    // every sample within the jerk filter's reach is on moves of that speed.
+/// Asserts every joint within its travel, speed and acceleration on every sample; the
+/// peak speed of each joint as a share of its limit.
+fn joints_within(samples: &[(Pose, [f64; 5], usize)], joints: &JointLimits) -> [f64; 5] {
     let mut peak_joint = [0.0f64; 5];
-    let mut fastest = std::collections::BTreeMap::<u64, f64>::new();
-    let reach = 40;
     for k in 2..samples.len() {
         let q = |j: usize| samples[j].1;
         for (i, peak) in peak_joint.iter_mut().enumerate() {
@@ -251,6 +244,64 @@ fn the_multi_operation_file_is_planned_within_its_speeds_the_limits_and_the_tole
             );
             assert!(q(k)[i] >= joints.min[i] && q(k)[i] <= joints.max[i]);
         }
+    }
+    peak_joint.map(|p| (p * 1000.0).round() / 1000.0)
+}
+
+#[test]
+fn the_nx_multi_operation_file_is_read_with_one_warning_per_kind() {
+    let text = cam_examples::nx_multi_operation_cls();
+    let gotos = text.lines().filter(|l| l.starts_with("GOTO/")).count();
+    let operations = text.lines().filter(|l| l.starts_with("TOOL PATH/")).count();
+    assert!(gotos > 10_000, "{gotos} GOTOs");
+    assert_eq!(operations, 15);
+    let program = parse_cl(&text, "multi.cls").unwrap();
+    // Every GOTO a pose, and each CIRCLE's chords besides.
+    assert!(program.poses().len() > gotos);
+    let kinds: Vec<&str> = program
+        .warnings
+        .iter()
+        .map(|w| w.message.split(' ').next().unwrap())
+        .collect();
+    assert_eq!(
+        kinds,
+        ["text", "TOOL", "TLDATA", "PAINT", "LOAD"],
+        "{kinds:?}"
+    );
+    assert_eq!(program.warnings[0].place.line, 1);
+}
+
+#[test]
+fn the_multi_operation_file_is_planned_within_its_speeds_the_limits_and_the_tolerances() {
+    let text = cam_examples::nx_multi_operation_cls();
+    let pieces = read(&text);
+    let limits = PathLimits::at_feed(FEED);
+    let joints = JointLimits::default();
+    let start = Instant::now();
+    let program = parse_cl(&text, "multi.cls").unwrap();
+    let mut reference = planned(&program, "multi.cls", limits).unwrap_or_else(|e| panic!("{e}"));
+    let seconds = start.elapsed().as_secs_f64();
+    let duration = reference.planned_duration().unwrap();
+    let Followed {
+        samples,
+        tip: worst_tip,
+        axis: worst_axis,
+    } = follow(&pieces, &mut reference);
+    assert!(
+        worst_tip <= limits.tolerance * (1.0 + 1e-6),
+        "tip {worst_tip} mm"
+    );
+    assert!(
+        worst_axis <= limits.orientation_tolerance * (1.0 + 1e-6),
+        "axis {worst_axis} rad"
+    );
+
+    // The joints within their limits; the tip no faster than the move it is on, where
+    // every sample within the jerk filter's reach is on moves of that speed.
+    let peak_joint = joints_within(&samples, &joints);
+    let mut fastest = std::collections::BTreeMap::<u64, f64>::new();
+    let reach = 40;
+    for k in 2..samples.len() {
         let speed = geometry::dist(&samples[k].0.tip, &samples[k - 1].0.tip) / TS;
         let feed = pieces[samples[k].2].feed;
         let window = k.saturating_sub(reach)..(k + reach).min(samples.len());
@@ -291,6 +342,104 @@ fn the_multi_operation_file_is_planned_within_its_speeds_the_limits_and_the_tole
         samples.len(),
         worst_tip,
         worst_axis * 1e3,
-        peak_joint.map(|p| (p * 1000.0).round() / 1000.0)
+        peak_joint
     );
+}
+
+/// The reader's poses as straight pieces with their speeds.
+fn pieces_of(program: &PartProgram) -> Vec<Piece> {
+    let poses = program.poses();
+    let feeds = program_feeds(program, FEED, RAPID);
+    poses
+        .windows(2)
+        .enumerate()
+        .map(|(i, w)| Piece {
+            from: w[0],
+            to: w[1],
+            feed: feed_of_move(&feeds, FEED, i + 1),
+        })
+        .collect()
+}
+
+/// The public CL files of `tests/data/cl` (their sources and licences in its README),
+/// each read and planned as the interpolator does, every sample within the tolerances of
+/// the reader's poses and the joints within their limits; the table printed
+/// (`--nocapture`). `CL_FILES=dir` surveys another folder instead: a file refused there
+/// is a row of the table with its reason, not a failure.
+#[test]
+fn public_cl_files_are_read_and_planned() {
+    let survey = std::env::var_os("CL_FILES").map(std::path::PathBuf::from);
+    let dir = survey.clone().unwrap_or_else(|| {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/cl")
+    });
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x != "md"))
+        .collect();
+    files.sort();
+    assert!(survey.is_some() || !files.is_empty(), "{files:?}");
+    println!(
+        "| file | poses | warnings | planning | duration | tip | axis | peak joint speeds (X Y Z A C) |"
+    );
+    // The files of tests/data/cl the reader refuses, and why (its README).
+    let refused = [
+        ("bohren_1.ncl", "16: CYCLE/DEEP"),
+        ("PrepaFlans_Pointage.aptsource", "36: CYCLE/DRILL"),
+        ("RotateThin.apt", "20: CUTCOM"),
+    ];
+    for file in files {
+        let name = file.file_name().unwrap().to_string_lossy().to_string();
+        let expected = refused
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, why)| *why);
+        match (read_and_plan(&file, &name), expected) {
+            (Ok(row), None) => println!("{row}"),
+            (Err(why), _) if survey.is_some() => {
+                println!("| {name} | refused: {why} | | | | | | |")
+            }
+            (Err(why), Some(reason)) if why.contains(reason) => {
+                println!("| {name} | refused: {why} | | | | | | |")
+            }
+            (Ok(_), Some(reason)) => panic!("{name}: read, expected refused for {reason}"),
+            (Err(why), _) => panic!("{name}: {why}"),
+        }
+    }
+}
+
+/// One CL file read and planned at the interpolator's defaults: its row of the table, or
+/// why it is refused.
+fn read_and_plan(file: &std::path::Path, name: &str) -> Result<String, String> {
+    let limits = PathLimits::at_feed(FEED);
+    let start = Instant::now();
+    let program = load_cl(file).map_err(|e| e.to_string())?;
+    let mut reference = planned(&program, name, limits)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let pieces = pieces_of(&program);
+    let followed = follow(&pieces, &mut reference);
+    assert!(
+        followed.tip <= limits.tolerance * (1.0 + 1e-6),
+        "{name}: tip {} mm",
+        followed.tip
+    );
+    assert!(
+        followed.axis <= limits.orientation_tolerance * (1.0 + 1e-6),
+        "{name}: axis {} rad",
+        followed.axis
+    );
+    let peaks = joints_within(&followed.samples, &JointLimits::default());
+    let kinds: Vec<String> = program
+        .warnings
+        .iter()
+        .map(|w| w.message.split(' ').next().unwrap_or("").to_string())
+        .collect();
+    Ok(format!(
+        "| {name} | {} | {} | {seconds:.2} s | {:.1} s | {:.2e} mm | {:.2e} rad | {peaks:?} |",
+        program.poses().len(),
+        kinds.join(", "),
+        reference.planned_duration().unwrap(),
+        followed.tip,
+        followed.axis,
+    ))
 }

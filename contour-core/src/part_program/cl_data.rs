@@ -7,8 +7,9 @@
 //! - `GOTO` with six numbers, or three (the tool axis then stays as it was, +Z at the
 //!   start, or as `TLAXIS` set it); `GODLTA/dx,dy,dz` (a move by that much); `FROM` (where
 //!   the tool starts, a move at rapid from the origin like any first move).
-//! - `UNITS/MM` or `UNITS/INCHES`; without it, a first `FEDRAT` in `IPM` or `IPR` means
-//!   inches (with a warning saying so). Inch data is read as inch: every length × 25.4.
+//! - `UNITS/MM` or `UNITS/INCHES` (`UNIT/…` too); without it, a file whose first `FEDRAT` is in `IPM` or
+//!   `IPR` is in inches from its first record (NX writes rapids before it), with a warning
+//!   saying so. Inch data is read as inch: every length × 25.4.
 //! - `FEDRAT/f`, `FEDRAT/MMPM,f`, `FEDRAT/IPM,f` (or the unit after the number): the feed
 //!   of the moves after it, mm/min or in/min; `MMPR`/`IPR` per spindle turn, with the turns
 //!   of the last `SPINDL` (refused without one). `RAPID`: the next move at rapid.
@@ -30,10 +31,12 @@
 //!
 //! Refused with the file and line: a malformed `GOTO` (wrong count, not a number,
 //! non-finite, a zero axis), `CYCLE` (drilling cycles: their moves are the controller's),
-//! `CUTCOM` on (compensation), a `CIRCLE` not followed by a `GOTO` on it, a feed per turn
+//! `CUTCOM` on (compensation), `NURBS` (NX's spline motion, with its `KNOT` and `CNTRL`
+//! records: skipping it would cut straight across the curve), a `CIRCLE` not followed by
+//! a `GOTO` on it, a feed per turn
 //! without a spindle speed. `$$` starts a comment; a line ending in `$` continues on the
-//! next one. Axis vectors are normalised; one whose length is off 1 by more than 1e-6
-//! gets a warning.
+//! next one, a comment too. Axis vectors are normalised; one whose length is off 1 by
+//! more than 1e-6 gets a warning.
 
 use std::collections::BTreeSet;
 
@@ -100,6 +103,29 @@ pub fn load_cl_with(
     parse_cl_with(&text, &name, options)
 }
 
+/// Where a file without a `UNITS` record has its first `FEDRAT` in inches (`IPM`,
+/// `IPR`): its line and unit.
+fn inch_by_first_feed(text: &str) -> Option<(usize, String)> {
+    let records = text
+        .lines()
+        .map(|l| l.split("$$").next().unwrap_or("").trim());
+    let mut first_feed = None;
+    for (index, record) in records.enumerate() {
+        let upper = record.to_ascii_uppercase();
+        if upper.starts_with("UNIT") {
+            return None;
+        }
+        if first_feed.is_none() && upper.starts_with("FEDRAT") {
+            let unit = ["IPM", "IPR", "MMPM", "MMPR"]
+                .into_iter()
+                .find(|u| upper.contains(u))
+                .unwrap_or("MMPM");
+            first_feed = Some((index + 1, unit.to_string()));
+        }
+    }
+    first_feed.filter(|(_, unit)| unit.starts_with("IP"))
+}
+
 /// Parses the text of a CL file; `name` is used in messages.
 pub fn parse_cl(text: &str, name: &str) -> Result<PartProgram, PathError> {
     parse_cl_with(text, name, &ClOptions::default())
@@ -118,10 +144,29 @@ pub fn parse_cl_with(
         )));
     }
     let mut reader = Reader::new(name, *options);
+    if let Some((line, unit)) = inch_by_first_feed(text) {
+        // NX writes the first rapids before the first FEDRAT: the feed's unit is the
+        // file's, from its first record.
+        reader.scale = INCH;
+        reader.warn(
+            line,
+            format!("no UNITS record and the first FEDRAT in {unit}: the file is read in inches"),
+        );
+    }
     let mut record = String::new();
     let mut first_line = 0;
+    let mut comment_continues = false;
     for (index, raw) in text.lines().enumerate() {
-        let line = raw.split("$$").next().unwrap_or("").trim();
+        // A comment that ends in `$` goes on over the next line (Creo's `$$-> CSYS / …, $`).
+        if comment_continues {
+            comment_continues = raw.trim_end().ends_with('$');
+            continue;
+        }
+        let (line, comment) = match raw.split_once("$$") {
+            Some((code, comment)) => (code.trim(), Some(comment)),
+            None => (raw.trim(), None),
+        };
+        comment_continues = comment.is_some_and(|c| c.trim_end().ends_with('$'));
         if record.is_empty() {
             first_line = index + 1;
         }
@@ -173,7 +218,6 @@ struct Reader<'a> {
     data: PartProgram,
     /// mm per length unit of the file.
     scale: f64,
-    units_given: bool,
     axis: Vector<3>,
     tip: Vector<3>,
     feed: Option<f64>,
@@ -198,7 +242,6 @@ impl<'a> Reader<'a> {
                 warnings: Vec::new(),
             },
             scale: 1.0,
-            units_given: false,
             axis: Vector::<3>::z(),
             tip: Vector::<3>::zeros(),
             feed: None,
@@ -298,7 +341,8 @@ impl<'a> Reader<'a> {
             "RAPID" => self.rapid_next = true,
             "FEDRAT" => self.feed_rate(args, line)?,
             "SPINDL" => self.spindle(args),
-            "UNITS" => {
+            // CAMWorks writes `UNIT/MM`.
+            "UNITS" | "UNIT" => {
                 let unit = args.trim().to_ascii_uppercase();
                 self.scale = match unit.as_str() {
                     "MM" | "MILLIMETERS" | "MILLIMETER" => 1.0,
@@ -307,7 +351,6 @@ impl<'a> Reader<'a> {
                         return Err(self.fail(line, format!("UNITS/{other}: expected MM or INCHES")))
                     }
                 };
-                self.units_given = true;
             }
             "CIRCLE" => {
                 let n = self.numbers(args, line, "CIRCLE")?;
@@ -370,6 +413,16 @@ impl<'a> Reader<'a> {
                             .into(),
                     ));
                 }
+            }
+            "NURBS" | "KNOT" | "CNTRL" => {
+                return Err(self.fail(
+                    line,
+                    format!(
+                        "{word}: NURBS motion is not read (skipping it would cut straight \
+                         across the curve); output the path as GOTO moves and CIRCLEs from \
+                         the CAM system (NX: NURBS output off)"
+                    ),
+                ))
             }
             "GOHOME" => {
                 return Err(self.fail(
@@ -580,14 +633,6 @@ impl<'a> Reader<'a> {
         };
         let unit = unit.unwrap_or_else(|| "MMPM".to_string());
         let inch = unit.starts_with("IP");
-        if inch && !self.units_given && self.data.moves.is_empty() && self.scale == 1.0 {
-            // No UNITS record, a feed in inches before any move: the file is in inches.
-            self.scale = INCH;
-            self.warn(
-                line,
-                format!("no UNITS record and FEDRAT in {unit}: the file is read in inches"),
-            );
-        }
         let per_unit = if inch { INCH } else { 1.0 };
         let per_minute = match unit.as_str() {
             "MMPM" | "IPM" => value * per_unit,
@@ -835,16 +880,17 @@ mod tests {
     #[test]
     fn an_nx_inch_file_with_msys_rapid_feed_and_a_circle() {
         // NX's CLSF as it writes an inch program: no UNITS record, FEDRAT/IPM, an MSYS
-        // record, paint and tool records, a CIRCLE before the GOTO that ends the arc.
+        // record, paint and tool records, a rapid before the first FEDRAT (in inches too),
+        // a CIRCLE before the GOTO that ends the arc.
         let text = "TOOL PATH/FINISH,TOOL,EM_250\n\
             TLDATA/MILL,0.2500,0.0000,2.0000,0.0000,0.0000\n\
             MSYS/0.0000,0.0000,0.0000,1.0000000,0.0000000,0.0000000,0.0000000,1.0000000,0.0000000\n\
             $$ centerline data\n\
             PAINT/PATH\n\
             PAINT/SPEED,10\n\
-            FEDRAT/IPM,20.0000\n\
             RAPID\n\
             GOTO/1.0000,0.0000,0.5000,0.0000000,0.0000000,1.0000000\n\
+            FEDRAT/IPM,20.0000\n\
             PAINT/COLOR,211\n\
             GOTO/1.0000,0.0000,0.0000\n\
             CIRCLE/0.0000,0.0000,0.0000,0.0000000,0.0000000,1.0000000,1.0000,0.0010,0.0500,0.2500,0.0000\n\
@@ -884,15 +930,37 @@ mod tests {
         assert_eq!(
             data.warning_lines(),
             [
+                "nx.cls:9: no UNITS record and the first FEDRAT in IPM: the file is read in \
+                 inches",
                 "nx.cls:1: TOOL PATH skipped (it does not move the tool); further ones are \
                  skipped silently",
                 "nx.cls:2: TLDATA skipped (it does not move the tool); further ones are \
                  skipped silently",
                 "nx.cls:5: PAINT skipped (it does not move the tool); further ones are skipped \
                  silently",
-                "nx.cls:7: no UNITS record and FEDRAT in IPM: the file is read in inches",
             ]
         );
+    }
+
+    #[test]
+    fn a_creo_file_with_spaced_slashes_and_a_comment_continued() {
+        // As Creo's Pro/CLfile writes it: a `$$->` comment continued with `$` over two
+        // lines of numbers, spaced slashes, a record continued with `$`.
+        let text = "$$*          Pro/CLfile  Version 8.0 - 8.0.3.0\nUNITS / MM\n\
+            $$-> CSYS / 1.0, 0.0, 0.0, 0.0,  $\n            0.0, 1.0, 0.0, 0.0,  $\n\
+            \x20           0.0, 0.0, 1.0, 0.0\nRAPID \nGOTO / 0.0, 1.5, 2.0\n\
+            FEDRAT / 400.000000,  MMPM\nGOTO / 0.0, 1.5, -1.5\n\
+            CIRCLE / 0.0, 0.0, -1.5,  $\n0.0, 0.0, -1.0,  1.5\nGOTO / 1.5, 0.0, -1.5\nFINI \n";
+        let data = parse_cl(text, "creo.ncl").unwrap();
+        assert!(data.warnings.is_empty(), "{:?}", data.warning_lines());
+        let t = tips(&data);
+        assert_eq!(t[0], Vector::<3>::new(0.0, 1.5, 2.0));
+        // Clockwise about +Z (axis −Z) from (0, 1.5) to (1.5, 0): a quarter, x rising.
+        assert_eq!(t[t.len() - 1], Vector::<3>::new(1.5, 0.0, -1.5));
+        assert!(t[2..].windows(2).all(|w| w[1][0] > w[0][0]));
+        for p in &t[2..] {
+            assert!((math::hypot(p[0], p[1]) - 1.5).abs() < 1e-9, "{p:?}");
+        }
     }
 
     #[test]
@@ -1001,6 +1069,15 @@ mod tests {
             ),
             ("UNITS/FEET\nGOTO/0,0,0\n", 1, "expected MM or INCHES"),
             ("GOTO/0,0,0\nGOHOME\nGOTO/1,0,0\n", 2, "GOHOME"),
+            (
+                // NX's spline output, as in a public NX listing (TetraDecaPost's test_prt).
+                "GOTO/-1.7710,1.5994,1.3538\nNURBS/\nKNOT/1.0000000\n\
+                 CNTRL/-1.6893,1.6898,1.3538\nCNTRL/-1.6017,1.7730,1.3538\n\
+                 CNTRL/-1.5072,1.8500,1.3538\nGOTO/-1.2004,2.1000,1.3538\n",
+                2,
+                "NURBS: NURBS motion is not read",
+            ),
+            ("GOTO/0,0,0\nCNTRL/1,0,0\n", 2, "CNTRL: NURBS motion"),
             (
                 "GOTO/1e11,0,0\nCIRCLE/0,0,0,0,0,1,1e11\nGOTO/1e11,0,0\n",
                 2,
