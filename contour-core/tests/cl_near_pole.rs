@@ -8,33 +8,8 @@
 use contour_core::geometry;
 use contour_core::kinematics::TableTiltingAc;
 use contour_core::limits::{JointLimits, PathLimits};
-use contour_core::math;
 use contour_core::part_program::cl_data::parse_cl;
-use contour_core::path::five_axis::plan_joints;
-
-/// The pass as CL text: `n` GOTOs `step` inches apart along x, the axis tilted between
-/// 0.3° and `max_tilt` degrees, its azimuth `swing`·sin(x / period).
-fn nx_pass(n: usize, step: f64, max_tilt: f64, swing: f64, period: f64) -> String {
-    let mut text = String::from(
-        "TOOL PATH/NEAR_POLE,TOOL,BALL_125\nTLDATA/MILL,0.1250,0.0625,2.0000,0.0000,0.0000\n\
-         MSYS/0.0000,0.0000,0.0000,1.0000000,0.0000000,0.0000000,0.0000000,1.0000000,0.0000000\n\
-         PAINT/PATH\nFEDRAT/IPM,40.0000\n",
-    );
-    for i in 0..n {
-        let x = i as f64 * step;
-        let tilt = (0.3 + (max_tilt - 0.3) * 0.5 * (1.0 + math::sin(x / 0.12))).to_radians();
-        let azimuth = swing * math::sin(x / period);
-        let (st, ct) = math::sincos(tilt);
-        text += &format!(
-            "GOTO/{x:.4},{:.4},0.0000,{:.7},{:.7},{:.7}\n",
-            0.01 * math::sin(x / 0.3),
-            st * math::cos(azimuth),
-            st * math::sin(azimuth),
-            ct
-        );
-    }
-    text + "END-OF-PATH\n"
-}
+use contour_core::path::five_axis::{cam_examples::nx_near_pole_pass as nx_pass, plan_joints};
 
 #[test]
 fn a_near_vertical_pass_with_the_azimuth_swinging_is_planned_within_the_travel() {

@@ -411,12 +411,20 @@ fn public_cl_files_are_read_and_planned() {
 /// One CL file read and planned at the interpolator's defaults: its row of the table, or
 /// why it is refused.
 fn read_and_plan(file: &std::path::Path, name: &str) -> Result<String, String> {
-    let limits = PathLimits::at_feed(FEED);
     let start = Instant::now();
     let program = load_cl(file).map_err(|e| e.to_string())?;
-    let mut reference = planned(&program, name, limits)?;
+    plan_and_follow(&program, name, start)
+}
+
+/// `program` planned at the interpolator's defaults (`start`: when its reading began)
+/// and followed: every sample within the tolerances of the reader's poses, the joints
+/// within their limits, the duration no shorter than every move at its speed; the row of
+/// the table.
+fn plan_and_follow(program: &PartProgram, name: &str, start: Instant) -> Result<String, String> {
+    let limits = PathLimits::at_feed(FEED);
+    let mut reference = planned(program, name, limits)?;
     let seconds = start.elapsed().as_secs_f64();
-    let pieces = pieces_of(&program);
+    let pieces = pieces_of(program);
     let followed = follow(&pieces, &mut reference);
     assert!(
         followed.tip <= limits.tolerance * (1.0 + 1e-6),
@@ -429,17 +437,39 @@ fn read_and_plan(file: &std::path::Path, name: &str) -> Result<String, String> {
         followed.axis
     );
     let peaks = joints_within(&followed.samples, &JointLimits::default());
+    let duration = reference.planned_duration().unwrap();
+    let lower: f64 = pieces
+        .iter()
+        .map(|p| geometry::dist(&p.from.tip, &p.to.tip) / p.feed)
+        .sum();
+    assert!(duration >= lower, "{name}: {duration} s against {lower} s");
     let kinds: Vec<String> = program
         .warnings
         .iter()
         .map(|w| w.message.split(' ').next().unwrap_or("").to_string())
         .collect();
     Ok(format!(
-        "| {name} | {} | {} | {seconds:.2} s | {:.1} s | {:.2e} mm | {:.2e} rad | {peaks:?} |",
+        "| {name} | {} | {} | {seconds:.2} s | {duration:.1} s (≥ {lower:.1} s) | {:.2e} mm | \
+         {:.2e} rad | {peaks:?} |",
         program.poses().len(),
         kinds.join(", "),
-        reference.planned_duration().unwrap(),
         followed.tip,
         followed.axis,
     ))
+}
+
+/// The near-vertical pass as NX writes it (inch, `MSYS`, `FEDRAT/IPM`; the axis 0.3°–2.05°
+/// from vertical, its azimuth swinging up to ±172°, across the pole cone again and again;
+/// `cl_near_pole.rs` checks the reading and the joints at the nodes): planned with its
+/// feed like any CL file, within the tolerances, the limits and the time bound.
+#[test]
+fn the_near_vertical_nx_pass_is_planned_within_its_feed_and_the_limits() {
+    for (step, swing, period) in [(0.004, 2.5, 0.2), (0.02, 2.5, 0.08), (0.004, 3.0, 0.8)] {
+        let text = cam_examples::nx_near_pole_pass(600, step, 2.05, swing, period);
+        let start = Instant::now();
+        let program = parse_cl(&text, "near_pole.cls").unwrap();
+        let name = format!("near_pole step {step} in, swing {swing} rad, period {period} in");
+        let row = plan_and_follow(&program, &name, start).unwrap_or_else(|e| panic!("{e}"));
+        println!("{row}");
+    }
 }

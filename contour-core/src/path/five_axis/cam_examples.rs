@@ -407,3 +407,29 @@ pub fn nx_multi_operation_cls() -> String {
     });
     w.text
 }
+
+/// A pass near vertical as NX writes it (inch, `MSYS`, `FEDRAT/IPM` at 40 in/min): `n`
+/// GOTOs `step` inches apart along x, the tool axis tilted between 0.3° and `max_tilt`
+/// degrees, its azimuth `swing`·sin(x / `period`) (rad); the pass crosses the default
+/// pole cone (2°) again and again.
+pub fn nx_near_pole_pass(n: usize, step: f64, max_tilt: f64, swing: f64, period: f64) -> String {
+    let mut text = String::from(
+        "TOOL PATH/NEAR_POLE,TOOL,BALL_125\nTLDATA/MILL,0.1250,0.0625,2.0000,0.0000,0.0000\n\
+         MSYS/0.0000,0.0000,0.0000,1.0000000,0.0000000,0.0000000,0.0000000,1.0000000,0.0000000\n\
+         PAINT/PATH\nFEDRAT/IPM,40.0000\n",
+    );
+    for i in 0..n {
+        let x = i as f64 * step;
+        let tilt = (0.3 + (max_tilt - 0.3) * 0.5 * (1.0 + math::sin(x / 0.12))).to_radians();
+        let azimuth = swing * math::sin(x / period);
+        let (st, ct) = math::sincos(tilt);
+        text += &format!(
+            "GOTO/{x:.4},{:.4},0.0000,{:.7},{:.7},{:.7}\n",
+            0.01 * math::sin(x / 0.3),
+            st * math::cos(azimuth),
+            st * math::sin(azimuth),
+            ct
+        );
+    }
+    text + "END-OF-PATH\n"
+}
