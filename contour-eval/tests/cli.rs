@@ -217,25 +217,28 @@ fn a_displaced_helix_gives_its_displacement() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-#[test]
-fn the_same_helix_as_cl_data_gives_the_same_errors() {
-    let dir = scratch("cl");
+/// The helix's poses as CL text in `file` (its extension names the format): `header`,
+/// then each GOTO in units of `unit` mm with 10 decimals; contour-eval on the displaced
+/// run must give the displacement at every sample.
+fn helix_as_cl_gives_the_same_errors(file: &str, header: &str, unit: f64) {
+    let dir = scratch(file);
     let ToolPath::Poses { tips, axes } = ToolPath::tilted_helix() else {
         unreachable!("the helix is sampled")
     };
-    let mut cl = String::from("PARTNO/HELIX\n$$ the tilted helix\nMULTAX\nFEDRAT/MMPM,1200\n");
+    let mut cl = String::from(header);
     let (csv, us) = displaced_helix_csv();
     let needed = us[us.len() - 1] as usize + 50;
     for (p, o) in tips.iter().zip(axes.iter()).take(needed) {
+        let p = p / unit;
         writeln!(
             cl,
-            "GOTO/{:.7},{:.7},{:.7},{:.12},{:.12},{:.12}",
+            "GOTO/{:.10},{:.10},{:.10},{:.12},{:.12},{:.12}",
             p[0], p[1], p[2], o[0], o[1], o[2]
         )
         .unwrap();
     }
-    cl.push_str("FINI\n");
-    let (part, run, err) = (dir.join("helix.cl"), dir.join("run.csv"), dir.join("e.csv"));
+    cl.push_str("END-OF-PATH\nFINI\n");
+    let (part, run, err) = (dir.join(file), dir.join("run.csv"), dir.join("e.csv"));
     std::fs::write(&part, cl).unwrap();
     std::fs::write(&run, csv).unwrap();
     let mut args = vec!["--path", s(&part), "--measured", s(&run), "--out", s(&err)];
@@ -248,6 +251,29 @@ fn the_same_helix_as_cl_data_gives_the_same_errors() {
     );
     check_errors(&err, &us);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_same_helix_as_cl_data_gives_the_same_errors() {
+    helix_as_cl_gives_the_same_errors(
+        "helix.cl",
+        "PARTNO/HELIX\n$$ the tilted helix\nMULTAX\nFEDRAT/MMPM,1200\n",
+        1.0,
+    );
+}
+
+#[test]
+fn the_same_helix_as_nx_writes_it_in_inches_gives_the_same_errors() {
+    // NX's CLSF: a listing header, no UNITS record (FEDRAT/IPM: inches),
+    // MSYS, TOOL PATH, PAINT; `.cls`. The measured run's columns (X Y Z A C) make it a
+    // five-axis evaluation, whatever the reference file's extension.
+    helix_as_cl_gives_the_same_errors(
+        "helix.cls",
+        "Information listing created by\tsomeone\nTOOL PATH/HELIX,TOOL,BALL\n\
+         MSYS/0.0000,0.0000,0.0000,1.0000000,0.0000000,0.0000000,0.0000000,1.0000000,0.0000000\n\
+         PAINT/PATH\nFEDRAT/IPM,47.2441\n",
+        25.4,
+    );
 }
 
 #[test]
