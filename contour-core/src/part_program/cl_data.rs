@@ -22,6 +22,11 @@
 //!   in (origin, X and Y axes in the part's coordinates). The first one is the frame of
 //!   the whole reference; the records after a later, different one are carried into it.
 //! - `TLAXIS/i,j,k`: the tool axis for the following three-number `GOTO`s.
+//! - `NURBS/` with its `KNOT/…` and `CNTRL/x,y,z` records (NX's spline motion): a clamped
+//!   cubic B-spline from the tool's position through the control points (see
+//!   [`SplineBlock`]), as chords within [`ClOptions::arc_sag`] at the feed, the tool axis
+//!   unchanged; a block that does not fit that reading (counts, knots, weights or axes in
+//!   `CNTRL`) is refused.
 //! - `FINI`: the end. `PARTNO`, `MULTAX`, `INTOL`, `OUTTOL`, `TOLER`, `END-OF-PATH`: read,
 //!   nothing to do. `TOOL PATH`, `TLDATA`, `PAINT`, `LOAD`, `SELECT`, `COOLNT`, `PPRINT`
 //!   and any other record that does not move the tool: skipped with one warning per kind.
@@ -31,9 +36,7 @@
 //!
 //! Refused with the file and line: a malformed `GOTO` (wrong count, not a number,
 //! non-finite, a zero axis), `CYCLE` (drilling cycles: their moves are the controller's),
-//! `CUTCOM` on (compensation), `NURBS` (NX's spline motion, with its `KNOT` and `CNTRL`
-//! records: skipping it would cut straight across the curve), a `CIRCLE` not followed by
-//! a `GOTO` on it, a feed per turn
+//! `CUTCOM` on (compensation), a `CIRCLE` not followed by a `GOTO` on it, a feed per turn
 //! without a spindle speed. `$$` starts a comment; a line ending in `$` continues on the
 //! next one, a comment too. Axis vectors are normalised; one whose length is off 1 by
 //! more than 1e-6 gets a warning.
@@ -44,7 +47,7 @@ use super::{Corner, Motion, PartMove, PartProgram, Place, Speed, Warning};
 use crate::geometry::{self, Vector};
 use crate::math;
 use crate::path::nurbs_file::read_path_file;
-use crate::path::PathError;
+use crate::path::{Curve, Nurbs, PathError};
 
 /// How far an axis vector's length may be off 1 before it is worth a warning.
 const UNIT_TOLERANCE: f64 = 1e-6;
@@ -75,6 +78,9 @@ const MAX_RADIUS: f64 = 1e4;
 /// The most moves a file becomes, `CIRCLE` chords included (2²⁴, the sampling budget of
 /// a five-axis curve pair): a huge circle at a tiny sag is refused, not allocated.
 const MAX_MOVES: usize = 1 << 24;
+/// The most chords one `NURBS` block may become: 20 m of 10 mm radii at the default
+/// sag, so no block of a few lines asks for millions of moves.
+const MAX_SPLINE_CHORDS: usize = 100_000;
 
 /// What the reader needs beyond the file.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -190,6 +196,82 @@ pub fn parse_cl_with(
     reader.finish()
 }
 
+/// An NX `NURBS` block: a clamped cubic B-spline from the tool's position (its first
+/// control point, not written) through the `CNTRL` points (the last one its end), whose
+/// `KNOT` records list the interior knots on 0..1 and then 1. Its chords are moves at the
+/// feed; the tool axis stays as it was. No document states the format: how it was
+/// established is in docs/design/five-axis.md §5.3a.
+#[derive(Clone, Debug)]
+struct SplineBlock {
+    line: usize,
+    start: Vector<3>,
+    knots: Vec<f64>,
+    points: Vec<Vector<3>>,
+}
+
+impl SplineBlock {
+    fn curve(&self) -> Result<Nurbs<3>, String> {
+        let (m, n) = (self.knots.len(), self.points.len());
+        if m == 0 || n != m + 2 {
+            return Err(format!(
+                "{m} knots and {n} control points: a cubic block has two control points more \
+                 than knots (at least one knot, the last 1)"
+            ));
+        }
+        if self.knots[m - 1] != 1.0 || self.knots.iter().any(|k| !(*k > 0.0 && *k <= 1.0)) {
+            return Err("the knots must lie in (0, 1] and end with 1".into());
+        }
+        let mut knots = vec![0.0; 4];
+        knots.extend_from_slice(&self.knots[..m - 1]);
+        knots.extend_from_slice(&[1.0; 4]);
+        let mut points = vec![self.start];
+        points.extend_from_slice(&self.points);
+        Nurbs::new(3, knots, points, None).map_err(|e| e.to_string())
+    }
+}
+
+/// Points along `curve` (its end the last) whose chords leave it by at most `sag` mm,
+/// judged at a quarter, half and three quarters of each chord's parameter span; `None`
+/// beyond `room` points.
+fn chords_within(curve: &Nurbs<3>, sag: f64, room: usize) -> Option<Vec<Vector<3>>> {
+    let (u0, u1) = curve.param_range();
+    let mut out = Vec::new();
+    // Spans still to judge, the next one last; each with its end points.
+    let mut spans = vec![(u0, u1, curve.point(u0), curve.point(u1))];
+    while let Some((a, b, pa, pb)) = spans.pop() {
+        let off = [0.25, 0.5, 0.75].iter().any(|t| {
+            let p = curve.point(a + (b - a) * t);
+            // NaN (lengths past f64) counts as off.
+            let off = off_chord(&p, &pa, &pb);
+            off.is_nan() || off > sag
+        });
+        if off && b - a > 1e-9 * (u1 - u0) {
+            let m = 0.5 * (a + b);
+            let pm = curve.point(m);
+            spans.push((m, b, pm, pb));
+            spans.push((a, m, pa, pm));
+            continue;
+        }
+        if out.len() >= room {
+            return None;
+        }
+        out.push(pb);
+    }
+    Some(out)
+}
+
+/// The distance of `p` from the chord from `a` to `b`, mm.
+fn off_chord(p: &Vector<3>, a: &Vector<3>, b: &Vector<3>) -> f64 {
+    let d = b - a;
+    let length2 = d.norm_squared();
+    let t = if length2 > 0.0 {
+        ((p - a).dot(&d) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    geometry::dist(&(a + d * t), p)
+}
+
 /// A `CIRCLE` record waiting for the `GOTO` that ends it.
 #[derive(Clone, Copy, Debug)]
 struct Circle {
@@ -224,6 +306,8 @@ struct Reader<'a> {
     rapid_next: bool,
     spindle_rpm: Option<f64>,
     circle: Option<Circle>,
+    /// An NX `NURBS` block being read.
+    spline: Option<SplineBlock>,
     /// The reference's frame (the first `MSYS`) and the frame records are written in now.
     first_frame: Option<Frame>,
     frame: Option<Frame>,
@@ -248,6 +332,7 @@ impl<'a> Reader<'a> {
             rapid_next: false,
             spindle_rpm: None,
             circle: None,
+            spline: None,
             first_frame: None,
             frame: None,
             skipped: BTreeSet::new(),
@@ -315,6 +400,11 @@ impl<'a> Reader<'a> {
             return Ok(true);
         }
         let args = args.unwrap_or("");
+        // A NURBS block ends at the first record that is not its own (PAINT may come
+        // between its records).
+        if !matches!(word.as_str(), "KNOT" | "CNTRL" | "PAINT") {
+            self.end_spline()?;
+        }
         match word.as_str() {
             "GOTO" => {
                 let n = self.numbers(args, line, "GOTO")?;
@@ -414,15 +504,41 @@ impl<'a> Reader<'a> {
                     ));
                 }
             }
-            "NURBS" | "KNOT" | "CNTRL" => {
-                return Err(self.fail(
+            "NURBS" => {
+                if self.data.moves.is_empty() {
+                    return Err(self.fail(line, "NURBS before any GOTO: it has no start".into()));
+                }
+                self.spline = Some(SplineBlock {
                     line,
-                    format!(
-                        "{word}: NURBS motion is not read (skipping it would cut straight \
-                         across the curve); output the path as GOTO moves and CIRCLEs from \
-                         the CAM system (NX: NURBS output off)"
-                    ),
-                ))
+                    start: self.tip,
+                    knots: Vec::new(),
+                    points: Vec::new(),
+                });
+            }
+            "KNOT" => {
+                let n = self.numbers(args, line, "KNOT")?;
+                match &mut self.spline {
+                    Some(block) if block.points.is_empty() => block.knots.extend(n),
+                    _ => return Err(self.fail(line, "KNOT outside a NURBS block's head".into())),
+                }
+            }
+            "CNTRL" => {
+                let n = self.numbers(args, line, "CNTRL")?;
+                if n.len() != 3 {
+                    return Err(self.fail(
+                        line,
+                        format!(
+                            "CNTRL needs x,y,z, got {} numbers (weights and tool axes in NURBS \
+                             blocks are not read)",
+                            n.len()
+                        ),
+                    ));
+                }
+                let point = self.in_part_frame(&Vector::<3>::new(n[0], n[1], n[2]));
+                match &mut self.spline {
+                    Some(block) => block.points.push(point),
+                    None => return Err(self.fail(line, "CNTRL outside a NURBS block".into())),
+                }
             }
             "GOHOME" => {
                 return Err(self.fail(
@@ -560,6 +676,35 @@ impl<'a> Reader<'a> {
             z_place: None,
         });
         self.tip = tip;
+    }
+
+    /// The chords of the NURBS block being read, if any (see [`SplineBlock`]).
+    fn end_spline(&mut self) -> Result<(), PathError> {
+        let Some(block) = self.spline.take() else {
+            return Ok(());
+        };
+        let curve = block
+            .curve()
+            .map_err(|e| self.fail(block.line, format!("NURBS: {e}")))?;
+        let room = MAX_MOVES
+            .saturating_sub(self.data.moves.len())
+            .min(MAX_SPLINE_CHORDS);
+        let chords = chords_within(&curve, self.options.arc_sag, room).ok_or_else(|| {
+            self.fail(
+                block.line,
+                format!(
+                    "NURBS: more than {room} chords at a sag of {} mm (a block may have \
+                     {MAX_SPLINE_CHORDS}, the file {MAX_MOVES} moves)",
+                    self.options.arc_sag
+                ),
+            )
+        })?;
+        for point in chords {
+            self.push_move(point, block.line);
+            // Every chord at the feed: only the first one may follow a RAPID.
+            self.rapid_next = false;
+        }
+        Ok(())
     }
 
     /// The chords of a `CIRCLE` from the tip to `end`, counter-clockwise about its axis.
@@ -713,7 +858,8 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
-    fn finish(self) -> Result<PartProgram, PathError> {
+    fn finish(mut self) -> Result<PartProgram, PathError> {
+        self.end_spline()?;
         if let Some(circle) = self.circle {
             return Err(self.fail(circle.line, "a CIRCLE record with no GOTO after it".into()));
         }
@@ -942,6 +1088,93 @@ mod tests {
         );
     }
 
+    /// The test's own cubic B-spline (Cox–de Boor) at u.
+    fn de_boor(knots: &[f64], points: &[Vector<3>], u: f64) -> Vector<3> {
+        fn basis(k: &[f64], i: usize, p: usize, u: f64) -> f64 {
+            if p == 0 {
+                let last = u == k[k.len() - 1] && k[i] < k[i + 1] && k[i + 1] == u;
+                return if (k[i] <= u && u < k[i + 1]) || last {
+                    1.0
+                } else {
+                    0.0
+                };
+            }
+            let left = if k[i + p] > k[i] {
+                (u - k[i]) / (k[i + p] - k[i]) * basis(k, i, p - 1, u)
+            } else {
+                0.0
+            };
+            let right = if k[i + p + 1] > k[i + 1] {
+                (k[i + p + 1] - u) / (k[i + p + 1] - k[i + 1]) * basis(k, i + 1, p - 1, u)
+            } else {
+                0.0
+            };
+            left + right
+        }
+        points
+            .iter()
+            .enumerate()
+            .fold(Vector::<3>::zeros(), |sum, (i, q)| {
+                sum + q * basis(knots, i, 3, u)
+            })
+    }
+
+    #[test]
+    fn nx_nurbs_blocks_are_read_as_cubic_splines_from_the_tool_position() {
+        // As NX writes spline motion (TetraDecaPost's test_prt listing): the start is the
+        // GOTO before the block, KNOT lists the interior knots and 1, the last CNTRL is
+        // the end; a second block goes on from there, PAINT between records, KNOT values
+        // over two lines.
+        let text = "GOTO/-1.7710,1.5994,1.3538\nNURBS/\nKNOT/1.0000000\n\
+            CNTRL/-1.6893,1.6898,1.3538\nPAINT/COLOR,37\nCNTRL/-1.6017,1.7730,1.3538\n\
+            CNTRL/-1.5072,1.8500,1.3538\nNURBS/\nKNOT/0.1153846\nKNOT/0.8846154,1.0000000\n\
+            CNTRL/-1.40,1.92,1.3538\nCNTRL/-1.10,2.05,1.35\nCNTRL/-0.80,2.10,1.34\n\
+            CNTRL/-0.50,2.12,1.33\nCNTRL/-0.20,2.10,1.33\nGOTO/0.0,2.0,1.33\n";
+        let data = parse_cl(text, "nx.cls").unwrap();
+        assert!(data.warnings.len() == 1, "{:?}", data.warning_lines()); // PAINT
+        let t = tips(&data);
+        let v = |x: f64, y: f64, z: f64| Vector::<3>::new(x, y, z);
+        let first = [
+            v(-1.7710, 1.5994, 1.3538),
+            v(-1.6893, 1.6898, 1.3538),
+            v(-1.6017, 1.7730, 1.3538),
+            v(-1.5072, 1.8500, 1.3538),
+        ];
+        let mut second = vec![first[3]];
+        second.extend([
+            v(-1.40, 1.92, 1.3538),
+            v(-1.10, 2.05, 1.35),
+            v(-0.80, 2.10, 1.34),
+            v(-0.50, 2.12, 1.33),
+            v(-0.20, 2.10, 1.33),
+        ]);
+        let k1 = [0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        let k2 = [0.0, 0.0, 0.0, 0.0, 0.1153846, 0.8846154, 1.0, 1.0, 1.0, 1.0];
+        // Dense samples of the test's own curves.
+        let dense: Vec<(usize, Vector<3>)> = (0..=20_000)
+            .map(|i| (1, de_boor(&k1, &first, i as f64 / 20_000.0)))
+            .chain((0..=20_000).map(|i| (2, de_boor(&k2, &second, i as f64 / 20_000.0))))
+            .collect();
+        let near = |p: &Vector<3>| {
+            dense
+                .iter()
+                .map(|(_, q)| geometry::dist(p, q))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let sag = ClOptions::default().arc_sag;
+        let ends = t.iter().position(|p| *p == first[3]).unwrap();
+        assert!(ends > 2, "the first block in {ends} chords");
+        // Every chord end on the curves (to the dense sampling's reach), every chord's
+        // middle within the sag, the second block's end its last CNTRL, then the GOTO.
+        assert_eq!(t[t.len() - 2], second[5]);
+        assert_eq!(t[t.len() - 1], v(0.0, 2.0, 1.33));
+        for w in t[..t.len() - 1].windows(2) {
+            assert!(near(&w[1]) < 2e-5, "{:?}", w[1]);
+            assert!(near(&((w[0] + w[1]) * 0.5)) <= sag + 2e-5);
+        }
+        assert!(t.len() > 12, "{} points", t.len());
+    }
+
     #[test]
     fn a_creo_file_with_spaced_slashes_and_a_comment_continued() {
         // As Creo's Pro/CLfile writes it: a `$$->` comment continued with `$` over two
@@ -1069,15 +1302,38 @@ mod tests {
             ),
             ("UNITS/FEET\nGOTO/0,0,0\n", 1, "expected MM or INCHES"),
             ("GOTO/0,0,0\nGOHOME\nGOTO/1,0,0\n", 2, "GOHOME"),
+            ("NURBS/\nKNOT/1\nCNTRL/1,0,0\n", 1, "NURBS before any GOTO"),
             (
-                // NX's spline output, as in a public NX listing (TetraDecaPost's test_prt).
-                "GOTO/-1.7710,1.5994,1.3538\nNURBS/\nKNOT/1.0000000\n\
-                 CNTRL/-1.6893,1.6898,1.3538\nCNTRL/-1.6017,1.7730,1.3538\n\
-                 CNTRL/-1.5072,1.8500,1.3538\nGOTO/-1.2004,2.1000,1.3538\n",
+                "GOTO/0,0,0\nCNTRL/1,0,0\n",
                 2,
-                "NURBS: NURBS motion is not read",
+                "CNTRL outside a NURBS block",
             ),
-            ("GOTO/0,0,0\nCNTRL/1,0,0\n", 2, "CNTRL: NURBS motion"),
+            (
+                "GOTO/0,0,0\nNURBS/\nKNOT/1\nCNTRL/1,0,0\nCNTRL/2,0,0\nGOTO/3,0,0\n",
+                2,
+                "1 knots and 2 control points",
+            ),
+            (
+                "GOTO/0,0,0\nNURBS/\nKNOT/0.5\nCNTRL/1,0,0\nCNTRL/2,0,0\nCNTRL/3,0,0\n",
+                2,
+                "end with 1",
+            ),
+            (
+                "GOTO/0,0,0\nNURBS/\nKNOT/1\nCNTRL/1,0,0,0,0,1\n",
+                4,
+                "weights and tool axes in NURBS blocks are not read",
+            ),
+            (
+                "GOTO/0,0,0\nNURBS/\nKNOT/1\nCNTRL/1e200,0,0\nCNTRL/0,1e200,0\n\
+                 CNTRL/1,1,0\n",
+                2,
+                "NURBS: more than 100000 chords",
+            ),
+            (
+                "GOTO/0,0,0\nNURBS/\nKNOT/1\nCNTRL/1,0,0\nKNOT/1\n",
+                5,
+                "KNOT outside a NURBS block's head",
+            ),
             (
                 "GOTO/1e11,0,0\nCIRCLE/0,0,0,0,0,1,1e11\nGOTO/1e11,0,0\n",
                 2,
