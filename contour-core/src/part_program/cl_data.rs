@@ -7,9 +7,9 @@
 //! - `GOTO` with six numbers, or three (the tool axis then stays as it was, +Z at the
 //!   start, or as `TLAXIS` set it); `GODLTA/dx,dy,dz` (a move by that much); `FROM` (where
 //!   the tool starts, a move at rapid from the origin like any first move).
-//! - `UNITS/MM` or `UNITS/INCHES` (`UNIT/…` too); without it, a file whose first `FEDRAT` is in `IPM` or
-//!   `IPR` is in inches from its first record (NX writes rapids before it), with a warning
-//!   saying so. Inch data is read as inch: every length × 25.4.
+//! - `UNITS/MM` or `UNITS/INCHES` (`UNIT/…` too); without it, a file whose first
+//!   `FEDRAT` is in `IPM` or `IPR` is in inches from its first record (NX writes rapids
+//!   before it), with a warning saying so. Inch data is read as inch: every length × 25.4.
 //! - `FEDRAT/f`, `FEDRAT/MMPM,f`, `FEDRAT/IPM,f` (or the unit after the number): the feed
 //!   of the moves after it, mm/min or in/min; `MMPR`/`IPR` per spindle turn, with the turns
 //!   of the last `SPINDL` (refused without one). `RAPID`: the next move at rapid.
@@ -44,6 +44,7 @@
 use std::collections::BTreeSet;
 
 use super::{Corner, Motion, PartMove, PartProgram, Place, Speed, Warning};
+use crate::contour::five_axis::hmm::segment_distance;
 use crate::geometry::{self, Vector};
 use crate::math;
 use crate::path::nurbs_file::read_path_file;
@@ -242,7 +243,7 @@ fn chords_within(curve: &Nurbs<3>, sag: f64, room: usize) -> Option<Vec<Vector<3
         let off = [0.25, 0.5, 0.75].iter().any(|t| {
             let p = curve.point(a + (b - a) * t);
             // NaN (lengths past f64) counts as off.
-            let off = off_chord(&p, &pa, &pb);
+            let off = segment_distance(&p, &pa, &pb);
             off.is_nan() || off > sag
         });
         if off && b - a > 1e-9 * (u1 - u0) {
@@ -258,18 +259,6 @@ fn chords_within(curve: &Nurbs<3>, sag: f64, room: usize) -> Option<Vec<Vector<3
         out.push(pb);
     }
     Some(out)
-}
-
-/// The distance of `p` from the chord from `a` to `b`, mm.
-fn off_chord(p: &Vector<3>, a: &Vector<3>, b: &Vector<3>) -> f64 {
-    let d = b - a;
-    let length2 = d.norm_squared();
-    let t = if length2 > 0.0 {
-        ((p - a).dot(&d) / length2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    geometry::dist(&(a + d * t), p)
 }
 
 /// A `CIRCLE` record waiting for the `GOTO` that ends it.
