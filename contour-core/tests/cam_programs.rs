@@ -221,6 +221,7 @@ fn fanuc_post_with_o_number_g43_home_returns_a_dwell_in_ms_holes_and_an_optional
         dialect: Dialect::Fanuc,
         optional_stop: true,
         home: contour_core::geometry::Vector::<3>::new(-50.0, -40.0, 100.0),
+        ..GcodeOptions::default()
     };
     let program =
         Program::parse_gcode_with(&text, "hsm.nc", &options).unwrap_or_else(|e| panic!("{e}"));

@@ -14,28 +14,15 @@
 use std::time::Instant;
 
 use contour_core::geometry::{self, Vector};
-use contour_core::kinematics::{Pose, TableTiltingAc};
+use contour_core::kinematics::Pose;
 use contour_core::limits::{JointLimits, PathLimits};
 use contour_core::math;
 use contour_core::part_program::cl_data::{load_cl, parse_cl};
-use contour_core::part_program::PartProgram;
-use contour_core::path::five_axis::{
-    cam_examples, feed_of_move, program_feeds, FiveAxisInputs, FiveAxisReference, Planner, ToolPath,
-};
+use contour_core::path::five_axis::cam_examples;
 
-const TS: f64 = 1e-3;
-/// The interpolator's `feed` and `rapid` parameters, mm/s: the file's FEDRATs win.
-const FEED: f64 = 50.0;
-const RAPID: f64 = 100.0;
+mod support;
 
-/// One straight piece of the CL path as this test reads the file.
-#[derive(Clone, Copy)]
-struct Piece {
-    from: Pose,
-    to: Pose,
-    /// mm/s.
-    feed: f64,
-}
+use support::*;
 
 /// A record's numbers (its words, `MMPM`, left out).
 fn numbers(record: &str) -> Vec<f64> {
@@ -118,136 +105,6 @@ fn read(text: &str) -> Vec<Piece> {
     pieces
 }
 
-/// The distance of `pose`'s tip from piece `p` and the angle of its axis from the
-/// piece's (slerped) axis there.
-fn off(p: &Piece, pose: &Pose) -> (f64, f64) {
-    let d = p.to.tip - p.from.tip;
-    let length2 = d.norm_squared();
-    let t = if length2 > 0.0 {
-        ((pose.tip - p.from.tip).dot(&d) / length2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let axis = geometry::slerp(&p.from.axis, &p.to.axis, t).unwrap();
-    let distance = geometry::dist(&(p.from.tip + d * t), &pose.tip);
-    if length2 == 0.0 && distance <= TURN_REACH {
-        // The tool turns on the spot: every axis of the turn is programmed at this tip
-        // (sampled finely enough for the tolerances, 0.16 mrad at a half turn).
-        let nearest = (0..=10_000)
-            .map(|k| geometry::slerp(&p.from.axis, &p.to.axis, k as f64 / 1e4).unwrap())
-            .map(|axis| geometry::angle_between(&axis, &pose.axis))
-            .fold(f64::INFINITY, f64::min);
-        return (distance, nearest);
-    }
-    (distance, geometry::angle_between(&axis, &pose.axis))
-}
-
-/// How near a turn on the spot's tip a planned tip counts as on it: the planner's
-/// tolerance.
-const TURN_REACH: f64 = 5e-3;
-
-/// The interpolator's plan of `program` (the file's speeds, `FEED` and `RAPID`), and
-/// the time it took.
-fn planned(
-    program: &PartProgram,
-    name: &str,
-    limits: PathLimits,
-) -> Result<FiveAxisReference, String> {
-    let inputs = FiveAxisInputs {
-        path: ToolPath::from_poses(&program.poses()).map_err(|e| e.to_string())?,
-        builtin: None,
-        feeds: program_feeds(program, FEED, RAPID),
-        machine: TableTiltingAc::default(),
-        joints: JointLimits::default(),
-        limits,
-        ts: TS,
-    };
-    let lines = program.lines();
-    let at = |i: usize| format!("{name}:{}", lines[i]);
-    FiveAxisReference::new(inputs, &Planner::new(), &at).map_err(|e| e.to_string())
-}
-
-/// The samples of a reference followed to its end, each with its pose, joints and the
-/// piece it was matched to.
-struct Followed {
-    samples: Vec<(Pose, [f64; 5], usize)>,
-    /// The largest distance of a tip from its piece, mm.
-    tip: f64,
-    /// The largest angle of an axis from its piece's, rad.
-    axis: f64,
-}
-
-/// Walks `reference` to its end, each sample matched to the nearest piece a little behind
-/// or ahead of the last match (the path comes back near itself: rasters, rapids out and
-/// in); asserts that it ends on the last piece.
-fn follow(pieces: &[Piece], reference: &mut FiveAxisReference) -> Followed {
-    let mut samples: Vec<(Pose, [f64; 5], usize)> = Vec::new();
-    let mut near = 0usize;
-    let (mut worst_tip, mut worst_axis) = (0.0f64, 0.0f64);
-    loop {
-        let sample = reference.current();
-        let pose = TableTiltingAc::default().forward(&sample.joints);
-        let (mut best, mut best_off) = (near, (f64::INFINITY, 0.0));
-        let (mut k, mut ahead) = (near.saturating_sub(20), 0.0);
-        while k < pieces.len() && (ahead < 5.0 || k <= near + 2) {
-            let o = off(&pieces[k], &pose);
-            // On a tie the later piece: a move that retraces the one before (out of a
-            // hole) is matched to the move it is on.
-            if o.0 < best_off.0 || (o.0 == best_off.0 && k > near) {
-                (best, best_off) = (k, o);
-            }
-            // How far past the last match the pieces seen reach.
-            if k > near {
-                ahead += geometry::dist(&pieces[k].from.tip, &pieces[k].to.tip)
-                    + 1e-3 * geometry::angle_between(&pieces[k].from.axis, &pieces[k].to.axis);
-            }
-            k += 1;
-        }
-        near = best;
-        worst_tip = worst_tip.max(best_off.0);
-        worst_axis = worst_axis.max(best_off.1);
-        samples.push((pose, sample.joints.into(), best));
-        if sample.done {
-            break;
-        }
-        reference.step().unwrap();
-    }
-    assert_eq!(
-        near,
-        pieces.len() - 1,
-        "the reference ends on the last piece"
-    );
-    Followed {
-        samples,
-        tip: worst_tip,
-        axis: worst_axis,
-    }
-}
-
-/// Asserts every joint within its travel, speed and acceleration on every sample; the
-/// peak speed of each joint as a share of its limit.
-fn joints_within(samples: &[(Pose, [f64; 5], usize)], joints: &JointLimits) -> [f64; 5] {
-    let mut peak_joint = [0.0f64; 5];
-    for k in 2..samples.len() {
-        let q = |j: usize| samples[j].1;
-        for (i, peak) in peak_joint.iter_mut().enumerate() {
-            let v = (q(k)[i] - q(k - 1)[i]) / TS;
-            let a = (q(k)[i] - 2.0 * q(k - 1)[i] + q(k - 2)[i]) / (TS * TS);
-            *peak = peak.max(v.abs() / joints.velocity[i]);
-            assert!(
-                v.abs() <= joints.velocity[i] * (1.0 + 1e-6) + 1e-6,
-                "joint {i} at {v}/s, sample {k}"
-            );
-            assert!(
-                a.abs() <= joints.acceleration[i] * (1.0 + 1e-5) + 1e-2,
-                "joint {i} at {a}/s², sample {k}"
-            );
-            assert!(q(k)[i] >= joints.min[i] && q(k)[i] <= joints.max[i]);
-        }
-    }
-    peak_joint.map(|p| (p * 1000.0).round() / 1000.0)
-}
-
 #[test]
 fn the_nx_multi_operation_file_is_read_with_one_warning_per_kind() {
     let text = cam_examples::nx_multi_operation_cls();
@@ -299,21 +156,7 @@ fn the_multi_operation_file_is_planned_within_its_speeds_the_limits_and_the_tole
     // The joints within their limits; the tip no faster than the move it is on, where
     // every sample within the jerk filter's reach is on moves of that speed.
     let peak_joint = joints_within(&samples, &joints);
-    let mut fastest = std::collections::BTreeMap::<u64, f64>::new();
-    let reach = 40;
-    for k in 2..samples.len() {
-        let speed = geometry::dist(&samples[k].0.tip, &samples[k - 1].0.tip) / TS;
-        let feed = pieces[samples[k].2].feed;
-        let window = k.saturating_sub(reach)..(k + reach).min(samples.len());
-        if window.clone().all(|j| pieces[samples[j].2].feed == feed) {
-            assert!(
-                speed <= feed * (1.0 + 1e-6),
-                "sample {k}: {speed} mm/s on a move at {feed}"
-            );
-            let top = fastest.entry((feed * 1e6) as u64).or_insert(0.0);
-            *top = top.max(speed);
-        }
-    }
+    let fastest = speeds_within(&samples, &pieces);
     // Each speed of the file is reached somewhere: the file's FEDRATs, not the `feed`
     // parameter, and the rapids at `rapid`.
     let feeds: std::collections::BTreeSet<u64> =
@@ -346,21 +189,6 @@ fn the_multi_operation_file_is_planned_within_its_speeds_the_limits_and_the_tole
     );
 }
 
-/// The reader's poses as straight pieces with their speeds.
-fn pieces_of(program: &PartProgram) -> Vec<Piece> {
-    let poses = program.poses();
-    let feeds = program_feeds(program, FEED, RAPID);
-    poses
-        .windows(2)
-        .enumerate()
-        .map(|(i, w)| Piece {
-            from: w[0],
-            to: w[1],
-            feed: feed_of_move(&feeds, FEED, i + 1),
-        })
-        .collect()
-}
-
 /// The public CL files of `tests/data/cl` (their sources and licences in its README),
 /// each read and planned as the interpolator does, every sample within the tolerances of
 /// the reader's poses and the joints within their limits; the issue's table printed
@@ -368,44 +196,14 @@ fn pieces_of(program: &PartProgram) -> Vec<Piece> {
 /// is a row of the table with its reason, not a failure.
 #[test]
 fn public_cl_files_are_read_and_planned() {
-    let survey = std::env::var_os("CL_FILES").map(std::path::PathBuf::from);
-    let dir = survey.clone().unwrap_or_else(|| {
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/cl")
-    });
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x != "md"))
-        .collect();
-    files.sort();
-    assert!(survey.is_some() || !files.is_empty(), "{files:?}");
-    println!(
-        "| file | poses | warnings | planning | duration | tip | axis | peak joint speeds (X Y Z A C) |"
-    );
     // The files of tests/data/cl the reader refuses, and why (its README).
     let refused = [
         ("bohren_1.ncl", "16: CYCLE/DEEP"),
         ("PrepaFlans_Pointage.aptsource", "36: CYCLE/DRILL"),
         ("RotateThin.apt", "20: CUTCOM"),
     ];
-    for file in files {
-        let name = file.file_name().unwrap().to_string_lossy().to_string();
-        let expected = refused
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, why)| *why);
-        match (read_and_plan(&file, &name), expected) {
-            (Ok(row), None) => println!("{row}"),
-            (Err(why), _) if survey.is_some() => {
-                println!("| {name} | refused: {why} | | | | | | |")
-            }
-            (Err(why), Some(reason)) if why.contains(reason) => {
-                println!("| {name} | refused: {why} | | | | | | |")
-            }
-            (Ok(_), Some(reason)) => panic!("{name}: read, expected refused for {reason}"),
-            (Err(why), _) => panic!("{name}: {why}"),
-        }
-    }
+    let not_readme = |p: &std::path::Path| p.extension().is_some_and(|x| x != "md");
+    survey("CL_FILES", "cl", not_readme, &refused, read_and_plan);
 }
 
 /// One CL file read and planned at the interpolator's defaults: its row of the table, or
@@ -414,48 +212,6 @@ fn read_and_plan(file: &std::path::Path, name: &str) -> Result<String, String> {
     let start = Instant::now();
     let program = load_cl(file).map_err(|e| e.to_string())?;
     plan_and_follow(&program, name, start)
-}
-
-/// `program` planned at the interpolator's defaults (`start`: when its reading began)
-/// and followed: every sample within the tolerances of the reader's poses, the joints
-/// within their limits, the duration no shorter than every move at its speed; the row of
-/// the table.
-fn plan_and_follow(program: &PartProgram, name: &str, start: Instant) -> Result<String, String> {
-    let limits = PathLimits::at_feed(FEED);
-    let mut reference = planned(program, name, limits)?;
-    let seconds = start.elapsed().as_secs_f64();
-    let pieces = pieces_of(program);
-    let followed = follow(&pieces, &mut reference);
-    assert!(
-        followed.tip <= limits.tolerance * (1.0 + 1e-6),
-        "{name}: tip {} mm",
-        followed.tip
-    );
-    assert!(
-        followed.axis <= limits.orientation_tolerance * (1.0 + 1e-6),
-        "{name}: axis {} rad",
-        followed.axis
-    );
-    let peaks = joints_within(&followed.samples, &JointLimits::default());
-    let duration = reference.planned_duration().unwrap();
-    let lower: f64 = pieces
-        .iter()
-        .map(|p| geometry::dist(&p.from.tip, &p.to.tip) / p.feed)
-        .sum();
-    assert!(duration >= lower, "{name}: {duration} s against {lower} s");
-    let kinds: Vec<String> = program
-        .warnings
-        .iter()
-        .map(|w| w.message.split(' ').next().unwrap_or("").to_string())
-        .collect();
-    Ok(format!(
-        "| {name} | {} | {} | {seconds:.2} s | {duration:.1} s (≥ {lower:.1} s) | {:.2e} mm | \
-         {:.2e} rad | {peaks:?} |",
-        program.poses().len(),
-        kinds.join(", "),
-        followed.tip,
-        followed.axis,
-    ))
 }
 
 /// The near-vertical pass as NX writes it (inch, `MSYS`, `FEDRAT/IPM`; the axis 0.3°–2.05°

@@ -23,6 +23,7 @@ use contour_core::contour::five_axis::run_evaluation::{
 };
 use contour_core::geometry::{self, Vector};
 use contour_core::kinematics::{Joints, Pose, TableTiltingAc};
+use contour_core::part_program::cutter_compensation::ToolTable;
 use contour_core::part_program::gcode::GcodeOptions;
 
 use measured::{Kind, Samples};
@@ -40,13 +41,14 @@ mod reference;
 mod staged;
 
 const USAGE: &str = "\
-usage: contour-eval --path PART.cl|PART.apt|PART.json|tilted_helix|figure_eight
+usage: contour-eval --path PART.cl|PART.apt|PART.ngc|PART.json|tilted_helix|figure_eight
                     --measured RUN.csv --out ERR.csv [--out-reference REF.csv]
                     [--plot ERR.png] [--tool-length 100] [--pivot-a Y,Z] [--pivot-c X,Y]
                     [--max-skip K] [--angle-weight 0.1] [--window W]
-                    [--reference straight|smooth]
+                    [--reference straight|smooth] [--tool-radii D:R,...]
        contour-eval --path PART.ngc|NURBS.json|line|arc|circle|infinity|trident
                     --measured RUN.csv --out ERR.csv [--tolerance P] [--home X,Y,Z]
+                    [--tool-radii D:R,...] [--against compensated|programmed]
                     [--plot ERR.png]
        contour-eval --circle CX,CY,R --measured RUN.csv [--reverse RUN.csv]
                     [--from T0] [--to T1] [--out DEV.csv] [--plot BALLBAR.png]
@@ -88,7 +90,13 @@ along the path so that a pass that comes back near itself is not confused.
                program's own G64 P corners are blended
   --home       X,Y,Z, mm: the machine's home in the program's coordinates, where its
                G28/G30 go and what G53 counts from (PathInterpolator2D's 'home.*');
-               default 0,0,0
+               default 0,0,0; also for a G-code program on five axes
+  --tool-radii D:R pairs, mm: the tools' radii for a program's cutter radius
+               compensation (G41/G42 D), as the FMUs' 'toolRadii'; also for five axes
+  --against    compensated (default): the errors against the tool centre's path, the
+               compensation applied, as the interpolator follows it; programmed: the
+               part's edge against the programmed contour (the signed distance less each
+               move's offset: 0 where the tool centre runs its radius off the contour)
 
 Circular test (ISO 230-4) of XY runs around the nominal circle CX,CY,R (mm): the
 least-squares circle, the circular deviation G, the radial deviation F (min, max) of each
@@ -129,6 +137,10 @@ struct Options {
     tolerance: Option<f64>,
     /// --home as given (XY runs only).
     home: Option<Vector<3>>,
+    /// --tool-radii: a G-code program's tools for cutter radius compensation.
+    tools: ToolTable,
+    /// --against programmed: the part's edge against the programmed contour.
+    against_programmed: bool,
     /// The five-axis-only options given, in order.
     five_axis_only: Vec<String>,
 }
@@ -186,6 +198,8 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
         window: None,
         tolerance: None,
         home: None,
+        tools: ToolTable::default(),
+        against_programmed: false,
         five_axis_only: Vec::new(),
     };
     let mut it = args.iter();
@@ -213,6 +227,20 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
             "--path" => path = Some(value.clone()),
             "--tolerance" => o.tolerance = Some(number("--tolerance")?),
             "--home" => o.home = Some(triple(value, "--home")?),
+            "--tool-radii" => {
+                o.tools = ToolTable::parse(value).map_err(|e| format!("--tool-radii: {e}"))?
+            }
+            "--against" => {
+                o.against_programmed = match value.as_str() {
+                    "compensated" => false,
+                    "programmed" => true,
+                    other => {
+                        return Err(format!(
+                            "--against must be compensated or programmed, got '{other}'"
+                        ))
+                    }
+                }
+            }
             "--measured" => measured = Some(PathBuf::from(value)),
             "--out" => out = Some(PathBuf::from(value)),
             "--out-reference" => o.out_reference = Some(PathBuf::from(value)),
@@ -303,11 +331,7 @@ fn run(o: Options) -> Result<(), Failure> {
     // Options of the other kind are a mistake, not something to ignore.
     let other = match kind {
         Kind::Planar => o.five_axis_only.first().cloned(),
-        Kind::FiveAxis => o
-            .tolerance
-            .map(|_| "--tolerance")
-            .or(o.home.map(|_| "--home"))
-            .map(str::to_string),
+        Kind::FiveAxis => o.tolerance.map(|_| "--tolerance".to_string()),
     };
     if let Some(flag) = other {
         return Err(Failure::Input(format!(
@@ -317,16 +341,19 @@ fn run(o: Options) -> Result<(), Failure> {
     }
     let gcode = GcodeOptions {
         home: o.home.unwrap_or_else(Vector::<3>::zeros),
+        tools: o.tools.clone(),
         ..GcodeOptions::default()
     };
-    let reference = reference::load(&o.path, kind, &name, &gcode).map_err(Failure::Input)?;
+    let reference = reference::load(&o.path, kind, &name, &gcode, o.against_programmed)
+        .map_err(Failure::Input)?;
     match (reference, measured.samples) {
-        (Reference::Planar(path), Samples::Planar(points)) => {
+        (Reference::Planar(path, offsets), Samples::Planar(points)) => {
             let options = PlanarOptions {
                 spec: o.path.clone(),
                 out: o.out.clone(),
                 plot: o.plot.clone(),
                 tolerance: o.tolerance.unwrap_or(0.0),
+                offsets,
             };
             planar_run::run(&options, path, &measured.times, &points, started)
         }

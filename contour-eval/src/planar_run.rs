@@ -21,6 +21,9 @@ pub struct PlanarOptions {
     pub plot: Option<PathBuf>,
     /// The blend tolerance of bare G64 and of the start, mm (0: none).
     pub tolerance: f64,
+    /// With `--against programmed`: each programmed move's offset, subtracted from the
+    /// signed errors of the samples whose foot is on it (the part's edge).
+    pub offsets: Option<Vec<f64>>,
 }
 
 fn write_errors(staged: &Staged, times: &[f64], samples: &[PlanarSample]) -> std::io::Result<()> {
@@ -84,7 +87,14 @@ pub fn run(
         );
     }
     let geometry = Geometry::new(path, o.tolerance).map_err(Failure::Input)?;
-    let samples = evaluate(&geometry, points);
+    let mut samples = evaluate(&geometry, points);
+    if let Some(offsets) = &o.offsets {
+        for s in &mut samples {
+            let offset = offsets.get(s.segment).copied().unwrap_or(0.0);
+            s.contour -= offset;
+            s.planned -= offset;
+        }
+    }
 
     let mut staged = vec![Staged::new(&o.out)];
     let mut written = write_errors(&staged[0], times, &samples)
@@ -103,7 +113,11 @@ pub fn run(
     println!(
         "{}",
         summary_line(
-            "contour error (programmed)",
+            if o.offsets.is_some() {
+                "part edge error (programmed contour, less each move's offset)"
+            } else {
+                "contour error (programmed)"
+            },
             &programmed,
             &place(&geometry, times, &samples, programmed.at)
         )

@@ -1,14 +1,17 @@
 //! What `--path` names, read for the kind of run the measured columns say it is: a path
 //! of the XY table (a G-code program, a NURBS JSON file, a built-in of
-//! [`builtin::NAMES`]) or a five-axis reference (a CL file, a two-curve JSON file, a
-//! built-in of [`BUILTIN_TOOL_PATHS`]). A built-in name in both lists is read as the
-//! columns say; a path of the other kind is refused, naming both.
+//! [`builtin::NAMES`]) or a five-axis reference (a CL file, a G-code program, a two-curve
+//! JSON file, a built-in of [`BUILTIN_TOOL_PATHS`]). A built-in name in both lists is read
+//! as the columns say; a path of the other kind is refused, naming both. A G-code
+//! program's reference is the tool centre's path (cutter radius compensation applied), or
+//! with `--against programmed` (XY runs) the programmed contour with the offset of each
+//! move, so that the part's edge is evaluated.
 
 use contour_core::kinematics::Pose;
-use contour_core::part_program::gcode::GcodeOptions;
-use contour_core::part_program::{self, FileKind};
-use contour_core::path::five_axis::{load_poses, ToolPath, BUILTIN_TOOL_PATHS};
-use contour_core::path::planar::{builtin, Path};
+use contour_core::part_program::gcode::{load_gcode, GcodeOptions};
+use contour_core::part_program::{self, FileKind, Side};
+use contour_core::path::five_axis::{load_poses_with, ToolPath, BUILTIN_TOOL_PATHS};
+use contour_core::path::planar::{builtin, Path, Program};
 
 use crate::measured::Kind;
 
@@ -17,7 +20,9 @@ const JSON_CHORD: f64 = 0.01;
 
 /// A reference of the run's kind.
 pub enum Reference {
-    Planar(Path),
+    /// The path, and with `--against programmed` each programmed move's offset (mm,
+    /// signed as the contour error: > 0 the tool right of travel, G42).
+    Planar(Path, Option<Vec<f64>>),
     /// The poses and the CL reader's warnings.
     FiveAxis(Vec<Pose>, Vec<String>),
 }
@@ -39,8 +44,7 @@ fn builtin_kind(spec: &str, columns: Kind, planar: &[&str], five_axis: &[&str]) 
 fn file_kind(spec: &str) -> Option<Kind> {
     match part_program::file_kind(std::path::Path::new(spec))? {
         FileKind::ClData => Some(Kind::FiveAxis),
-        FileKind::GCode => Some(Kind::Planar),
-        FileKind::Json => None,
+        FileKind::GCode | FileKind::Json => None,
     }
 }
 
@@ -67,20 +71,43 @@ fn planar(spec: &str, gcode: &GcodeOptions) -> Result<Path, String> {
     Path::from_spec_with(spec, None, gcode).map_err(|e| e.to_string())
 }
 
-fn five_axis(spec: &str) -> Result<Reference, String> {
-    load_poses(spec, JSON_CHORD)
+/// A G-code program's programmed contour (compensation not applied) and each of its
+/// moves' offset: the part's edge, which the tool centre should run the offset from.
+pub fn programmed_contour(spec: &str, gcode: &GcodeOptions) -> Result<(Path, Vec<f64>), String> {
+    let mut part = load_gcode(spec, gcode).map_err(|e| e.to_string())?;
+    let mut by_line = std::collections::BTreeMap::new();
+    for m in &mut part.moves {
+        let offset = m.compensation.take().map_or(0.0, |c| match c.side {
+            Side::Left => -c.radius,
+            Side::Right => c.radius,
+        });
+        by_line.entry(m.place.line).or_insert(offset);
+    }
+    let program = Program::from_part_program(&part).map_err(|e| e.to_string())?;
+    let offsets = program
+        .moves()
+        .iter()
+        .map(|m| by_line.get(&m.line).copied().unwrap_or(0.0))
+        .collect();
+    Ok((Path::Program(program), offsets))
+}
+
+fn five_axis(spec: &str, gcode: &GcodeOptions) -> Result<Reference, String> {
+    load_poses_with(spec, JSON_CHORD, gcode)
         .map(|(poses, warnings)| Reference::FiveAxis(poses, warnings))
         .map_err(|e| e.to_string())
 }
 
 /// The reference `spec` names, read for a run of `columns` (the file `measured`, named
-/// in messages; a G-code program read with `gcode`). Errors are the readers' own, or a
-/// mismatch naming both kinds.
+/// in messages; a G-code program read with `gcode`; `programmed`: an XY run's program
+/// as programmed, with its offsets). Errors are the readers' own, or a mismatch naming
+/// both kinds.
 pub fn load(
     spec: &str,
     columns: Kind,
     measured: &str,
     gcode: &GcodeOptions,
+    programmed: bool,
 ) -> Result<Reference, String> {
     let by_name = builtin_kind(spec, columns, &builtin::NAMES, &BUILTIN_TOOL_PATHS);
     if let Some(kind) = by_name.or_else(|| file_kind(spec)) {
@@ -90,15 +117,28 @@ pub fn load(
     }
     // A JSON file the run's kind cannot read may be one of the other kind.
     let json = part_program::file_kind(std::path::Path::new(spec)) == Some(FileKind::Json);
+    let is_gcode = part_program::file_kind(std::path::Path::new(spec)) == Some(FileKind::GCode);
+    if programmed {
+        if !(is_gcode && columns == Kind::Planar) {
+            return Err(format!(
+                "--against programmed applies to a G-code program and a run of the XY table, \
+                 not --path {spec} with {measured}"
+            ));
+        }
+        let (path, offsets) = programmed_contour(spec, gcode)?;
+        return Ok(Reference::Planar(path, Some(offsets)));
+    }
     match columns {
-        Kind::Planar => planar(spec, gcode).map(Reference::Planar).map_err(|e| {
-            if json && ToolPath::load(spec).is_ok() {
-                mismatch(spec, Kind::FiveAxis, measured, columns)
-            } else {
-                e
-            }
-        }),
-        Kind::FiveAxis => five_axis(spec).map_err(|e| {
+        Kind::Planar => planar(spec, gcode)
+            .map(|p| Reference::Planar(p, None))
+            .map_err(|e| {
+                if json && ToolPath::load(spec).is_ok() {
+                    mismatch(spec, Kind::FiveAxis, measured, columns)
+                } else {
+                    e
+                }
+            }),
+        Kind::FiveAxis => five_axis(spec, gcode).map_err(|e| {
             if json && planar(spec, gcode).is_ok() {
                 mismatch(spec, Kind::Planar, measured, columns)
             } else {
@@ -143,8 +183,9 @@ mod tests {
 
     #[test]
     fn file_endings_say_the_kind() {
-        assert_eq!(file_kind("a/part.NGC"), Some(Kind::Planar));
-        assert_eq!(file_kind("part.tap"), Some(Kind::Planar));
+        // G-code runs on either machine, as a JSON file is read by either.
+        assert_eq!(file_kind("a/part.NGC"), None);
+        assert_eq!(file_kind("part.tap"), None);
         assert_eq!(file_kind("blade.cl"), Some(Kind::FiveAxis));
         assert_eq!(file_kind("blade.APT"), Some(Kind::FiveAxis));
         assert_eq!(file_kind("curve.json"), None);

@@ -601,11 +601,12 @@ fn the_columns_decide_the_kind_of_run_and_a_path_of_the_other_kind_is_refused() 
             ],
         );
     }
+    // The part's edge is measured on the XY table only.
     check(
         s(&part),
         &five,
-        &[],
-        &["part.ngc is a path of the XY table", five_cols],
+        &["--against", "programmed"],
+        &["--against programmed applies to a G-code program and a run of the XY table"],
     );
     check(
         s(&nurbs),
@@ -659,6 +660,7 @@ fn the_columns_decide_the_kind_of_run_and_a_path_of_the_other_kind_is_refused() 
     for (path, run) in [
         ("circle", &xy),
         (s(&part), &xy),
+        (s(&part), &five),
         (s(&nurbs), &xy),
         ("tilted_helix", &five),
     ] {
@@ -689,7 +691,7 @@ fn bad_xy_inputs_fail_naming_file_and_line_and_write_nothing() {
     let short = write("short.csv", "time,X,Y\n0,0,0\n0.001,0\n");
     let empty = write("empty.csv", "");
     let header = write("header.csv", "time,X,Y\n");
-    let g18 = write("g18.ngc", "G1 X10 F600\nG18\nG1 X20\n");
+    let g18 = write("g18.ngc", "G1 X10 F600\nG18 G2 X20 Z0 I5 K0\n");
     let arc = write("arc.ngc", "G1 X10 F600\nG2 X20 Y0 I1 J0\n");
     let out = dir.join("out.csv");
     let plot = dir.join("out.png");
@@ -822,5 +824,60 @@ fn a_home_return_is_measured_against_the_home_that_is_given() {
         "{}",
         last.contour
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_compensated_program_is_measured_against_the_tool_centre_or_the_part_edge() {
+    // Under G41 D1 (r 2) the tool centre runs 2 mm left of X0→X20 (y = 2, from the
+    // convex corner's arc about (0, 0)) and of X20→Y10 (x = 18, the concave corner cut at
+    // (18, 2)). The measured tool runs 0.01 mm further left: against the tool centre's
+    // path and against the programmed contour less the offset, −0.01 mm either way.
+    let dir = scratch("compensation");
+    let part = dir.join("comp.ngc");
+    std::fs::write(
+        &part,
+        "G0 X0 Y-10\nG41 D1 G1 X0 Y0 F600\nG1 X20\nG1 Y10\nG40 G1 X30 Y10\n",
+    )
+    .unwrap();
+    let mut points: Vec<P2> = (10..=170).map(|k| [0.1 * k as f64, 2.01]).collect();
+    points.extend((30..=90).map(|k| [17.99, 0.1 * k as f64]));
+    for against in ["compensated", "programmed"] {
+        let (rows, stdout) = evaluate(
+            &dir,
+            s(&part),
+            &points,
+            &["--tool-radii", "1:2", "--against", against],
+        );
+        for (k, row) in rows.iter().enumerate() {
+            assert!(
+                (row.contour + 0.01).abs() < 1e-9,
+                "{against} {k}: {}",
+                row.contour
+            );
+        }
+        assert_eq!(
+            stdout.contains("part edge error"),
+            against == "programmed",
+            "{stdout}"
+        );
+    }
+    // Against the programmed contour without the offsets the tool is 2.01 mm off.
+    let (plain, _) = evaluate(&dir, s(&part), &points, &["--tool-radii", "1:0"]);
+    assert!(plain.iter().all(|r| (r.contour + 0.01 - 0.0).abs() > 1.9));
+    // D1 must be in the table; --against takes one of two words.
+    let out = dir.join("out.csv");
+    let run = dir.join("run.csv");
+    for (extra, expected) in [
+        (vec![], ["comp.ngc:2", "D1 is not in the tool table"]),
+        (
+            vec!["--against", "edge"],
+            ["--against must be compensated", "or programmed"],
+        ),
+    ] {
+        let mut args = vec!["--path", s(&part), "--measured", s(&run), "--out", s(&out)];
+        args.extend(extra);
+        refused(&args, &expected);
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

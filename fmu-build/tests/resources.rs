@@ -136,7 +136,7 @@ fn bad_resource_requests_are_refused_with_a_clear_message() {
     let e = Resource::new("PathInterpolator2D", &broken).unwrap_err();
     assert!(e.contains("broken.json:3:"), "{e}");
     let program = dir.join("part.NGC");
-    std::fs::write(&program, "G21\nG1 X10 F600\nG18\n").unwrap();
+    std::fs::write(&program, "G21\nG1 X10 F600\nG18 G2 X0 Z10 I-5 K5\n").unwrap();
     let e = Resource::new("PathInterpolator2D", &program).unwrap_err();
     assert!(e.contains("part.NGC:3:1: G18 arcs are in a plane"), "{e}");
     std::fs::write(&program, "G21\nG1 X10 F600\nG2 X0 R5\n").unwrap();

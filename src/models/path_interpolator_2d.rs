@@ -81,6 +81,7 @@ variable_table! {
     DIALECT: Int = path_parameter::DIALECT;
     OPTIONAL_STOP: Bool = path_parameter::OPTIONAL_STOP;
     HOME: Reals<3> = path_parameter::HOME;
+    TOOL_RADII: Str = path_parameter::TOOL_RADII;
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -175,6 +176,7 @@ const READER: path_parameter::ReaderParameters = path_parameter::ReaderParameter
     dialect: DIALECT,
     optional_stop: OPTIONAL_STOP,
     home: HOME,
+    tools: TOOL_RADII,
 };
 
 /// The reference the parameters choose.

@@ -10,17 +10,18 @@
 use std::path::Path;
 
 use super::axis_variables::{REFERENCE_ACCELERATION_OUT, REFERENCE_OUT, REFERENCE_VELOCITY_OUT};
-use super::{joint_limits_parameters, kinematics_parameters};
+use super::{joint_limits_parameters, kinematics_parameters, path_parameter};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
 use crate::framework::saved_state::{RestoredState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, XYZAC};
 use crate::framework::variables::{Start, Values, Variable};
 use contour_core::limits::PathLimits;
-use contour_core::part_program::{cl_data, file_kind, FileKind};
+use contour_core::part_program::gcode::GcodeOptions;
+use contour_core::part_program::{file_kind, FileKind};
 use contour_core::path::five_axis::{
-    program_feeds, FeedChange, FiveAxisInputs, FiveAxisReference, SavedFiveAxisReference, ToolPath,
-    BUILTIN_TOOL_PATHS,
+    load_program, program_feeds, FeedChange, FiveAxisInputs, FiveAxisReference,
+    SavedFiveAxisReference, ToolPath, BUILTIN_TOOL_PATHS,
 };
 
 variable_table! {
@@ -35,9 +36,10 @@ variable_table! {
         "path",
         Start::String("tilted_helix"),
         "tilted_helix or figure_eight (built-in), or a file: APT CL data (.cl, .apt, NX .cls, \
-         CATIA .aptsource, Creo .ncl: GOTO/x,y,z,i,j,k records) or a two-curve JSON file \
-         (.json); absolute, or relative \
-         to the FMU's resources folder, which holds the example CL part blade.cl",
+         CATIA .aptsource, Creo .ncl: GOTO/x,y,z,i,j,k records), a three-axis G-code program \
+         (.ngc, .nc, .gcode, .tap; the tool axis vertical) or a two-curve JSON file (.json); \
+         absolute, or relative to the FMU's resources folder, which holds the example CL part \
+         blade.cl",
     );
     FEED: Real = Variable::parameter(
         "feed",
@@ -115,7 +117,19 @@ variable_table! {
         "Tool-tip speed of a CL file's RAPID moves with a plan (> 0)",
     )
     .unit("mm/s");
+    DIALECT: Int = path_parameter::DIALECT;
+    OPTIONAL_STOP: Bool = path_parameter::OPTIONAL_STOP;
+    HOME: Reals<3> = path_parameter::HOME;
+    TOOL_RADII: Str = path_parameter::TOOL_RADII;
 }
+
+/// The G-code reader's parameters.
+const READER: path_parameter::ReaderParameters = path_parameter::ReaderParameters {
+    dialect: DIALECT,
+    optional_stop: OPTIONAL_STOP,
+    home: HOME,
+    tools: TOOL_RADII,
+};
 
 pub static INFO: ModelInfo = ModelInfo {
     identifier: "PathInterpolator5X",
@@ -287,11 +301,12 @@ struct Programmed {
     warnings: Vec<String>,
 }
 
-/// `speeds`: the `feed` and `rapid` parameters, a CL file's speeds before its first
-/// `FEDRAT` and at `RAPID`.
+/// `speeds`: the `feed` and `rapid` parameters, a part program's speeds before its first
+/// feed word and at its rapids; G-code is read with `options`.
 fn programmed(
     spec: &str,
     speeds: (f64, f64),
+    options: &GcodeOptions,
     environment: &Environment,
 ) -> Result<Programmed, String> {
     let spec = spec.trim();
@@ -316,9 +331,9 @@ fn programmed(
         let h = super::path_parameter::resource_hint(spec, environment, &e);
         e + h
     };
-    if file_kind(file) == Some(FileKind::ClData) {
-        // Read here rather than through ToolPath::load: the plan names CL lines.
-        let program = cl_data::load_cl(&full).map_err(|e| hint(message(e)))?;
+    if matches!(file_kind(file), Some(FileKind::ClData | FileKind::GCode)) {
+        // Read here rather than through ToolPath::load: the plan names the program's lines.
+        let program = load_program(&full, options).map_err(|e| hint(message(e)))?;
         let path = ToolPath::from_poses(&program.poses()).map_err(message)?;
         return Ok(Programmed {
             path,
@@ -361,7 +376,8 @@ impl Model for PathInterpolator5X {
         if rapid <= 0.0 {
             return Err(format!("parameter 'rapid' must be > 0 (got {rapid})"));
         }
-        let programmed = programmed(PATH.get(values), (feed, rapid), &self.environment)?;
+        let options = READER.options(values)?;
+        let programmed = programmed(PATH.get(values), (feed, rapid), &options, &self.environment)?;
         let unplanned_speeds = limits.accel == 0.0 && !programmed.feeds.is_empty();
         let lines = &programmed.lines;
         let name = |i: usize| match lines {

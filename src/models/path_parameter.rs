@@ -4,9 +4,10 @@
 
 use super::line_arc_parameters;
 use crate::framework::model::Environment;
-use crate::framework::variable_table::{Bool, Int, Reals};
+use crate::framework::variable_table::{Bool, Int, Reals, Str};
 use crate::framework::variables::{EnumItem, EnumType, Start, Values, Variable};
 use contour_core::geometry::Vector;
+use contour_core::part_program::cutter_compensation::ToolTable;
 use contour_core::part_program::gcode::{Dialect, GcodeOptions};
 use contour_core::path::planar::Path;
 
@@ -84,12 +85,22 @@ const fn home(name: &'static str) -> Variable {
     .unit("mm")
 }
 
+/// The `toolRadii` parameter, the same in every model that reads G-code.
+pub const TOOL_RADII: Variable = Variable::parameter(
+    "toolRadii",
+    Start::String(""),
+    "The tools' radii in mm by D number for cutter radius compensation (G41, G42): D:radius \
+     pairs, e.g. '1:3, 2:5.5' (a negative radius puts the tool on the other side); G41.1 and \
+     G42.1 give the diameter in their D word",
+);
+
 /// A model's handles of the G-code reader's parameters.
 #[derive(Clone, Copy)]
 pub struct ReaderParameters {
     pub dialect: Int,
     pub optional_stop: Bool,
     pub home: Reals<3>,
+    pub tools: Str,
 }
 
 impl ReaderParameters {
@@ -113,10 +124,13 @@ impl ReaderParameters {
                 HOME_NAMES[bad], home[bad]
             ));
         }
+        let tools = ToolTable::parse(self.tools.get(values))
+            .map_err(|e| format!("parameter 'toolRadii': {e}"))?;
         Ok(GcodeOptions {
             dialect,
             optional_stop: self.optional_stop.get(values),
             home: Vector::<3>::new(home[0], home[1], home[2]),
+            tools,
         })
     }
 }

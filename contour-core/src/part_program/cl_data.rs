@@ -663,6 +663,7 @@ impl<'a> Reader<'a> {
             corner: Corner::BlendDefault,
             place: Place { line, column: 0 },
             z_place: None,
+            compensation: None,
         });
         self.tip = tip;
     }

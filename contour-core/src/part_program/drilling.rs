@@ -1,4 +1,4 @@
-//! The drilling cycles of G-code (docs/design/two-axis.md §4.7), G73, G81–G83, G85 and
+//! The drilling cycles of G-code (docs/design/two-axis.md §4.7), G73, G74, G81–G85 and
 //! G89 in the XY plane, as LinuxCNC runs them: each hole is the moves the machine makes
 //! (rapid up to R if below it, rapid over the hole, rapid down to R, the cycle's feed
 //! moves in Z, a dwell, the retract at rapid to where Z began (G98) or to R (G99)), so a
@@ -30,6 +30,9 @@ pub enum CycleKind {
     Bore,
     /// G89: feed to the bottom, dwell P, feed back to R.
     BoreDwell,
+    /// G84 (G74 left-handed): tap, feeding to the bottom, dwelling P and feeding back to R
+    /// as the spindle reverses (which the axes do not see).
+    Tap,
 }
 
 impl CycleKind {
@@ -42,6 +45,7 @@ impl CycleKind {
             83 => CycleKind::Peck,
             85 => CycleKind::Bore,
             89 => CycleKind::BoreDwell,
+            74 | 84 => CycleKind::Tap,
             _ => return None,
         })
     }
@@ -193,14 +197,20 @@ impl Cycle {
             }
             (false, _) => hole.go(x, y, depth, StepSpeed::Feed),
         }
-        if matches!(self.kind, CycleKind::DrillDwell | CycleKind::BoreDwell) {
+        if matches!(
+            self.kind,
+            CycleKind::DrillDwell | CycleKind::BoreDwell | CycleKind::Tap
+        ) {
             hole.steps.push(Step {
                 motion: Motion::Dwell(self.dwell),
                 speed: StepSpeed::Rapid,
                 end: hole.tip,
             });
         }
-        if matches!(self.kind, CycleKind::Bore | CycleKind::BoreDwell) {
+        if matches!(
+            self.kind,
+            CycleKind::Bore | CycleKind::BoreDwell | CycleKind::Tap
+        ) {
             hole.go(x, y, r, StepSpeed::Feed);
         }
         let top = if retract_to_start {

@@ -12,8 +12,11 @@ use g_code::parse::ast::Spanned;
 use g_code::parse::snippet_parser;
 
 use super::arc_words::{self, Circle};
+use super::cutter_compensation::ToolTable;
 use super::drilling::{self, Cycle, CycleKind};
-use super::{Corner, Motion, PartMove, PartProgram, Place, Speed, Warning};
+use super::{
+    Compensation, Corner, Motion, PartMove, PartProgram, Place, Plane, Side, Speed, Warning,
+};
 use crate::geometry::{Vector, Vector2};
 use crate::path::nurbs_file::read_path_file;
 use crate::path::PathError;
@@ -30,7 +33,7 @@ pub enum Dialect {
 }
 
 /// How a program is read: what the file cannot say.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct GcodeOptions {
     /// The controller the program was written for.
     pub dialect: Dialect,
@@ -39,6 +42,8 @@ pub struct GcodeOptions {
     /// The machine's home (its reference point) in the program's coordinates, mm: where
     /// G28 and G30 go and what G53's machine coordinates count from.
     pub home: Vector<3>,
+    /// The tools' radii by D number, for cutter radius compensation (G41, G42).
+    pub tools: ToolTable,
 }
 
 impl Default for GcodeOptions {
@@ -47,6 +52,7 @@ impl Default for GcodeOptions {
             dialect: Dialect::LinuxCnc,
             optional_stop: false,
             home: Vector::<3>::zeros(),
+            tools: ToolTable::default(),
         }
     }
 }
@@ -66,7 +72,7 @@ pub fn parse_gcode(
     name: &str,
     options: &GcodeOptions,
 ) -> Result<PartProgram, PathError> {
-    let mut reader = Reader::new(name, *options);
+    let mut reader = Reader::new(name, options.clone());
     let blocks = reader.blocks(text)?;
     reader.decimals = blocks
         .iter()
@@ -169,6 +175,17 @@ struct Reader<'a> {
     origin: Vector<3>,
     /// G9 in the block: its move ends in an exact stop.
     stop_here: bool,
+    /// The plane of arcs and of cutter compensation (G17, G18, G19).
+    plane: Plane,
+    /// Cutter radius compensation (G41, G42) until G40.
+    compensation: Option<Compensation>,
+    /// The tool the last T word selected, and the one M6 loaded (G41 without D takes its
+    /// radius).
+    tool_selected: Option<f64>,
+    tool_loaded: Option<f64>,
+    /// The motion mode before a drilling cycle began: Fanuc's G80 returns to it (its
+    /// cycles are a modal group of their own), LinuxCNC's G80 leaves none.
+    before_cycle: Option<Mode>,
     moves: Vec<PartMove>,
     skipped: BTreeSet<String>,
     warnings: Vec<Warning>,
@@ -191,6 +208,11 @@ impl<'a> Reader<'a> {
             position: Vector::<3>::zeros(),
             origin: Vector::<3>::zeros(),
             stop_here: false,
+            plane: Plane::Xy,
+            compensation: None,
+            tool_selected: None,
+            tool_loaded: None,
+            before_cycle: None,
             moves: Vec::new(),
             skipped: BTreeSet::new(),
             warnings: Vec::new(),
@@ -333,7 +355,7 @@ impl<'a> Reader<'a> {
                 'M' => m_codes.push((code()?, w.column)),
                 // Block and program numbers.
                 'N' | 'O' => {}
-                'D' | 'A' | 'B' | 'C' | 'E' | 'V' | 'W' => {
+                'A' | 'B' | 'C' | 'E' | 'V' | 'W' => {
                     return Err(self.error(
                         line,
                         w.column,
@@ -359,6 +381,8 @@ impl<'a> Reader<'a> {
         let mut motion: Option<(Option<Mode>, usize)> = None;
         let mut one_block: Option<(OneBlock, usize)> = None;
         let mut corner_word: Option<(u32, usize)> = None;
+        let mut plane_word: Option<(Plane, usize)> = None;
+        let mut compensation_word: Option<(u32, usize)> = None;
         for &(code, column) in &g_codes {
             let set_motion = |motion: &mut Option<(Option<Mode>, usize)>, m: Option<Mode>| {
                 if motion.is_some() {
@@ -380,7 +404,7 @@ impl<'a> Reader<'a> {
                 20 => set_motion(&mut motion, Some(Mode::Clockwise))?,
                 30 => set_motion(&mut motion, Some(Mode::CounterClockwise))?,
                 800 => set_motion(&mut motion, None)?,
-                c @ (730 | 810 | 820 | 830 | 850 | 890) => {
+                c @ (730 | 740 | 810 | 820 | 830 | 840 | 850 | 890) => {
                     let kind = CycleKind::from_code(c / 10).expect("a cycle's code");
                     set_motion(&mut motion, Some(Mode::Drilling(kind)))?
                 }
@@ -391,19 +415,9 @@ impl<'a> Reader<'a> {
                 // G92.1, G92.2: the G92 offsets cleared (suspended: nothing restores them).
                 921 | 922 => self.origin = Vector::<3>::zeros(),
                 90 => self.stop_here = true,
-                170 => {}
-                180 | 190 => {
-                    return Err(self.error(
-                        line,
-                        column,
-                        format!(
-                            "G{} arcs are in a plane with the third axis, which the XY table \
-                             does not have: run the program on the five-axis machine \
-                             (PathInterpolator5X)",
-                            code / 10
-                        ),
-                    ))
-                }
+                170 => plane_word = Some((Plane::Xy, column)),
+                180 => plane_word = Some((Plane::Zx, column)),
+                190 => plane_word = Some((Plane::Yz, column)),
                 200 => self.scale = 25.4,
                 210 => self.scale = 1.0,
                 900 => self.absolute = true,
@@ -413,7 +427,20 @@ impl<'a> Reader<'a> {
                 980 => self.retract_to_start = true,
                 990 => self.retract_to_start = false,
                 c @ (610 | 611 | 640) => corner_word = Some((c, column)),
-                400 => self.skip("G40 (cutter compensation off)", line, column),
+                c @ (400 | 410 | 420 | 411 | 421) => {
+                    if compensation_word.is_some() {
+                        return Err(self.error(line, column, "two of G40, G41, G42 in one block"));
+                    }
+                    compensation_word = Some((c, column));
+                }
+                430 | 490 if self.compensation.is_some() => {
+                    return Err(self.error(
+                        line,
+                        column,
+                        "the tool length offset cannot change while cutter radius \
+                         compensation is on (G40 first)",
+                    ))
+                }
                 430 => {
                     self.skip(
                         "G43 H (tool length offset: the program gives the tip)",
@@ -433,14 +460,6 @@ impl<'a> Reader<'a> {
                     line,
                     column,
                 ),
-                410 | 420 => {
-                    return Err(self.error(
-                        line,
-                        column,
-                        "cutter radius compensation (G41, G42) is not supported: program the \
-                         tool centre",
-                    ))
-                }
                 _ => {
                     return Err(self.error(
                         line,
@@ -465,7 +484,20 @@ impl<'a> Reader<'a> {
                 }
                 20 | 300 => end = true,
                 30..=50 => self.skip("M3-M5 (spindle)", line, column),
-                60 => self.skip("M6 (tool change)", line, column),
+                60 if self.compensation.is_some() => {
+                    return Err(self.error(
+                        line,
+                        column,
+                        "no tool change while cutter radius compensation is on (G40 first)",
+                    ))
+                }
+                60 => {
+                    // The T of this block, or the one selected before.
+                    self.tool_loaded = letters.0[Letters::slot('T')]
+                        .map(|w| w.value)
+                        .or(self.tool_selected);
+                    self.skip("M6 (tool change)", line, column)
+                }
                 70..=90 => self.skip("M7-M9 (coolant)", line, column),
                 // Subprogram calls and returns, program repeats and the modal-state
                 // save and restore change which moves run or how they read.
@@ -500,6 +532,9 @@ impl<'a> Reader<'a> {
         }
         for (letter, kind) in [('S', "S (spindle speed)"), ('T', "T (tool number)")] {
             if let Some(w) = letters.take(letter) {
+                if letter == 'T' {
+                    self.tool_selected = Some(w.value);
+                }
                 self.skip(kind, line, w.column);
             }
         }
@@ -509,10 +544,40 @@ impl<'a> Reader<'a> {
         if let Some((c, _)) = corner_word {
             self.corner = self.corner_mode(c, &mut letters, line)?;
         }
+        if let Some((plane, column)) = plane_word {
+            if self.compensation.is_some() && plane != self.plane {
+                return Err(self.error(
+                    line,
+                    column,
+                    "the plane cannot change while cutter radius compensation is on (G40 first)",
+                ));
+            }
+            self.plane = plane;
+        }
+        if let Some((code, column)) = compensation_word {
+            self.compensation = self.compensation_mode(code, &mut letters, line, column)?;
+        }
         if let Some((m, _)) = motion {
-            self.motion = m;
-            if !matches!(m, Some(Mode::Drilling(_))) {
+            let drilling = |m: Option<Mode>| matches!(m, Some(Mode::Drilling(_)));
+            if drilling(m) && !drilling(self.motion) {
+                self.before_cycle = self.motion;
+            }
+            self.motion = match (m, self.options.dialect) {
+                (None, Dialect::Fanuc) if drilling(self.motion) => self.before_cycle,
+                _ => m,
+            };
+            if !drilling(m) {
                 self.cycle = None;
+            }
+        }
+        if let (Some(_), Some((code, column))) = (self.compensation, one_block) {
+            if code != OneBlock::Dwell {
+                return Err(self.error(
+                    line,
+                    column,
+                    "G28, G30, G53 and G92 are not allowed while cutter radius compensation is \
+                     on (G40 first)",
+                ));
             }
         }
         match one_block {
@@ -578,6 +643,74 @@ impl<'a> Reader<'a> {
         } else {
             Corner::Blend(p.value * self.scale)
         })
+    }
+
+    /// Cutter radius compensation after G40, G41, G42 (D: the tool's number in the tool
+    /// table) or G41.1, G42.1 (D: the tool's diameter); a negative radius puts the tool on
+    /// the other side (LinuxCNC's reading).
+    fn compensation_mode(
+        &mut self,
+        code: u32,
+        letters: &mut Letters,
+        line: usize,
+        column: usize,
+    ) -> Result<Option<Compensation>, PathError> {
+        if code == 400 {
+            if let Some(d) = letters.take('D') {
+                return Err(self.error(line, d.column, "G40 takes no D"));
+            }
+            return Ok(None);
+        }
+        if self.compensation.is_some() {
+            return Err(self.error(
+                line,
+                column,
+                "cutter radius compensation is already on: turn it off (G40) before G41 or G42",
+            ));
+        }
+        if self.plane == Plane::Yz {
+            return Err(self.error(
+                line,
+                column,
+                "cutter radius compensation is allowed only in the XY and XZ planes (G17, G18)",
+            ));
+        }
+        // G41.1 and G42.1: D is the diameter.
+        let diameter = matches!(code, 411 | 421);
+        let d =
+            match (letters.take('D'), self.tool_loaded) {
+                (Some(d), _) => d,
+                // LinuxCNC: without D, the loaded tool's radius.
+                (None, Some(tool)) if !diameter => Word {
+                    letter: 'D',
+                    value: tool,
+                    column,
+                    decimals: 0,
+                },
+                (None, _) => return Err(self.error(
+                    line,
+                    column,
+                    "G41 and G42 need D, the tool's number in the tool table, or a tool loaded \
+                     (T M6); G41.1 and G42.1 need D, its diameter",
+                )),
+            };
+        let radius = if diameter {
+            if !d.value.is_finite() {
+                return Err(self.error(line, d.column, "the tool's diameter D must be finite"));
+            }
+            0.5 * d.value * self.scale
+        } else {
+            self.options
+                .tools
+                .radius(d.value)
+                .map_err(|m| self.error(line, d.column, m))?
+        };
+        let left = (code / 10 == 41) == (radius >= 0.0);
+        Ok(Some(Compensation {
+            side: if left { Side::Left } else { Side::Right },
+            radius: radius.abs(),
+            plane: self.plane,
+        }))
     }
 
     /// G4: the tool stands for P (seconds in LinuxCNC, milliseconds in Fanuc) or for X or
@@ -745,7 +878,8 @@ impl<'a> Reader<'a> {
     ) -> Result<(), PathError> {
         let names_axes = ['X', 'Y', 'Z'].iter().any(|&l| letters.has(l));
         let motion_column = motion.map_or(1, |(_, c)| c);
-        let arc_centre = letters.has('I') || letters.has('J');
+        let [u, v, _] = self.plane.axes();
+        let arc_centre = letters.has(['I', 'J', 'K'][u]) || letters.has(['I', 'J', 'K'][v]);
         let Some(mode) = self.motion else {
             if let Some(column) = ['X', 'Y', 'Z'].iter().find_map(|&l| letters.column(l)) {
                 return Err(self.error(
@@ -779,14 +913,15 @@ impl<'a> Reader<'a> {
             _ => self.speed(),
         };
         let shape = if arc {
+            let plane = self.plane;
             let circle = self.circle(letters, line, motion_column)?;
-            let start = Vector2::new(self.position[0], self.position[1]);
-            let to = Vector2::new(end[0], end[1]);
+            let start = plane.in_plane(&self.position);
+            let to = plane.in_plane(&end);
             let resolution = 10f64.powi(-(self.decimals.max(MIN_DECIMALS) as i32)) * self.scale;
             let allowance = arc_words::allowance(self.scale != 1.0, resolution);
             let arc = arc_words::arc(start, to, circle, mode == Mode::Clockwise, allowance)
                 .map_err(|m| self.error(line, motion_column, m))?;
-            Motion::Arc(arc)
+            Motion::Arc { arc, plane }
         } else {
             if end == self.position {
                 return Ok(());
@@ -797,21 +932,28 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
-    /// The circle of a G2/G3 block: I and J (K must be 0: the XY plane's), or R; P, the
-    /// turns, must be 1.
+    /// The circle of a G2/G3 block in the plane: its two centre words (I and J in G17, K
+    /// and I in G18, J and K in G19; the third must be 0), or R; P, the turns, must be 1.
     fn circle(
         &self,
         letters: &mut Letters,
         line: usize,
         motion_column: usize,
     ) -> Result<Circle, PathError> {
-        if let Some(k) = letters.take('K') {
+        const CENTRE_WORDS: [char; 3] = ['I', 'J', 'K'];
+        let [u, v, w] = self.plane.axes();
+        if let Some(k) = letters.take(CENTRE_WORDS[w]) {
             if k.value != 0.0 {
                 return Err(self.error(
                     line,
                     k.column,
-                    "a G17 arc's K must be 0 (a helix needs the third axis: run the program \
-                     on the five-axis machine, PathInterpolator5X)",
+                    format!(
+                        "a {} arc's {} must be 0: the arc's centre is given by {} and {}",
+                        self.plane.code(),
+                        CENTRE_WORDS[w],
+                        CENTRE_WORDS[u],
+                        CENTRE_WORDS[v]
+                    ),
                 ));
             }
         }
@@ -824,14 +966,23 @@ impl<'a> Reader<'a> {
                 ));
             }
         }
-        let (i, j, r) = (letters.take('I'), letters.take('J'), letters.take('R'));
+        let (i, j, r) = (
+            letters.take(CENTRE_WORDS[u]),
+            letters.take(CENTRE_WORDS[v]),
+            letters.take('R'),
+        );
+        let pair = format!("{} and {}", CENTRE_WORDS[u], CENTRE_WORDS[v]);
         match (i, j, r) {
-            (None, None, None) => {
-                Err(self.error(line, motion_column, "an arc needs I and J, or R"))
-            }
-            (Some(w), _, Some(_)) | (_, Some(w), Some(_)) => {
-                Err(self.error(line, w.column, "an arc takes I and J, or R, not both"))
-            }
+            (None, None, None) => Err(self.error(
+                line,
+                motion_column,
+                format!("a {} arc needs {pair}, or R", self.plane.code()),
+            )),
+            (Some(w), _, Some(_)) | (_, Some(w), Some(_)) => Err(self.error(
+                line,
+                w.column,
+                format!("an arc takes {pair}, or R, not both"),
+            )),
             (None, None, Some(r)) => Ok(Circle::Radius(r.value * self.scale)),
             (i, j, None) => {
                 let offset = |w: Option<Word>, k: usize| -> Result<f64, PathError> {
@@ -842,11 +993,11 @@ impl<'a> Reader<'a> {
                         (None, true) => Err(self.error(
                             line,
                             motion_column,
-                            "with G90.1 an arc needs both I and J",
+                            format!("with G90.1 an arc needs both {pair}"),
                         )),
                     }
                 };
-                Ok(Circle::Centre(Vector2::new(offset(i, 0)?, offset(j, 1)?)))
+                Ok(Circle::Centre(Vector2::new(offset(i, u)?, offset(j, v)?)))
             }
         }
     }
@@ -866,6 +1017,24 @@ impl<'a> Reader<'a> {
                 line,
                 column,
                 "drilling cycles in incremental mode (G91) are not supported: write them in G90",
+            ));
+        }
+        if self.compensation.is_some() {
+            return Err(self.error(
+                line,
+                column,
+                "drilling cycles are not allowed while cutter radius compensation is on (G40 \
+                 first)",
+            ));
+        }
+        if self.plane != Plane::Xy {
+            return Err(self.error(
+                line,
+                column,
+                format!(
+                    "drilling cycles drill along Z here: select G17, not {}",
+                    self.plane.code()
+                ),
             ));
         }
         let z = |w: Option<Word>| w.map(|w| (self.origin[2] + w.value * self.scale, w.column));
@@ -937,6 +1106,7 @@ impl<'a> Reader<'a> {
             corner,
             place: Place { line, column: 1 },
             z_place,
+            compensation: self.compensation,
         });
         self.position = end;
     }
@@ -1166,14 +1336,15 @@ mod tests {
             "G21 G40 G49 G80 G94\nG54\nT1 M6\nS12000 M3 M8\nG0 Z5\nG0 X10 Y10\nG1 Z-1 F100\n\
              G1 X20 F600\nG2 X30 Y10 I5 J0\nG0 Z5\nG0 X0 Y0\nM5 M9\nM2\n",
         );
-        // G40, G49, G94, G54, T, M6, S, M3-M5, M7-M9 (G80 is a motion code; a Z-only
-        // move is a standstill: the retract after the arc, 6 mm at rapid).
-        assert_eq!(p.warnings.len(), 9, "{:#?}", p.warnings);
+        // G49, G94, G54, T, M6, S, M3-M5, M7-M9 (G80 is a motion code, G40 turns cutter
+        // compensation off; a Z-only move is a standstill: the retract after the arc, 6 mm
+        // at rapid).
+        assert_eq!(p.warnings.len(), 8, "{:#?}", p.warnings);
         let standstill = p.moves()[1].standstill;
         assert_eq!((standstill.at_rapid, standstill.seconds), (6.0, 0.0));
         // A skipped word is named where it stands.
         assert!(
-            p.warnings[0].starts_with("t.ngc:1:5: G40 "),
+            p.warnings[0].starts_with("t.ngc:1:9: G49 "),
             "{}",
             p.warnings[0]
         );
@@ -1217,7 +1388,7 @@ mod tests {
     fn wrong_programs_are_refused_with_their_line_and_column() {
         for (text, want) in [
             (
-                "G1 X1\nG18\n",
+                "G1 X1\nG18 G2 X0 Z1 I-1 K0\n",
                 "t.ngc:2:1: G18 arcs are in a plane with the third axis",
             ),
             ("G1 X1 A3\n", "t.ngc:1:7: the word A"),
@@ -1234,7 +1405,10 @@ mod tests {
                 "G1 X10\nG3 Y5 I-5 R3\n",
                 "t.ngc:2:7: an arc takes I and J, or R",
             ),
-            ("G1 X10\nG3 Y5\n", "t.ngc:2:1: an arc needs I and J, or R"),
+            (
+                "G1 X10\nG3 Y5\n",
+                "t.ngc:2:1: a G17 arc needs I and J, or R",
+            ),
             ("G1 X1 F0\n", "t.ngc:1:7: feed F0 must be > 0"),
             ("G1 X1\nM98 P100\n", "t.ngc:2:1: M98 is not supported"),
             ("G1 X1\nM99\n", "t.ngc:2:1: M99 is not supported"),
@@ -1368,6 +1542,51 @@ mod tests {
         assert_eq!(end(&p), Vector::<3>::new(-98.0, 1.0, 80.0));
         assert!(refused("G2 X2 I1\nG53 X0\n").contains("G53 moves with G0 or G1 only"));
         assert!(refused("G28 G1 X1\n").contains("no motion code"));
+    }
+
+    #[test]
+    fn tapping_the_loaded_tools_radius_and_g80_by_dialect() {
+        // G84 at one hole: rapid to R, feed to Z, dwell P, feed back to R, rapid to Z10
+        // (G98); then Fanuc's G80 returns to G0, in which `Z20` moves; LinuxCNC refuses it.
+        let text = "G21 G90\nG0 X0 Y0 Z10\nG98 G84 X5 Y5 Z-6 R2 P200 F100\nG80\nZ20\nM30\n";
+        let fanuc = GcodeOptions {
+            dialect: Dialect::Fanuc,
+            ..GcodeOptions::default()
+        };
+        let p = part(text, &fanuc);
+        let steps: Vec<_> = p.moves.iter().map(|m| (m.end[2], m.speed)).collect();
+        let feed = Speed::Feed(100.0 / 60.0);
+        assert_eq!(
+            steps,
+            [
+                (10.0, Speed::Rapid),
+                (10.0, Speed::Rapid),
+                (2.0, Speed::Rapid),
+                (-6.0, feed),
+                (-6.0, Speed::Rapid),
+                (2.0, feed),
+                (10.0, Speed::Rapid),
+                (20.0, Speed::Rapid),
+            ]
+        );
+        assert_eq!(dwells(&p), [0.2]);
+        let e = parse_gcode(text, "t.ngc", &GcodeOptions::default()).unwrap_err();
+        assert!(
+            e.to_string().starts_with("t.ngc:5:1: axis words without"),
+            "{e}"
+        );
+        // G41 without D: the radius of the tool M6 loaded (T on its block or before).
+        let tools = GcodeOptions {
+            tools: ToolTable::parse("3:1.5, 4:2").unwrap(),
+            ..GcodeOptions::default()
+        };
+        for text in ["T3 M6\nG41 G1 X10 F60\n", "T3\nM6\nT4\nG41 G1 X10 F60\n"] {
+            let p = part(text, &tools);
+            let c = p.moves.last().unwrap().compensation.unwrap();
+            assert_eq!((c.side, c.radius), (Side::Left, 1.5), "{text}");
+        }
+        let e = parse_gcode("G42 G1 X10 F60\n", "t.ngc", &tools).unwrap_err();
+        assert!(e.to_string().contains("or a tool loaded (T M6)"), "{e}");
     }
 
     #[test]

@@ -9,6 +9,7 @@
 
 mod arc_words;
 pub mod cl_data;
+pub mod cutter_compensation;
 mod drilling;
 pub mod gcode;
 
@@ -16,9 +17,9 @@ use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::Vector;
+use crate::geometry::{Vector, Vector2};
 use crate::kinematics::Pose;
-use crate::path::CircularArc;
+use crate::path::{CircularArc, Curve, PathError};
 
 /// The speed a move was programmed at.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -47,11 +48,94 @@ pub enum Corner {
 pub enum Motion {
     /// A straight move of the tip (G0, G1, a CL `GOTO`).
     Line,
-    /// A circular arc in the XY plane (G2, G3 under G17), its z unchanged.
-    Arc(CircularArc),
+    /// A circular arc (G2, G3) in `plane`, in its (u, v) coordinates; the third axis w
+    /// goes from the start's to the end's in proportion to the angle (a helix where they
+    /// differ).
+    Arc {
+        /// The arc in the plane's (u, v) coordinates.
+        arc: CircularArc,
+        /// The plane it lies in.
+        plane: Plane,
+    },
     /// The tool stands where it is for this many seconds (G4, a drilling cycle's dwell);
     /// 0: a stop (M0, M1) and nothing more. Its `end` is where it stands.
     Dwell(f64),
+}
+
+/// The plane of an arc and of cutter radius compensation (G17, G18, G19), as its axes
+/// (u, v, w), right-handed: an arc turns in (u, v), counter-clockwise (G3) as seen from
+/// +w, and a helix climbs along w.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Plane {
+    /// G17: (X, Y, Z).
+    #[default]
+    Xy,
+    /// G18: (Z, X, Y).
+    Zx,
+    /// G19: (Y, Z, X).
+    Yz,
+}
+
+impl Plane {
+    /// The indices (0 = X, 1 = Y, 2 = Z) of u, v and w.
+    pub fn axes(self) -> [usize; 3] {
+        match self {
+            Plane::Xy => [0, 1, 2],
+            Plane::Zx => [2, 0, 1],
+            Plane::Yz => [1, 2, 0],
+        }
+    }
+
+    /// The G code that selects it.
+    pub fn code(self) -> &'static str {
+        match self {
+            Plane::Xy => "G17",
+            Plane::Zx => "G18",
+            Plane::Yz => "G19",
+        }
+    }
+
+    /// `p`'s (u, v).
+    pub fn in_plane(self, p: &Vector<3>) -> Vector2 {
+        let [u, v, _] = self.axes();
+        Vector2::new(p[u], p[v])
+    }
+
+    /// `p`'s w.
+    pub fn across(self, p: &Vector<3>) -> f64 {
+        p[self.axes()[2]]
+    }
+
+    /// The point at (u, v) and w.
+    pub fn point(self, uv: Vector2, w: f64) -> Vector<3> {
+        let [u, v, n] = self.axes();
+        let mut p = Vector::<3>::zeros();
+        p[u] = uv[0];
+        p[v] = uv[1];
+        p[n] = w;
+        p
+    }
+}
+
+/// Which side of the programmed contour the tool runs on, looking along the motion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Side {
+    /// G41.
+    Left,
+    /// G42.
+    Right,
+}
+
+/// Cutter radius compensation in force on a move (G41, G42): the programmed contour is
+/// the part's edge, and the tool's centre runs `radius` mm to its `side` in `plane`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Compensation {
+    /// The side of the contour the tool is on.
+    pub side: Side,
+    /// The tool's radius, mm (≥ 0).
+    pub radius: f64,
+    /// The plane the offset lies in (G17 or G18).
+    pub plane: Plane,
 }
 
 /// Where in its file something was read: 1-based line and column, 0 when not known.
@@ -82,6 +166,9 @@ pub struct PartMove {
     /// Where the Z word of the block was, when it had one (a third-axis move is refused
     /// there by a machine that has no third axis).
     pub z_place: Option<Place>,
+    /// Cutter radius compensation in force on the move: `end` (and an arc) are then the
+    /// part's contour, not the tool's centre ([`cutter_compensation`]).
+    pub compensation: Option<Compensation>,
 }
 
 /// Something a reader read past or corrected, with where.
@@ -144,6 +231,55 @@ impl PartProgram {
             .filter(|m| !matches!(m.motion, Motion::Dwell(_)))
             .map(|m| m.place.line)
             .collect()
+    }
+
+    /// The program with every arc as straight chords leaving it by at most `sag` mm (a
+    /// helix's chords rise with it); a program that would pass `max_moves` moves is
+    /// refused, naming the arc's line.
+    pub fn with_arcs_as_chords(&self, sag: f64, max_moves: usize) -> Result<Self, PathError> {
+        let mut moves = Vec::with_capacity(self.moves.len());
+        let mut from = self.start;
+        for m in &self.moves {
+            if let Motion::Arc { arc, plane } = &m.motion {
+                let step = 2.0 * crate::math::acos((1.0 - sag / arc.radius()).max(-1.0));
+                let chords = (arc.sweep().abs() / step).ceil().max(1.0);
+                if chords + moves.len() as f64 >= max_moves as f64 {
+                    return Err(PathError::File {
+                        file: self.file.clone(),
+                        line: m.place.line,
+                        column: m.place.column.max(1),
+                        message: format!(
+                            "this arc as chords of sag {sag} mm would make the program more                              than {max_moves} moves"
+                        ),
+                    });
+                }
+                let chords = chords as usize;
+                let (w0, w1) = (plane.across(&from), plane.across(&m.end));
+                for k in 1..chords {
+                    let t = k as f64 / chords as f64;
+                    let end = plane.point(arc.point(t), w0 + (w1 - w0) * t);
+                    moves.push(PartMove {
+                        motion: Motion::Line,
+                        corner: Corner::BlendDefault,
+                        ..m.clone()
+                    });
+                    moves.last_mut().expect("pushed").end = end;
+                }
+                moves.push(PartMove {
+                    motion: Motion::Line,
+                    ..m.clone()
+                });
+            } else {
+                moves.push(m.clone());
+            }
+            if !matches!(m.motion, Motion::Dwell(_)) {
+                from = m.end;
+            }
+        }
+        Ok(PartProgram {
+            moves,
+            ..self.clone()
+        })
     }
 
     /// The warnings as text, `file:line[:column]: message` each.

@@ -585,7 +585,7 @@ fn state_bytes_of(model: &'static ModelInfo) -> Vec<u8> {
 // Path files
 
 fn write_path_files() {
-    let files: [(&str, &str); 18] = [
+    let files: [(&str, &str); 19] = [
         (
             "syntax.json",
             "{\n  \"degree\": 1,\n  \"knots\": [0, 0,, 1, 1],\n  \"control_points\": [[0, 0], [3, 4]]\n}\n",
@@ -625,11 +625,16 @@ fn write_path_files() {
                 "length": 100}"#,
         ),
         ("far.cl", "GOTO/-1e308,0,0,0,0,1\nGOTO/1e308,0,0,0,0,1\n"),
-        ("plane.ngc", "G21 G90\nG1 X10 F600\nG18 G2 X0 Z10 I-5\n"),
+        ("plane.ngc", "G21 G90\nG1 X10 F600\nG18 G2 X0 Z10 I-5 K5\n"),
         ("off_circle.ngc", "G1 X10 F600\nG2 X0 Y10 I0 J5\n"),
         ("helix.ngc", "G0 Z5\nG1 X10 F600\nG1 X20 Z-1\n"),
         ("expression.ngc", "G21\nG1 X[1+2] F600\n"),
         ("drill.ngc", "G21\nG0 Z5\nG1 X10 F600\nG81 X20 Z-2 F100\n"),
+        // A slot 4 mm wide under G42 D7.
+        (
+            "compensated.ngc",
+            "G0 X-10 Y-10\nG42 D7 G1 X0 Y0 F600\nG1 X10\nG1 Y10\nG1 X14\nG1 Y0\nG1 X30\n",
+        ),
     ];
     std::fs::create_dir_all(folder()).unwrap();
     for (name, text) in files {

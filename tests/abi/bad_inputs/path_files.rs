@@ -54,6 +54,38 @@ pub(super) static CASES: &[Case] = &[
         Corrected,
     ),
     case(
+        "a tool table that is not D:radius pairs",
+        P2,
+        Initialization,
+        |s| s.exit_with(|s| s.set_string("toolRadii", "1:3, 2")),
+        ERROR,
+        Some("parameter 'toolRadii': tool table: \"2\" is not D:radius (e.g. 1:3.0)"),
+        Corrected,
+    ),
+    case(
+        "a compensated G-code program whose D is not in the tool table (five axes)",
+        P5,
+        Initialization,
+        |s| s.exit_with(|s| s.set_string("path", &s.file("compensated.ngc"))),
+        ERROR,
+        Some("compensated.ngc:2:5: D7 is not in the tool table (parameter toolRadii: empty"),
+        Corrected,
+    ),
+    case(
+        "a concave corner a compensated tool cannot reach",
+        P2,
+        Initialization,
+        |s| {
+            s.exit_with(|s| {
+                s.ok(s.set_string("toolRadii", "7:3"));
+                s.set_string("path", &s.file("compensated.ngc"))
+            })
+        },
+        ERROR,
+        Some("compensated.ngc:6:1: concave corner with line 5"),
+        Corrected,
+    ),
+    case(
         "a G-code dialect that is not one",
         P2,
         Initialization,

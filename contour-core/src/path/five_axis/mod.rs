@@ -27,4 +27,7 @@ pub use planned_reference::{PlannedFiveAxisReference, SavedPlannedReference};
 pub use planner::{FiveAxisInputs, Planner};
 pub use programmed_feed::{check_feeds, feed_of_move, greatest_feed, program_feeds, FeedChange};
 pub use reference::{FiveAxisReference, ReferenceSample, SavedFiveAxisReference};
-pub use tool_path::{load_poses, ToolPath, ToolPathData, BUILTIN_TOOL_PATHS};
+pub use tool_path::{
+    load_poses, load_poses_with, load_program, machine_moves, ToolPath, ToolPathData,
+    BUILTIN_TOOL_PATHS, GCODE_ARC_SAG,
+};

@@ -12,7 +12,9 @@ use super::programmed_feed::{program_feeds, FeedChange};
 use crate::geometry::{self, slerp, Vector};
 use crate::kinematics::Pose;
 use crate::part_program::cl_data::load_cl;
-use crate::part_program::{file_kind, FileKind};
+use crate::part_program::cutter_compensation::compensate;
+use crate::part_program::gcode::{load_gcode, GcodeOptions};
+use crate::part_program::{file_kind, FileKind, Motion, PartProgram, Speed, Warning};
 use crate::path::nurbs_file::read_path_file;
 use crate::path::{clamp_param, Curve, Nurbs, NurbsData, PathError};
 
@@ -169,18 +171,73 @@ struct ToolPathFile {
 /// Names of the built-in five-axis paths.
 pub const BUILTIN_TOOL_PATHS: [&str; 2] = ["tilted_helix", "figure_eight"];
 
-/// How a five-axis reference is named: a CL file (`.cl`, `.apt`, `.cls`, `.aptsource`,
-/// `.ncl`), a two-curve JSON file
+/// The largest sag of the chords a G-code arc becomes on the five-axis machine (as a CL
+/// `CIRCLE`'s), mm.
+pub const GCODE_ARC_SAG: f64 = 5e-4;
+
+/// A part program as the five-axis machine follows it: the tool centre's moves (cutter
+/// radius compensation applied), every arc as chords within [`GCODE_ARC_SAG`].
+/// As on the XY table, rapids before the first cut only position the tool: the path
+/// starts where the first feed move starts. A dwell or stop is not a standstill of the
+/// five-axis plan: it is skipped, with a warning.
+pub fn machine_moves(program: &PartProgram) -> Result<PartProgram, PathError> {
+    let mut moves = compensate(program)?.with_arcs_as_chords(GCODE_ARC_SAG, MAX_SAMPLED_POSES)?;
+    let is_move = |m: &crate::part_program::PartMove| !matches!(m.motion, Motion::Dwell(_));
+    if let Some(cut) = moves
+        .moves
+        .iter()
+        .position(|m| is_move(m) && m.speed != Speed::Rapid)
+    {
+        let from = moves.moves[..cut]
+            .iter()
+            .rev()
+            .find(|m| is_move(m))
+            .map_or(moves.start, |m| m.end);
+        let mut start = moves.moves[cut].clone();
+        start.motion = Motion::Line;
+        start.end = from;
+        moves.moves.splice(..cut, [start]);
+    }
+    if let Some(dwell) = moves
+        .moves
+        .iter()
+        .find(|m| matches!(m.motion, Motion::Dwell(_)))
+    {
+        moves.warnings.push(Warning {
+            file: moves.file.clone(),
+            place: dwell.place,
+            message: "dwells and stops (G4, M0, M1) skipped: the five-axis plan has no \
+                      standstill; further ones are skipped silently"
+                .into(),
+        });
+    }
+    Ok(moves)
+}
+
+/// A part program file, CL data or G-code (read with `options`) by its ending, as the
+/// five-axis machine follows it ([`machine_moves`]).
+pub fn load_program(
+    file: &std::path::Path,
+    options: &GcodeOptions,
+) -> Result<PartProgram, PathError> {
+    match file_kind(file) {
+        Some(FileKind::GCode) => machine_moves(&load_gcode(file, options)?),
+        _ => load_cl(file),
+    }
+}
+
+/// How a five-axis reference is named: a part program (CL data: `.cl`, `.apt`, `.cls`,
+/// `.aptsource`, `.ncl`; G-code: `.ngc`, `.nc`, `.gcode`, `.tap`), a two-curve JSON file
 /// (`.json`), or a built-in.
 enum Source<'a> {
-    Cl(&'a str),
+    Program(&'a str),
     Json(&'a str),
     Builtin(&'a str),
 }
 
 fn source(spec: &str) -> Source<'_> {
     match file_kind(std::path::Path::new(spec)) {
-        Some(FileKind::ClData) => Source::Cl(spec),
+        Some(FileKind::ClData | FileKind::GCode) => Source::Program(spec),
         Some(FileKind::Json) => Source::Json(spec),
         _ => Source::Builtin(spec),
     }
@@ -190,9 +247,18 @@ fn source(spec: &str) -> Source<'_> {
 /// warnings: a CL file's records as written (a tool turning on the spot is kept), a
 /// curve pair sampled so that no tip chord exceeds `chord` mm.
 pub fn load_poses(spec: &str, chord: f64) -> Result<(Vec<Pose>, Vec<String>), PathError> {
+    load_poses_with(spec, chord, &GcodeOptions::default())
+}
+
+/// [`load_poses`] with a G-code program read with `gcode`.
+pub fn load_poses_with(
+    spec: &str,
+    chord: f64,
+    gcode: &GcodeOptions,
+) -> Result<(Vec<Pose>, Vec<String>), PathError> {
     match source(spec) {
-        Source::Cl(file) => {
-            let program = load_cl(file)?;
+        Source::Program(file) => {
+            let program = load_program(file.as_ref(), gcode)?;
             Ok((program.poses(), program.warning_lines()))
         }
         Source::Json(file) => {
@@ -253,14 +319,14 @@ impl ToolPath {
             }
             _ => Err(PathError::invalid(format!(
                 "unknown five-axis path {name:?}: expected a CL file (.cl, .apt, .cls, .aptsource, \
-                 .ncl) or a .json file, or a \
+                 .ncl), a G-code program (.ngc, .nc, .gcode, .tap) or a .json file, or a \
                  built-in ({})",
                 BUILTIN_TOOL_PATHS.join(", ")
             ))),
         }
     }
 
-    /// The reference named `spec`: a CL file (`.cl`, `.apt`, `.cls`, `.aptsource`, `.ncl`), a
+    /// The reference named `spec`: a part program (CL data or G-code, see [`Source`]), a
     /// two-curve JSON file (`.json`), or a built-in name; with the CL reader's warnings.
     pub fn load(spec: &str) -> Result<(ToolPath, Vec<String>), PathError> {
         let (path, _, warnings) = Self::load_with_feeds(spec, 1.0, 1.0)?;
@@ -275,8 +341,8 @@ impl ToolPath {
         rapid: f64,
     ) -> Result<(ToolPath, Vec<FeedChange>, Vec<String>), PathError> {
         match source(spec) {
-            Source::Cl(file) => {
-                let program = load_cl(file)?;
+            Source::Program(file) => {
+                let program = load_program(file.as_ref(), &GcodeOptions::default())?;
                 Ok((
                     ToolPath::from_poses(&program.poses())?,
                     program_feeds(&program, feed, rapid),

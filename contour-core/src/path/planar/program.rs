@@ -13,8 +13,9 @@ use serde::{Deserialize, Serialize};
 
 use super::CornerBlend;
 use crate::geometry::{self, Vector2};
+use crate::part_program::cutter_compensation::compensate;
 use crate::part_program::gcode::{load_gcode, parse_gcode, GcodeOptions};
-use crate::part_program::{Corner, Motion, PartProgram, Place, Speed, Warning};
+use crate::part_program::{Corner, Motion, PartProgram, Place, Plane, Speed, Warning};
 use crate::path::{clamp_param, CircularArc, Curve, CurvePoint, Line, PathError};
 
 /// The geometry of one move.
@@ -202,6 +203,7 @@ impl Program {
     /// part of the path). A move of X or Y together with Z at a feed (a ramp or a helix)
     /// is refused at its Z word: it needs the third axis.
     pub fn from_part_program(part: &PartProgram) -> Result<Self, PathError> {
+        let part = &compensate(part)?;
         let mut skipped = BTreeSet::new();
         let mut warnings = part.warning_lines();
         let mut skip = |kind: &'static str, line: usize| {
@@ -240,7 +242,24 @@ impl Program {
                 continue;
             }
             let end = Vector2::new(m.end[0], m.end[1]);
-            let arc = matches!(m.motion, Motion::Arc(_));
+            let arc = matches!(m.motion, Motion::Arc { .. });
+            if let Motion::Arc {
+                plane: plane @ (Plane::Zx | Plane::Yz),
+                ..
+            } = m.motion
+            {
+                return Err(PathError::File {
+                    file: part.file.clone(),
+                    line,
+                    column: m.place.column.max(1),
+                    message: format!(
+                        "{} arcs are in a plane with the third axis, which the XY table does \
+                         not have: run the program on the five-axis machine \
+                         (PathInterpolator5X)",
+                        plane.code()
+                    ),
+                });
+            }
             if m.speed != Speed::Rapid {
                 cutting = true;
             }
@@ -279,7 +298,7 @@ impl Program {
                         message: e.to_string(),
                     })?)
                 }
-                Motion::Arc(a) => Shape::Arc(a.clone()),
+                Motion::Arc { arc, .. } => Shape::Arc(arc.clone()),
                 Motion::Dwell(_) => continue,
             };
             if !cutting {
