@@ -338,3 +338,37 @@ fn public_gcode_programs_are_read_and_planned_on_five_axes() {
         },
     );
 }
+
+#[test]
+fn a_drilling_cycle_reaches_the_bottom_of_every_hole() {
+    // A plunge and its retract turn back on the spot: the distance to the path cannot
+    // see a hole cut short, so the plan checks the reach of such corners (docs/design
+    // five-axis.md §5.3d). G81 and G83 (pecks of 2 mm, each turning back) at F200.
+    let text = "G21 G90 G17\nG0 X0 Y0 Z10\nG1 Z5 F600\nG98 G81 X10 Y10 Z-5 R1 F200\nX20\n\
+                G83 X30 Z-6 Q2\nG80\nG0 X0 Y0 Z20\nM30\n";
+    let program =
+        machine_moves(&parse_gcode(text, "holes.ngc", &GcodeOptions::default()).unwrap()).unwrap();
+    let limits = PathLimits::at_feed(FEED);
+    let mut reference = planned(&program, "holes.ngc", limits).unwrap();
+    let pieces = pieces_of(&program);
+    let followed = follow(&pieces, &mut reference);
+    assert!(
+        followed.tip <= limits.tolerance * (1.0 + 1e-6),
+        "{}",
+        followed.tip
+    );
+    // Every bottom the test knows: each hole's depth, and each peck's.
+    let mut bottoms = vec![V3::new(10.0, 10.0, -5.0), V3::new(20.0, 10.0, -5.0)];
+    bottoms.extend([-1.0, -3.0, -5.0, -6.0].map(|z| V3::new(30.0, 10.0, z)));
+    for bottom in bottoms {
+        let nearest = followed
+            .samples
+            .iter()
+            .map(|(pose, _, _)| contour_core::geometry::dist(&pose.tip, &bottom))
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            nearest <= limits.tolerance * (1.0 + 1e-6),
+            "{bottom:?}: the nearest sample is {nearest} mm away"
+        );
+    }
+}

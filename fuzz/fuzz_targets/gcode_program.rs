@@ -1,6 +1,9 @@
 //! The G-code program reader on arbitrary text (as PathInterpolator2D reads a `.ngc`
 //! file; lossily UTF-8, as a file would be refused otherwise before parsing), with the
-//! reader's options (dialect, optional stop, home) taken from the first byte. What reads is then used as the models use it: evaluated at awkward path
+//! reader's options (dialect, optional stop, home) taken from the first byte and a tool
+//! table for cutter radius compensation. The part program is made the five-axis
+//! machine's moves (compensation, arcs as chords, within a smaller budget than the
+//! library's) and, when not too many, a five-axis path. What the XY table reads is then used as the models use it: evaluated at awkward path
 //! positions, mirrored, measured against by the exact distance from points near and far,
 //! round-tripped through the FMU state's encoding and followed by the interpolator for a
 //! few samples. Nothing may panic; every loop in there is bounded.
@@ -8,7 +11,10 @@
 
 use contour_core::contour::planar::TrueErrorIndex;
 use contour_core::geometry::{Vector, Vector2};
-use contour_core::part_program::gcode::{Dialect, GcodeOptions};
+use contour_core::part_program::cutter_compensation::ToolTable;
+use contour_core::part_program::gcode::{parse_gcode, Dialect, GcodeOptions};
+use contour_core::part_program::cutter_compensation::compensate;
+use contour_core::path::five_axis::{ToolPath, GCODE_ARC_SAG};
 use contour_core::path::planar::{Path, Program, XyLimits, XyReference};
 use contour_core::path::{Curve, Interpolator};
 use contour_fmu_fuzz::install_panic_hook;
@@ -24,9 +30,20 @@ fuzz_target!(init: install_panic_hook(), |data: &[u8]| {
         dialect: if first & 1 == 0 { Dialect::LinuxCnc } else { Dialect::Fanuc },
         optional_stop: first & 2 != 0,
         home: Vector::<3>::new(-f64::from(first >> 2), 10.0, 50.0),
+        tools: ToolTable::parse("0:0, 1:2, 2:0.5, 3:-1.5, 4:1e-9").expect("a tool table"),
     };
     let text = String::from_utf8_lossy(rest);
-    let Ok(program) = Program::parse_gcode_with(&text, "fuzz.ngc", &options) else {
+    let Ok(part) = parse_gcode(&text, "fuzz.ngc", &options) else {
+        return;
+    };
+    // machine_moves with a budget a fuzzer's memory allows (the library's is 2^22 moves).
+    let chorded = compensate(&part).and_then(|p| p.with_arcs_as_chords(GCODE_ARC_SAG, 100_000));
+    if let Ok(moves) = chorded {
+        if moves.moves.len() <= 4096 {
+            let _ = ToolPath::from_poses(&moves.poses());
+        }
+    }
+    let Ok(program) = Program::from_part_program(&part) else {
         return;
     };
     let length = program.length();

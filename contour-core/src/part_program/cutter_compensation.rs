@@ -2,12 +2,12 @@
 //! programmed contour is the part's edge, and the tool's centre runs the tool's radius to
 //! the side G41 (left) or G42 (right) names, in the plane of G17 or G18. [`compensate`]
 //! turns a [`PartProgram`]'s compensated moves into the moves of the tool's centre, by
-//! LinuxCNC's rules: a straight entry move to the first point offset perpendicular to it,
-//! an arc of the tool's radius about a convex corner, the offset paths cut at their
-//! meeting point in a concave one, and a straight exit move after G40. What cannot be
-//! compensated is refused with its line: an entry move no longer than the radius, an
-//! entry or exit on an arc, an arc the tool does not fit inside, a concave corner the tool
-//! cannot reach without cutting into the part.
+//! LinuxCNC's rules: a straight entry move to the first point offset perpendicular to it
+//! (an entry arc to its arc's offset end), an arc of the tool's radius about a convex
+//! corner, the offset paths cut at their meeting point in a concave one, and a straight
+//! exit move after G40. What cannot be compensated is refused with its line: an entry
+//! ending within the tool's radius, an exit on an arc, an arc the tool does not fit inside,
+//! a concave corner the tool cannot reach without cutting into the part.
 
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
@@ -163,8 +163,13 @@ impl Piece {
 
     /// The piece ending at `p`, which lies on it.
     fn end_at(&mut self, p: Vector2) {
-        let (t, _) = self.share(p);
+        let (mut t, _) = self.share(p);
         if let Shape::Arc { sweep, .. } = &mut self.shape {
+            // On a whole circle its start is its end: a point just short of it (read as
+            // the start) ends the whole turn.
+            if t == 0.0 && sweep.abs() >= TAU * (1.0 - 1e-12) {
+                t = 1.0;
+            }
             *sweep *= t;
         }
         self.to = p;
@@ -262,9 +267,6 @@ impl Pass<'_> {
                 });
             }
         }
-        if m.compensation.is_some() {
-            self.exiting = None;
-        }
         let from = self.programmed;
         if !matches!(m.motion, Motion::Dwell(_)) {
             self.programmed = m.end;
@@ -295,7 +297,9 @@ impl Pass<'_> {
         let next = self.piece(m, from, c)?;
         let stretch = self.stretch.as_mut().expect("in a stretch");
         let Some(mut pending) = stretch.pending.take() else {
+            // The entry: the tool leaves the last stretch's offset point.
             stretch.pending = Some(next);
+            self.exiting = None;
             return Ok(());
         };
         let mut next = next;
@@ -1151,5 +1155,52 @@ mod tests {
         assert!(
             matches!(last.motion, Motion::Line) && last.end == Vector::<3>::new(50.0, 50.0, -1.0)
         );
+    }
+
+    #[test]
+    fn stretches_entries_and_exits_as_the_review_found_them() {
+        let head = "G21 G90\nG0 X-10 Y-10\nG41 D1 G1 X0 Y0 F600\nG1 X20\n";
+        // G40 then G41 with nothing moving between: a new entry from (20, 3), the first
+        // stretch's last offset end, toward (17, 20), cut where it meets the offset of
+        // the next side (y = 17).
+        let ends = ends(
+            &format!("{head}G40\nG41 D1\nG1 X20 Y20\nG1 X0\nG40 G1 X-10 Y30\n"),
+            3.0,
+        );
+        let at = ends
+            .iter()
+            .position(|p| geometry::dist(p, &Vector::<3>::new(20.0, 3.0, 0.0)) < 1e-12)
+            .expect("the first stretch ends at its offset end");
+        let x = 20.0 - 3.0 * 14.0 / 17.0;
+        assert!(
+            geometry::dist(&ends[at + 1], &Vector::<3>::new(x, 17.0, 0.0)) < 1e-12,
+            "{ends:?}"
+        );
+        // A whole circle whose end meets the next move's offset at a nearly tangent
+        // concave corner stays whole.
+        let text = "G0 X10 Y-20\nG41 D1 G1 X10 Y-10 F600\nG1 Y0\nG3 I-10 J0\n\
+                    G1 X9.9999995 Y10\nG40 G1 X0 Y20\n";
+        let part = parse_gcode(text, "p.ngc", &options(3.0)).unwrap();
+        let centre = compensate(&part).unwrap();
+        let sweeps: Vec<f64> = centre
+            .moves
+            .iter()
+            .filter_map(|m| match &m.motion {
+                Motion::Arc { arc, .. } => Some(arc.sweep()),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(sweeps.len(), 1);
+        assert!((sweeps[0] - TAU).abs() < 1e-6, "{sweeps:?}");
+        // A stretch that moves Z alone leaves the tool at the last offset point: the
+        // move after the next G40 is still an exit move, and an arc there is refused.
+        let e = refusal(
+            &format!("{head}G40 G0 Z5\nG41 D1 G0 Z6\nG40 G2 X30 Y-10 I0 J-10\n"),
+            3.0,
+        );
+        assert!(e.starts_with("p.ngc:7:1: the move after G40"), "{e}");
+        // G40 and G49 in one block: compensation is off before the length offset.
+        let text = format!("{head}G40 G49 G0 X30 Y-10\n");
+        assert!(parse_gcode(&text, "p.ngc", &options(3.0)).is_ok());
     }
 }

@@ -179,6 +179,8 @@ struct Reader<'a> {
     plane: Plane,
     /// Cutter radius compensation (G41, G42) until G40.
     compensation: Option<Compensation>,
+    /// The G41 and G42 read so far.
+    stretches: u32,
     /// The tool the last T word selected, and the one M6 loaded (G41 without D takes its
     /// radius).
     tool_selected: Option<f64>,
@@ -210,6 +212,7 @@ impl<'a> Reader<'a> {
             stop_here: false,
             plane: Plane::Xy,
             compensation: None,
+            stretches: 0,
             tool_selected: None,
             tool_loaded: None,
             before_cycle: None,
@@ -383,6 +386,7 @@ impl<'a> Reader<'a> {
         let mut corner_word: Option<(u32, usize)> = None;
         let mut plane_word: Option<(Plane, usize)> = None;
         let mut compensation_word: Option<(u32, usize)> = None;
+        let mut length_offset_word: Option<usize> = None;
         for &(code, column) in &g_codes {
             let set_motion = |motion: &mut Option<(Option<Mode>, usize)>, m: Option<Mode>| {
                 if motion.is_some() {
@@ -433,23 +437,22 @@ impl<'a> Reader<'a> {
                     }
                     compensation_word = Some((c, column));
                 }
-                430 | 490 if self.compensation.is_some() => {
-                    return Err(self.error(
-                        line,
-                        column,
-                        "the tool length offset cannot change while cutter radius \
-                         compensation is on (G40 first)",
-                    ))
+                430 | 490 if length_offset_word.is_none() => {
+                    length_offset_word = Some(column);
+                    if code == 430 {
+                        self.skip(
+                            "G43 H (tool length offset: the program gives the tip)",
+                            line,
+                            column,
+                        );
+                        letters.take('H');
+                    } else {
+                        self.skip("G49 (tool length offset off)", line, column);
+                    }
                 }
-                430 => {
-                    self.skip(
-                        "G43 H (tool length offset: the program gives the tip)",
-                        line,
-                        column,
-                    );
-                    letters.take('H');
+                430 | 490 => {
+                    return Err(self.error(line, column, "two of G43, G49 in one block"));
                 }
-                490 => self.skip("G49 (tool length offset off)", line, column),
                 940 => self.skip(
                     "G94 (feed per minute, the only feed mode here)",
                     line,
@@ -556,6 +559,15 @@ impl<'a> Reader<'a> {
         }
         if let Some((code, column)) = compensation_word {
             self.compensation = self.compensation_mode(code, &mut letters, line, column)?;
+        }
+        // After the block's G40 (RS-274 applies compensation before the length offset).
+        if let (Some(column), Some(_)) = (length_offset_word, self.compensation) {
+            return Err(self.error(
+                line,
+                column,
+                "the tool length offset cannot change while cutter radius compensation is on \
+                 (G40 first)",
+            ));
         }
         if let Some((m, _)) = motion {
             let drilling = |m: Option<Mode>| matches!(m, Some(Mode::Drilling(_)));
@@ -706,10 +718,12 @@ impl<'a> Reader<'a> {
                 .map_err(|m| self.error(line, d.column, m))?
         };
         let left = (code / 10 == 41) == (radius >= 0.0);
+        self.stretches += 1;
         Ok(Some(Compensation {
             side: if left { Side::Left } else { Side::Right },
             radius: radius.abs(),
             plane: self.plane,
+            stretch: self.stretches,
         }))
     }
 

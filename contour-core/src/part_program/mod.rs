@@ -136,6 +136,9 @@ pub struct Compensation {
     pub radius: f64,
     /// The plane the offset lies in (G17 or G18).
     pub plane: Plane,
+    /// Which G41 or G42 of the program turned it on (from 1): a G40 and a G41 with
+    /// nothing moving between them start a new stretch, with its own entry move.
+    pub stretch: u32,
 }
 
 /// Where in its file something was read: 1-based line and column, 0 when not known.
@@ -249,7 +252,8 @@ impl PartProgram {
                         line: m.place.line,
                         column: m.place.column.max(1),
                         message: format!(
-                            "this arc as chords of sag {sag} mm would make the program more                              than {max_moves} moves"
+                            "this arc as chords of sag {sag} mm would make the program more \
+                             than {max_moves} moves"
                         ),
                     });
                 }

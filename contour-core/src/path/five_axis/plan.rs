@@ -529,6 +529,15 @@ impl FiveAxisPlan {
         let mut slow: Vec<(usize, f64, f64)> = Vec::new();
         let window = self.filter.0 + self.filter.1;
         let mut intervals = std::collections::VecDeque::with_capacity(window + 1);
+        // Where the tip turns back by more than 90° (a plunge and its retract, a
+        // zigzag's end), the distance to the path does not see a corner cut short (the
+        // tip stays on the path as it turns back early): the nearest sample to such a
+        // corner must come within the tolerance of it. Per corner: that distance and the
+        // nodes the sample averaged.
+        let mut reach: Vec<(usize, f64, (usize, usize))> = (1..self.path.poses.len())
+            .filter(|&n| tip_turn(&self.path, n).is_some_and(|(b, a)| b.dot(&a) < 0.0))
+            .map(|n| (n, f64::INFINITY, (n, n)))
+            .collect();
         loop {
             let sample = self.sample(&mut cursor);
             intervals.push_back(cursor.interval);
@@ -609,11 +618,28 @@ impl FiveAxisPlan {
                     slow.push((n, 0.9 * r * r, 1.0));
                 }
             }
+            let from = reach.partition_point(|c| c.0 < first);
+            for corner in reach[from..].iter_mut().take_while(|c| c.0 <= last) {
+                let d = geometry::dist(&tip, &self.path.poses[corner.0].tip);
+                if d < corner.1 {
+                    (corner.1, corner.2) = (d, (first, last));
+                }
+            }
             history = [Some((cursor.joints, tip)), history[0], history[1]];
             if sample.done {
                 break;
             }
             self.advance(&mut cursor);
+        }
+        for &(_, nearest, (first, last)) in &reach {
+            report.tip_deviation = report.tip_deviation.max(nearest.min(1e300));
+            if nearest > limits.tolerance && nearest.is_finite() {
+                // The shortfall grows with the speed near the corner.
+                let r = limits.tolerance / nearest;
+                for n in first..=last {
+                    slow.push((n, 0.9 * r * r, 1.0));
+                }
+            }
         }
         (report, slow)
     }

@@ -175,13 +175,18 @@ pub const BUILTIN_TOOL_PATHS: [&str; 2] = ["tilted_helix", "figure_eight"];
 /// `CIRCLE`'s), mm.
 pub const GCODE_ARC_SAG: f64 = 5e-4;
 
+/// The most moves a G-code program's arcs may become (2²², under a gigabyte of moves: an
+/// arc of 10 m radius is 10 000 chords a turn); a program past it is refused, naming the
+/// arc.
+pub const MAX_GCODE_MOVES: usize = 1 << 22;
+
 /// A part program as the five-axis machine follows it: the tool centre's moves (cutter
 /// radius compensation applied), every arc as chords within [`GCODE_ARC_SAG`].
 /// As on the XY table, rapids before the first cut only position the tool: the path
 /// starts where the first feed move starts. A dwell or stop is not a standstill of the
 /// five-axis plan: it is skipped, with a warning.
 pub fn machine_moves(program: &PartProgram) -> Result<PartProgram, PathError> {
-    let mut moves = compensate(program)?.with_arcs_as_chords(GCODE_ARC_SAG, MAX_SAMPLED_POSES)?;
+    let mut moves = compensate(program)?.with_arcs_as_chords(GCODE_ARC_SAG, MAX_GCODE_MOVES)?;
     let is_move = |m: &crate::part_program::PartMove| !matches!(m.motion, Motion::Dwell(_));
     if let Some(cut) = moves
         .moves
