@@ -223,10 +223,23 @@ def test_controller_state_continues_bit_identically_in_a_fresh_instance(controll
     fresh.freeInstance()
 
 
-@pytest.mark.parametrize("path", ["blade", "tilted_helix", "figure_eight"])
-def test_interpolator_state_continues_in_a_fresh_instance(interpolator, path):
+BUILTINS = ("tilted_helix", "figure_eight")
+
+# A compensated G-code profile on the five-axis machine: a ramp, G41 with tool 1 (r 2), an
+# arc inside which the tool runs on r 3.
+GCODE = ("G21 G90\nG0 X0 Y0 Z5\nG1 Z-1 F600\nG1 X5 Z-2\nG41 D1 G1 X10 Y0\nG1 X20\n"
+         "G3 X25 Y5 I0 J5\nG1 Y15\nG40 G1 X30 Y15\nG0 Z5\nM30\n")
+
+
+@pytest.mark.parametrize("path", ["blade", "tilted_helix", "figure_eight", "gcode"])
+def test_interpolator_state_continues_in_a_fresh_instance(interpolator, path, tmp_path):
     i = interpolator
-    i.set(path=str(BLADE) if path == "blade" else path, feed=30.0)
+    if path == "gcode":
+        program = tmp_path / "profile.ngc"
+        program.write_text(GCODE)
+        i.set(path=str(program), feed=30.0, toolRadii="1:2")
+    else:
+        i.set(path=str(BLADE) if path == "blade" else path, feed=30.0)
     i.fmu.exitInitializationMode()
 
     def go(fmu, k0, k1):
@@ -243,7 +256,7 @@ def test_interpolator_state_continues_in_a_fresh_instance(interpolator, path):
     i.fmu.freeFMUstate(state)
     # A built-in is saved by name (its 80 001 poses are rebuilt from it), a file's path
     # once: the CL part's 301 poses take 2 × 301 × 24 bytes (22 kB when it was saved twice).
-    assert len(saved) < (2_000 if path != "blade" else 16_500), len(saved)
+    assert len(saved) < (2_000 if path in BUILTINS else 16_500), len(saved)
     expected = go(i.fmu, 300, 600)
     fresh = fresh_instance(i, "PathInterpolator5X")
     restored = fresh.deSerializeFMUstate(saved)

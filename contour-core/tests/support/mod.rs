@@ -162,6 +162,53 @@ pub fn follow(pieces: &[Piece], reference: &mut FiveAxisReference) -> Followed {
     }
 }
 
+/// [`follow`] for pieces that are the planned path's own poses (piece k from pose k to
+/// k + 1): each sample matched to the nearest piece among those from 10 mm of path behind
+/// the raw sample's pose (the reference's `u`, a hint only: the filtered tip lags the raw
+/// one) to two pieces past it. A program that comes back over itself (the same hole
+/// drilled by three tools) cannot mislead the match.
+pub fn follow_by_hint(pieces: &[Piece], reference: &mut FiveAxisReference) -> Followed {
+    let mut samples: Vec<(Pose, [f64; 5], usize)> = Vec::new();
+    let (mut worst_tip, mut worst_axis) = (0.0f64, 0.0f64);
+    let last = loop {
+        let sample = reference.current();
+        let pose = TableTiltingAc::default().forward(&sample.joints);
+        let raw = (sample.u.max(0.0) as usize).min(pieces.len() - 1);
+        let mut first = raw;
+        let mut behind = 0.0;
+        while first > 0 && behind < 10.0 {
+            first -= 1;
+            behind += geometry::dist(&pieces[first].from.tip, &pieces[first].to.tip);
+        }
+        let (mut best, mut best_off) = (raw, (f64::INFINITY, 0.0));
+        let end = (raw + 2).min(pieces.len() - 1);
+        for (k, piece) in pieces.iter().enumerate().take(end + 1).skip(first) {
+            let o = off(piece, &pose);
+            // On a tie the later piece: the one the raw sample is on or nearer it.
+            if o.0 <= best_off.0 {
+                (best, best_off) = (k, o);
+            }
+        }
+        worst_tip = worst_tip.max(best_off.0);
+        worst_axis = worst_axis.max(best_off.1);
+        samples.push((pose, sample.joints.into(), best));
+        if sample.done {
+            break best;
+        }
+        reference.step().unwrap();
+    };
+    assert_eq!(
+        last,
+        pieces.len() - 1,
+        "the reference ends on the last piece"
+    );
+    Followed {
+        samples,
+        tip: worst_tip,
+        axis: worst_axis,
+    }
+}
+
 /// Asserts every joint within its travel, speed and acceleration on every sample; the
 /// peak speed of each joint as a share of its limit.
 pub fn joints_within(samples: &[(Pose, [f64; 5], usize)], joints: &JointLimits) -> [f64; 5] {
@@ -238,7 +285,7 @@ pub fn plan_and_follow(
     let mut reference = planned(program, name, limits)?;
     let seconds = start.elapsed().as_secs_f64();
     let pieces = pieces_of(program);
-    let followed = follow(&pieces, &mut reference);
+    let followed = follow_by_hint(&pieces, &mut reference);
     assert!(
         followed.tip <= limits.tolerance * (1.0 + 1e-6),
         "{name}: tip {} mm",
