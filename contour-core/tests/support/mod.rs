@@ -94,18 +94,14 @@ pub struct Followed {
 /// or ahead of the last match (the path comes back near itself: rasters, rapids out and
 /// in); asserts that it ends on the last piece.
 pub fn follow(pieces: &[Piece], reference: &mut FiveAxisReference) -> Followed {
-    let mut samples: Vec<(Pose, [f64; 5], usize)> = Vec::new();
     let mut near = 0usize;
-    let (mut worst_tip, mut worst_axis) = (0.0f64, 0.0f64);
-    loop {
-        let sample = reference.current();
-        let pose = TableTiltingAc::default().forward(&sample.joints);
+    let mut last_tip: Option<contour_core::geometry::Vector<3>> = None;
+    walk(pieces, reference, |pose, _| {
         let (mut best, mut best_off) = (near, (f64::INFINITY, 0.0));
         let mut best_along = f64::NEG_INFINITY;
         // The way the tip moved since the last sample.
-        let moved = samples
-            .last()
-            .and_then(|(last, _, _)| geometry::unit(&(pose.tip - last.tip)));
+        let moved = last_tip.and_then(|last| geometry::unit(&(pose.tip - last)));
+        last_tip = Some(pose.tip);
         // The pieces from the last match on, as far as 5 mm past it (at least two),
         // then the 20 before it.
         let mut ahead = 0.0;
@@ -119,7 +115,7 @@ pub fn follow(pieces: &[Piece], reference: &mut FiveAxisReference) -> Followed {
             within
         });
         for k in forward.chain(near.saturating_sub(20)..near) {
-            let o = off(&pieces[k], &pose);
+            let o = off(&pieces[k], pose);
             let along = match (
                 moved,
                 geometry::unit(&(pieces[k].to.tip - pieces[k].from.tip)),
@@ -142,24 +138,8 @@ pub fn follow(pieces: &[Piece], reference: &mut FiveAxisReference) -> Followed {
             }
         }
         near = best;
-        worst_tip = worst_tip.max(best_off.0);
-        worst_axis = worst_axis.max(best_off.1);
-        samples.push((pose, sample.joints.into(), best));
-        if sample.done {
-            break;
-        }
-        reference.step().unwrap();
-    }
-    assert_eq!(
-        near,
-        pieces.len() - 1,
-        "the reference ends on the last piece"
-    );
-    Followed {
-        samples,
-        tip: worst_tip,
-        axis: worst_axis,
-    }
+        (best, best_off)
+    })
 }
 
 /// [`follow`] for pieces that are the planned path's own poses (piece k from pose k to
@@ -168,12 +148,8 @@ pub fn follow(pieces: &[Piece], reference: &mut FiveAxisReference) -> Followed {
 /// one) to two pieces past it. A program that comes back over itself (the same hole
 /// drilled by three tools) cannot mislead the match.
 pub fn follow_by_hint(pieces: &[Piece], reference: &mut FiveAxisReference) -> Followed {
-    let mut samples: Vec<(Pose, [f64; 5], usize)> = Vec::new();
-    let (mut worst_tip, mut worst_axis) = (0.0f64, 0.0f64);
-    let last = loop {
-        let sample = reference.current();
-        let pose = TableTiltingAc::default().forward(&sample.joints);
-        let raw = (sample.u.max(0.0) as usize).min(pieces.len() - 1);
+    walk(pieces, reference, |pose, u| {
+        let raw = (u.max(0.0) as usize).min(pieces.len() - 1);
         let mut first = raw;
         let mut behind = 0.0;
         while first > 0 && behind < 10.0 {
@@ -183,14 +159,32 @@ pub fn follow_by_hint(pieces: &[Piece], reference: &mut FiveAxisReference) -> Fo
         let (mut best, mut best_off) = (raw, (f64::INFINITY, 0.0));
         let end = (raw + 2).min(pieces.len() - 1);
         for (k, piece) in pieces.iter().enumerate().take(end + 1).skip(first) {
-            let o = off(piece, &pose);
+            let o = off(piece, pose);
             // On a tie the later piece: the one the raw sample is on or nearer it.
             if o.0 <= best_off.0 {
                 (best, best_off) = (k, o);
             }
         }
-        worst_tip = worst_tip.max(best_off.0);
-        worst_axis = worst_axis.max(best_off.1);
+        (best, best_off)
+    })
+}
+
+/// Walks `reference` to its end, `matched` giving each sample's piece and its (tip, axis)
+/// errors from its pose and the reference's path parameter; asserts that it ends on the
+/// last piece.
+fn walk(
+    pieces: &[Piece],
+    reference: &mut FiveAxisReference,
+    mut matched: impl FnMut(&Pose, f64) -> (usize, (f64, f64)),
+) -> Followed {
+    let mut samples: Vec<(Pose, [f64; 5], usize)> = Vec::new();
+    let (mut worst_tip, mut worst_axis) = (0.0f64, 0.0f64);
+    let last = loop {
+        let sample = reference.current();
+        let pose = TableTiltingAc::default().forward(&sample.joints);
+        let (best, (tip, axis)) = matched(&pose, sample.u);
+        worst_tip = worst_tip.max(tip);
+        worst_axis = worst_axis.max(axis);
         samples.push((pose, sample.joints.into(), best));
         if sample.done {
             break best;
