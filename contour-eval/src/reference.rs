@@ -9,7 +9,7 @@
 
 use contour_core::kinematics::Pose;
 use contour_core::part_program::gcode::{load_gcode, GcodeOptions};
-use contour_core::part_program::{self, FileKind, Side};
+use contour_core::part_program::{self, FileKind};
 use contour_core::path::five_axis::{load_poses_with, ToolPath, BUILTIN_TOOL_PATHS};
 use contour_core::path::planar::{builtin, Path, Program};
 
@@ -77,10 +77,11 @@ pub fn programmed_contour(spec: &str, gcode: &GcodeOptions) -> Result<(Path, Vec
     let mut part = load_gcode(spec, gcode).map_err(|e| e.to_string())?;
     let mut by_line = std::collections::BTreeMap::new();
     for m in &mut part.moves {
-        let offset = m.compensation.take().map_or(0.0, |c| match c.side {
-            Side::Left => -c.radius,
-            Side::Right => c.radius,
-        });
+        // Signed as the contour error, > 0 right of travel: the left normal's opposite.
+        let offset = m
+            .compensation
+            .take()
+            .map_or(0.0, |c| -c.side.sign() * c.radius);
         by_line.entry(m.place.line).or_insert(offset);
     }
     let program = Program::from_part_program(&part).map_err(|e| e.to_string())?;

@@ -115,9 +115,7 @@ fn fit_centre(
     if length2 == 0.0 {
         return Ok(c);
     }
-    // Onto the perpendicular bisector of the chord.
-    let middle = (start + end) * 0.5;
-    let fitted = c - chord * ((c - middle).dot(&chord) / length2);
+    let fitted = nearest_on_bisector(start, end, c);
     let off = off_the_cut_path(start, end, c, fitted, clockwise);
     if off > tolerance || off.is_nan() {
         return Err(format!(
@@ -129,6 +127,14 @@ fn fit_centre(
         ));
     }
     Ok(fitted)
+}
+
+/// The point of the perpendicular bisector of `start`–`end` (two distinct points) nearest
+/// `c`: the centre nearest `c` of a circle through both.
+pub fn nearest_on_bisector(start: Vector2, end: Vector2, c: Vector2) -> Vector2 {
+    let chord = end - start;
+    let middle = (start + end) * 0.5;
+    c - chord * ((c - middle).dot(&chord) / chord.dot(&chord))
 }
 
 /// How far the arc about `fitted` strays from the spiral a controller cuts about the

@@ -726,7 +726,7 @@ impl<'a> Reader<'a> {
         if sweep <= 1e-12 {
             sweep += std::f64::consts::TAU;
         }
-        let step = 2.0 * math::acos((1.0 - self.options.arc_sag / circle.radius).max(-1.0));
+        let step = super::chord_angle(circle.radius, self.options.arc_sag);
         let chords = ((sweep / step).ceil() as usize).max(1);
         if chords >= MAX_MOVES.saturating_sub(self.data.moves.len()) {
             return Err(self.fail(

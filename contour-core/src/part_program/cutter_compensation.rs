@@ -12,8 +12,9 @@
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
 
+use super::arc_words::nearest_on_bisector;
 use super::{Compensation, Motion, PartMove, PartProgram, Plane, Side};
-use crate::geometry::{self, Vector2};
+use crate::geometry::{self, Vector, Vector2};
 use crate::math;
 use crate::path::{CircularArc, PathError};
 
@@ -234,9 +235,9 @@ struct Pass<'a> {
     file: &'a str,
     moves: Vec<PartMove>,
     /// The programmed position after the last move read.
-    programmed: crate::geometry::Vector<3>,
+    programmed: Vector<3>,
     /// The tool centre there.
-    centre: crate::geometry::Vector<3>,
+    centre: Vector<3>,
     stretch: Option<Stretch>,
     /// The plane of the stretch that ended, until the exit move leaves it.
     exiting: Option<Plane>,
@@ -275,9 +276,7 @@ impl Pass<'_> {
             return self.uncompensated(m, from);
         };
         let plane = c.plane;
-        let moves_in_plane = matches!(m.motion, Motion::Arc { .. })
-            || geometry::dist(&plane.in_plane(&from), &plane.in_plane(&m.end)) > SAME_POINT;
-        if !moves_in_plane {
+        if !moves_in_plane(plane, &from, m) {
             let stretch = self.stretch.as_mut().expect("in a stretch");
             if stretch.pending.is_none() {
                 // Before the entry move: the tool is where it was programmed to be.
@@ -315,16 +314,10 @@ impl Pass<'_> {
 
     /// A move without compensation: as programmed, the one after a stretch (the exit move)
     /// straight from where the tool centre stands.
-    fn uncompensated(
-        &mut self,
-        m: &PartMove,
-        from: crate::geometry::Vector<3>,
-    ) -> Result<(), PathError> {
+    fn uncompensated(&mut self, m: &PartMove, from: Vector<3>) -> Result<(), PathError> {
         let mut m = m.clone();
         if let Some(plane) = self.exiting {
-            let moves_in_plane = matches!(m.motion, Motion::Arc { .. })
-                || geometry::dist(&plane.in_plane(&from), &plane.in_plane(&m.end)) > SAME_POINT;
-            if !moves_in_plane {
+            if !moves_in_plane(plane, &from, &m) {
                 m.end = plane.point(plane.in_plane(&self.centre), plane.across(&m.end));
             } else if matches!(m.motion, Motion::Arc { .. }) {
                 return Err(self.error(
@@ -347,17 +340,9 @@ impl Pass<'_> {
 
     /// The tool centre's piece for the programmed move `m` from `from`: the entry move
     /// when the stretch has none yet.
-    fn piece(
-        &self,
-        m: &PartMove,
-        from: crate::geometry::Vector<3>,
-        c: Compensation,
-    ) -> Result<Piece, PathError> {
+    fn piece(&self, m: &PartMove, from: Vector<3>, c: Compensation) -> Result<Piece, PathError> {
         let plane = c.plane;
-        let side = match c.side {
-            Side::Left => 1.0,
-            Side::Right => -1.0,
-        };
+        let side = c.side.sign();
         let (p0, p1) = (plane.in_plane(&from), plane.in_plane(&m.end));
         let entry = self.stretch.as_ref().is_some_and(|s| s.pending.is_none());
         let start = plane.in_plane(&self.centre);
@@ -414,10 +399,7 @@ impl Pass<'_> {
         p1: Vector2,
         c: Compensation,
     ) -> Result<Piece, PathError> {
-        let side = match c.side {
-            Side::Left => 1.0,
-            Side::Right => -1.0,
-        };
+        let side = c.side.sign();
         let ccw = arc.sweep() > 0.0;
         let inward = if ccw { side } else { -side };
         let radius = arc.radius() - inward * c.radius;
@@ -473,10 +455,7 @@ impl Pass<'_> {
     ) -> Result<Piece, PathError> {
         let offset = self.offset_arc(m, arc, p1, c)?;
         let end = offset.to;
-        let chord = end - start;
-        let middle = (start + end) * 0.5;
-        let o = arc.center();
-        let centre = o - chord * ((o - middle).dot(&chord) / chord.dot(&chord));
+        let centre = nearest_on_bisector(start, end, arc.center());
         let radius = geometry::dist(&start, &centre);
         let angle = |p: Vector2| math::atan2(p[1] - centre[1], p[0] - centre[0]);
         let (a0, a1) = (angle(start), angle(end));
@@ -560,6 +539,13 @@ impl Pass<'_> {
     }
 }
 
+/// Whether `m`, from `from`, moves in `plane` (an arc always does; a move of the third
+/// axis alone, or a dwell, does not).
+fn moves_in_plane(plane: Plane, from: &Vector<3>, m: &PartMove) -> bool {
+    matches!(m.motion, Motion::Arc { .. })
+        || geometry::dist(&plane.in_plane(from), &plane.in_plane(&m.end)) > SAME_POINT
+}
+
 /// The corner between `prev` and `next`: at a convex one, the arc of the tool's radius
 /// about the programmed corner that joins them; at a concave one, both cut where they
 /// meet (an error where they do not meet on both: the tool would gouge the part).
@@ -568,10 +554,7 @@ fn join(prev: &mut Piece, next: &mut Piece, c: Compensation) -> Result<Option<Pi
         next.start_at(prev.to);
         return Ok(None);
     }
-    let side = match c.side {
-        Side::Left => 1.0,
-        Side::Right => -1.0,
-    };
+    let side = c.side.sign();
     let turn = geometry::cross(&prev.end_tangent, &next.start_tangent) * side;
     let corner = prev.corner;
     if turn > 0.0 {

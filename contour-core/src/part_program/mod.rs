@@ -126,6 +126,24 @@ pub enum Side {
     Right,
 }
 
+impl Side {
+    /// +1 left of the motion, −1 right: the factor of the left normal that points to the
+    /// tool.
+    pub fn sign(self) -> f64 {
+        match self {
+            Side::Left => 1.0,
+            Side::Right => -1.0,
+        }
+    }
+}
+
+/// The angle of a chord of a circle of `radius` whose sag is `sag` (both mm, > 0): the
+/// most an arc may turn per chord to stay within `sag` of it (a whole turn when the sag
+/// reaches the diameter).
+pub fn chord_angle(radius: f64, sag: f64) -> f64 {
+    2.0 * crate::math::acos((1.0 - sag / radius).max(-1.0))
+}
+
 /// Cutter radius compensation in force on a move (G41, G42): the programmed contour is
 /// the part's edge, and the tool's centre runs `radius` mm to its `side` in `plane`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -244,8 +262,9 @@ impl PartProgram {
         let mut from = self.start;
         for m in &self.moves {
             if let Motion::Arc { arc, plane } = &m.motion {
-                let step = 2.0 * crate::math::acos((1.0 - sag / arc.radius()).max(-1.0));
-                let chords = (arc.sweep().abs() / step).ceil().max(1.0);
+                let chords = (arc.sweep().abs() / chord_angle(arc.radius(), sag))
+                    .ceil()
+                    .max(1.0);
                 if chords + moves.len() as f64 >= max_moves as f64 {
                     return Err(PathError::File {
                         file: self.file.clone(),
