@@ -67,6 +67,11 @@ impl SampleClock {
         due
     }
 
+    /// When the latest sample taken was due (the start before the first).
+    pub fn latest(&self) -> f64 {
+        self.due(self.taken.saturating_sub(1))
+    }
+
     /// Samples taken so far.
     pub fn taken(&self) -> u64 {
         self.taken

@@ -19,8 +19,8 @@ use crate::framework::variable_table::{axis_block, variable_table, Axis, AxisUni
 use crate::framework::variables::{EnumItem, EnumType, Start, Values, Variable};
 use contour_core::contour::planar::{Estimator, EstimatorKind, FreeCurveEstimator, ON_PATH};
 use contour_core::control::{
-    CccConfig, ConfigError, ControllerConfig, CrossCoupledController, FuzzyFactor, FuzzyFactors,
-    Parameter, Pid, PidGains,
+    CccConfig, ConfigError, ControllerConfig, CrossCoupledController, FeedForward, FuzzyFactor,
+    FuzzyFactors, Parameter, Pid, PidGains,
 };
 use contour_core::geometry::{Vector, Vector2};
 
@@ -167,10 +167,11 @@ pub static INFO: ModelInfo = ModelInfo {
 /// PIDs, unused in the plane, joined its state). Version 3: the program estimator's track
 /// keeps its last two foot points (its next search's guess). Version 4: the velocity
 /// feed-forward gain. Version 5: the acceleration feed-forward time. Version 6: a program's
-/// moves carry their standstill (dwells, stops, Z alone).
+/// moves carry their standstill (dwells, stops, Z alone). Version 7: the feed-forward
+/// remembers its inputs (the acceleration at the middle of the hold).
 const LAYOUT: StateLayout = StateLayout {
     model: "ContourCCC2D",
-    version: 6,
+    version: 7,
 };
 
 /// The G-code reader's parameters.
@@ -181,9 +182,9 @@ const READER: path_parameter::ReaderParameters = path_parameter::ReaderParameter
     tools: TOOL_RADII,
 };
 
-type State = ControllerState<CrossCoupledController<Estimator>>;
+type State = ControllerState<CrossCoupledController<Estimator>, 2>;
 
-impl SavedController for CrossCoupledController<Estimator> {
+impl SavedController<2> for CrossCoupledController<Estimator> {
     const AXES: &'static [Axis] = &XY;
 
     fn ts(&self) -> f64 {
@@ -331,8 +332,10 @@ impl Model for ContourCCC2D {
         self.state = Some(State {
             controller,
             clock: SampleClock::new(start_time, config.ts),
-            feed_forward: FEED_FORWARD.get(values),
-            acceleration_feed_forward: ACCELERATION_FEED_FORWARD.get(values),
+            feed_forward: FeedForward::new(
+                FEED_FORWARD.get(values),
+                ACCELERATION_FEED_FORWARD.get(values),
+            )?,
         });
         U.set(values, &Vector2::zeros());
         CONTOUR_ERROR.set(values, 0.0);
@@ -345,9 +348,12 @@ impl Model for ContourCCC2D {
         let state = self.state.as_mut().ok_or("not initialized")?;
         let reference = REF.vector(values);
         let actual = POS.vector(values);
-        let feed_forward = VREF.vector(values) * state.feed_forward
-            + AREF.vector(values) * state.acceleration_feed_forward;
+        state
+            .feed_forward
+            .read(time, VREF.vector(values), AREF.vector(values));
+        let ts = state.clock.period();
         while state.clock.take_before(time + step) {
+            let feed_forward = state.feed_forward.command(state.clock.latest(), ts);
             let out = state
                 .controller
                 .sample_with(reference, actual, feed_forward);

@@ -23,7 +23,7 @@ use contour_core::contour::five_axis::hmm::HmmParams;
 use contour_core::control::{
     CccConfig, CccMode, ConfigError, FuzzyFactor, FuzzyFactors, Parameter, Pid, PidGains,
 };
-use contour_core::control::{FiveAxisConfig, FiveAxisController};
+use contour_core::control::{FeedForward, FiveAxisConfig, FiveAxisController};
 use contour_core::geometry::Vector;
 
 /// Start values: the controller library's documented defaults.
@@ -273,15 +273,16 @@ pub static INFO: ModelInfo = ModelInfo {
 /// Version 1: `Option<State>` as below. Version 2: the controller carries the machine's
 /// limits and the guard of its correction. Version 3: the guard also remembers the
 /// commands sent and the joints' shortfall of travel. Version 4: the feed-forward gains;
-/// the guard averages the joints' speeds and commands (`lagging`).
+/// the guard averages the joints' speeds and commands (`lagging`). Version 5: the
+/// feed-forward remembers its inputs (the acceleration at the middle of the hold).
 const LAYOUT: StateLayout = StateLayout {
     model: "ContourCCC5X",
-    version: 4,
+    version: 5,
 };
 
-type State = ControllerState<FiveAxisController>;
+type State = ControllerState<FiveAxisController, 5>;
 
-impl SavedController for FiveAxisController {
+impl SavedController<5> for FiveAxisController {
     const AXES: &'static [Axis] = &XYZAC;
 
     fn ts(&self) -> f64 {
@@ -445,8 +446,10 @@ impl Model for ContourCCC5X {
         self.state = Some(State {
             controller,
             clock: SampleClock::new(start_time, config.ts),
-            feed_forward: FEED_FORWARD.get(values),
-            acceleration_feed_forward: ACCELERATION_FEED_FORWARD.get(values),
+            feed_forward: FeedForward::new(
+                FEED_FORWARD.get(values),
+                ACCELERATION_FEED_FORWARD.get(values),
+            )?,
         });
         Self::write_zero_outputs(values);
         Ok(())
@@ -456,10 +459,12 @@ impl Model for ContourCCC5X {
         let state = self.state.as_mut().ok_or("not initialized")?;
         let reference = REF.vector(values);
         let actual = POS.vector(values);
-        let feed_forward = VREF.vector(values) * state.feed_forward
-            + AREF.vector(values) * state.acceleration_feed_forward;
+        state
+            .feed_forward
+            .read(time, VREF.vector(values), AREF.vector(values));
         let ts = state.controller.config().ts;
         while state.clock.take_before(time + step) {
+            let feed_forward = state.feed_forward.command(state.clock.latest(), ts);
             // Inputs are finite (fmi2SetReal refuses others), so a sample cannot fail.
             // The inputs were set at this communication point and are held over it.
             let out = state

@@ -7,7 +7,7 @@ use crate::framework::sample_clock::SampleClock;
 use crate::framework::saved_state::SavedState;
 use crate::framework::variable_table::{Axis, AxisTemplate, AxisUnit, AxisWord};
 use crate::framework::variables::{Start, Variable};
-use contour_core::control::{CccMode, Gain, Pid};
+use contour_core::control::{CccMode, FeedForward, Gain, Pid};
 
 /// A Real parameter ≥ 0 (a gain or factor).
 pub const fn nonnegative(name: &'static str, start: f64, description: &'static str) -> Variable {
@@ -23,33 +23,17 @@ pub const FEED_FORWARD: Variable = nonnegative(
      reference's velocity)",
 );
 
-/// The acceleration feed-forward time: the command gains `accelerationFeedForward`·aref
-/// (a drive's velocity loop lags by about its time constant times the acceleration).
+/// The acceleration feed-forward time T_a: the command gains T_a times the acceleration
+/// at the middle of the sample's hold ([`FeedForward`]). A drive whose velocity loop has
+/// the time constant τ takes T_a = Ts/(1 − e^(−Ts/τ)) ≈ τ + Ts/2.
 pub const ACCELERATION_FEED_FORWARD: Variable = nonnegative(
     "accelerationFeedForward",
     0.0,
-    "Acceleration feed-forward time: the command adds accelerationFeedForward * aref; the \
-     drives' velocity-loop time constant cancels their lag behind the velocity feed-forward \
-     (0: none)",
+    "Acceleration feed-forward time: the command adds accelerationFeedForward times aref \
+     extrapolated to the middle of the sample's hold; for drives whose velocity loops have \
+     the time constant tau, Ts/(1 - exp(-Ts/tau)), about tau + Ts/2 (0: none)",
 )
 .unit("s");
-
-/// Checks a restored state's feed-forward parameters (`feedForward`,
-/// `accelerationFeedForward`) as the parameters' own checks would.
-fn check_feed_forward(velocity: f64, acceleration: f64) -> Result<(), String> {
-    for (parameter, value) in [
-        (&FEED_FORWARD, velocity),
-        (&ACCELERATION_FEED_FORWARD, acceleration),
-    ] {
-        if !(value.is_finite() && value >= 0.0) {
-            return Err(format!(
-                "{} = {value} must be finite and >= 0",
-                parameter.name
-            ));
-        }
-    }
-    Ok(())
-}
 
 /// A position-loop gain of every axis (`axis.x.Kp`, `axis.C.Kd`, …), ≥ 0.
 pub const fn axis_gain(
@@ -124,18 +108,15 @@ pub fn check_pid(name: &str, pid: &Pid, ts: f64) -> Result<(), String> {
 /// A controller model's internal state (saved as `Option<ControllerState<_>>` with the
 /// model's layout): its control law `C`, the sample clock it runs on and the feed-forward.
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
-pub struct ControllerState<C> {
+pub struct ControllerState<C, const D: usize> {
     pub controller: C,
     pub clock: SampleClock,
-    /// The velocity feed-forward gain (`feedForward`).
-    pub feed_forward: f64,
-    /// The acceleration feed-forward time (`accelerationFeedForward`), s.
-    pub acceleration_feed_forward: f64,
+    pub feed_forward: FeedForward<D>,
 }
 
 /// A controller model's control law, as the check of its restored [`ControllerState`]
 /// sees it: the part both models share is checked once, the rest by the model.
-pub trait SavedController: Sized {
+pub trait SavedController<const D: usize>: Sized {
     /// The axes of the position loops.
     const AXES: &'static [Axis];
 
@@ -150,18 +131,20 @@ pub trait SavedController: Sized {
 
     /// The model's own part of the check: its contour laws and their memories (`state`
     /// whole, so that a field's path in a message starts at the state).
-    fn check_rest(state: &ControllerState<Self>) -> Result<(), String>;
+    fn check_rest(state: &ControllerState<Self, D>) -> Result<(), String>;
 }
 
-impl<C> SavedState for ControllerState<C>
+impl<C, const D: usize> SavedState for ControllerState<C, D>
 where
-    C: SavedController + serde::de::DeserializeOwned,
+    C: SavedController<D> + serde::de::DeserializeOwned,
 {
     /// Checks a restored state like the parameters it was built from; the error names
     /// the offending value.
     fn validate(&self, time: f64, _environment: &Environment) -> Result<(), String> {
         self.clock.validate_at(time)?;
-        check_feed_forward(self.feed_forward, self.acceleration_feed_forward)?;
+        self.feed_forward
+            .validate()
+            .map_err(|e| format!("feed-forward: {e}"))?;
         let controller = &self.controller;
         controller
             .check_config()

@@ -6,6 +6,7 @@ mod ccc_law;
 mod config;
 mod correction_guard;
 mod cross_coupled;
+mod feed_forward;
 mod five_axis;
 mod fuzzy;
 mod pid;
@@ -18,6 +19,7 @@ pub use config::{
 };
 pub use correction_guard::{CorrectionGuard, Hold, LIMIT_SLACK};
 pub use cross_coupled::{ControlOutput, CrossCoupledController};
+pub use feed_forward::FeedForward;
 pub use five_axis::{FiveAxisConfig, FiveAxisController, FiveAxisOutput, SampleError};
 pub use fuzzy::{centroid, evaluate_table, membership, FuzzyEngine, FuzzyOutput, UNIVERSE};
 pub use pid::{Pid, PidGains};

@@ -338,20 +338,21 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
     let (controller_5x, controller_5x_bytes) = five_axis(&contour_ccc_5x::INFO);
     let (interpolator_5x, interpolator_5x_bytes) = five_axis(&path_interpolator_5x::INFO);
 
-    // The models' current layout versions: ContourCCC2D 6 (a program's moves carry their
-    // standstill; 5: the acceleration feed-forward; 4: the feed-forward gain; 3: the
+    // The models' current layout versions: ContourCCC2D 7 (the feed-forward remembers its
+    // inputs; 6: a program's moves carry their standstill; 5: the acceleration feed-forward; 4: the feed-forward gain; 3: the
     // program estimator keeps its last two feet; 2: the controller became N-axis),
     // XYServoPlant 3 (each axis gained its effects and the table behind the play; 2: the
     // lead became a transmission), PathInterpolator2D 3 (a program's moves carry their
-    // standstill; 2: the planned reference joined the constant-feed one), ContourCCC5X 4 (the feed-forward
-    // gains, the guard's averaged speeds and commands), PathInterpolator5X 5 (a plan's
+    // standstill; 2: the planned reference joined the constant-feed one), ContourCCC5X 5 (the feed-forward
+    // remembers its inputs; 4: the feed-forward gains, the guard's averaged speeds and
+    // commands), PathInterpolator5X 5 (a plan's
     // inputs carry a CL file's speeds; 4: the sample before the current one, for vref and
     // aref).
     for (i, bytes, model, version) in [
-        (&controller, &controller_bytes, "ContourCCC2D", 6u16),
+        (&controller, &controller_bytes, "ContourCCC2D", 7u16),
         (&plant_instance, &plant_bytes, "XYServoPlant", 3),
         (&interpolator, &interpolator_bytes, "PathInterpolator2D", 3),
-        (&controller_5x, &controller_5x_bytes, "ContourCCC5X", 4),
+        (&controller_5x, &controller_5x_bytes, "ContourCCC5X", 5),
         (
             &interpolator_5x,
             &interpolator_5x_bytes,
