@@ -2,7 +2,8 @@
 XYServoPlant with friction through the FMUs. Its figures come from contour-eval; here
 they are recomputed from the runs' CSVs by the standard's definitions (scipy's
 least_squares for the least-squares circle), and the controllers must rank as a machine
-tool engineer expects: the CCC shrinks the circular deviation, feed-forward more."""
+tool engineer expects: the CCC shrinks the circular deviation, feed-forward more, and
+the CCC on top of feed-forward (the shipped loop) keeps it."""
 
 import subprocess
 
@@ -37,7 +38,7 @@ def test_the_figures_are_the_standards_and_rank_the_controllers(results):
     figures, out = results
     ballbar_demo.print_table(figures)
     for label in figures:
-        name = label.replace(" + ", "_").replace(" ", "_")
+        name = ballbar_demo.file_name(label)
         assert (out / f"ballbar_{name}.png").stat().st_size > 10_000
         for index, direction in enumerate(("ccw", "cw")):
             run = np.genfromtxt(out / f"ballbar_{name}_{direction}.csv", delimiter=",", names=True)
@@ -47,4 +48,7 @@ def test_the_figures_are_the_standards_and_rank_the_controllers(results):
             assert abs(figures[label]["G"][index] - circular_deviation(points)) < 1e-3
     g = {label: f["Gb"] for label, f in figures.items()}
     assert g["fuzzy CCC"] < 0.6 * g["no CCC"]
-    assert g["fuzzy CCC + feed-forward"] < 0.5 * g["fuzzy CCC"]
+    # Feed-forward takes the lag but not the friction's quadrant glitch; the CCC on top
+    # (the shipped loop) takes most of that.
+    assert g["feed-forward"] < 0.5 * g["no CCC"]
+    assert g["fuzzy CCC + feed-forward (shipped)"] < 0.5 * min(g["fuzzy CCC"], g["feed-forward"])

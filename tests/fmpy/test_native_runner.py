@@ -16,6 +16,7 @@ import pytest
 
 from contour_fmu.engines import native
 from contour_fmu.engines.master import CLOSED_LOOP_RECORD, FIVE_AXIS_RECORD, closed_loop, five_axis_closed_loop
+from contour_fmu.loops.wiring import LOOPS
 from helpers import faulty_fmu
 
 STEP = 1e-3
@@ -55,12 +56,14 @@ def test_native_runner_equals_the_fmpy_master_bit_for_bit(loops, loop, scheme):
 def test_the_schemes_differ_and_a_parameter_set_equals_the_initial_copies(loops):
     """The Gauss-Seidel and Jacobi runs are different trajectories (the comparison above
     can tell them apart), and the five-axis path's parameter set starts the plant where the
-    initial copies do."""
+    initial copies do (and sets the controller's feed-forward, as the wiring reads it)."""
     ssd = loops / "five_axis.ssd"
     record = [("plant", "pos.X"), ("plant", "pos.Y"), ("controller", "u.X")]
     gs = native.run(ssd, parameter_set="tilted_helix", stop=0.2, record=record)
     jacobi = native.run(ssd, parameter_set="tilted_helix", stop=0.2, record=record, scheme="jacobi")
-    copied = native.run(ssd, start={"interpolator": {"path": "tilted_helix"}}, stop=0.2, record=record)
+    copied = native.run(ssd, start={"interpolator": {"path": "tilted_helix"},
+                                    "controller": LOOPS["five_axis"].feed_forward},
+                        stop=0.2, record=record)
     assert np.abs(gs["plant.pos.X"] - jacobi["plant.pos.X"]).max() > 1e-4
     for column in gs.dtype.names:
         assert np.array_equal(gs[column], copied[column]), column
@@ -191,11 +194,16 @@ def test_until_the_path_ends_then_settle(loops):
     """--until interpolator.done ends the run `settle` after the path's end, as the
     campaigns' runs end."""
     rows = native.run(loops / "two_axis.ssd", parameter_set="circle", until="interpolator.done",
-                      settle=0.05, max_stop=5.0, record=[("interpolator", "done"), ("plant", "pos.x")])
+                      settle=0.05, max_stop=5.0, record=[("interpolator", "done"), ("plant", "pos.x"),
+                                                         ("interpolator", "plannedDuration")])
     first_done = int(np.argmax(rows["interpolator.done"] > 0))
     assert rows["interpolator.done"][first_done - 1] == 0
     assert len(rows) == first_done + 50 + 1
-    assert abs(rows["time"][first_done] - 2.0) < 0.01  # the circle takes 2 s at its feed
+    # The circle takes 2 s at its feed, and the shipped set plans it: more to start and
+    # stop within 2000 mm/s2 and 1e5 mm/s3; done at the first sample of the planned end.
+    planned = rows["interpolator.plannedDuration"][-1]
+    assert 2.03 < planned < 2.1
+    assert planned <= rows["time"][first_done] < planned + 1e-3 + 1e-9
     with pytest.raises(native.RunFailed, match="the end signal never came within the longest run, 1"):
         native.run(loops / "two_axis.ssd", parameter_set="circle", until="interpolator.done",
                    max_stop=1.0)

@@ -14,6 +14,7 @@ usage: python -m contour_fmu.demo.ballbar [--fmu-dir DIR] [--out DIR]
 
 import argparse
 import json
+import re
 import subprocess
 from pathlib import Path
 
@@ -21,6 +22,7 @@ import numpy as np
 
 from .. import repo
 from ..engines.master import closed_loop
+from ..loops.wiring import LOOPS
 from ..output_files import write_csv
 
 RADIUS = 50.0  # mm, a ballbar's
@@ -30,11 +32,13 @@ ACCEL, JERK = 2000.0, 1e5  # the part demo's limits (usage.md)
 # 0.8 N.m to break away, the drop over 1 mm/s.
 FRICTION = {f"{axis}.{name}": value for axis in "xy"
             for name, value in (("coulomb", 0.5), ("stiction", 0.8), ("stribeckVelocity", 1.0))}
-CONTROLLERS = [
-    ("no CCC", {"ccc.enable": False}),
-    ("fuzzy CCC", {}),
-    ("fuzzy CCC + feed-forward", {"feedForward": 1.0}),
-]
+# No CCC, the fuzzy CCC, feed-forward alone and both (the shipped loop's settings).
+CONTROLLERS = LOOPS["two_axis"].variants()
+
+
+def file_name(label):
+    """A controller's label as part of a file name."""
+    return re.sub(r"[^A-Za-z0-9-]+", "_", label).strip("_")
 
 
 def program(clockwise):
@@ -79,7 +83,7 @@ def ballbar_demo(fmu_dir, out, tool=None):
         files[direction].write_text(program(clockwise))
     results = {}
     for label, controller in CONTROLLERS:
-        name = label.replace(" + ", "_").replace(" ", "_")
+        name = file_name(label)
         runs, windows = [], []
         for direction, file in files.items():
             before, start, end = run(fmu_dir, file, controller)
@@ -104,11 +108,11 @@ def ballbar_demo(fmu_dir, out, tool=None):
 def print_table(results):
     print(f"Ballbar test (ISO 230-4) on XYServoPlant with friction: R {RADIUS:g} mm, F{FEED:g}, "
           f"counter-clockwise / clockwise; um")
-    print(f"{'controller':26} {'G ccw':>7} {'G cw':>7} {'G(b)':>7} {'F min':>8} {'F max':>8}")
+    print(f"{'controller':34} {'G ccw':>7} {'G cw':>7} {'G(b)':>7} {'F min':>8} {'F max':>8}")
     for label, r in results.items():
         f_min = min(f[0] for f in r["F"])
         f_max = max(f[1] for f in r["F"])
-        print(f"{label:26} {r['G'][0]:7.3f} {r['G'][1]:7.3f} {r['Gb']:7.3f} {f_min:8.3f} "
+        print(f"{label:34} {r['G'][0]:7.3f} {r['G'][1]:7.3f} {r['Gb']:7.3f} {f_min:8.3f} "
               f"{f_max:8.3f}")
 
 

@@ -19,7 +19,7 @@ import numpy as np
 from ..checks.five_axis_truth import contour_errors, forward
 from ..engines.master import Master, Unit, five_axis_closed_loop
 from ..extras import needs
-from ..loops.wiring import FIVE_AXIS_JOINTS
+from ..loops.wiring import FIVE_AXIS_JOINTS, LOOPS
 from ..output_files import write_cross_check, write_csv
 from . import cam_paths
 
@@ -27,10 +27,9 @@ STEP = 1e-3
 SETTLE = 0.1  # seconds run after the reference is done, as the in-process simulator
 FEED = 50.0
 
-VARIANTS = [
-    ("no CCC", {"ccc.enable": False}),
-    ("five-axis CCC", {}),  # the FMU's defaults: fuzzy-PID laws on tip and orientation
-]
+# No CCC, the five-axis CCC with the FMU's defaults (fuzzy-PID laws on tip and orientation),
+# feed-forward alone and both: the shipped loop (contour_fmu/loops/five_axis.ssd).
+VARIANTS = LOOPS["five_axis"].variants("five-axis CCC")
 
 CROSS_CHECK_INPUTS = [(f"ref.{j}", f"interpolator.ref.{j}") for j in FIVE_AXIS_JOINTS] + [
     (f"pos.{j}", f"plant.pos.{j}") for j in FIVE_AXIS_JOINTS]
@@ -181,9 +180,9 @@ def print_table(rows):
           "FiveAxisPlant), Ts = 1 ms;")
     print("true contour errors: tool tip in um, tool orientation in urad; reductions of "
           "max and mean against no CCC")
-    print(f"{'path':13} {'feed':>5}  {'controller':14} {'tip max':>8} {'tip mean':>8} "
+    print(f"{'path':13} {'feed':>5}  {'controller':38} {'tip max':>8} {'tip mean':>8} "
           f"{'ori max':>8} {'ori mean':>8} {'red. tip %':>11} {'red. ori %':>11}")
     for label, feed, name, tmax, tmean, omax, omean, rtmax, rtmean, romax, romean in rows:
-        print(f"{label:13} {feed:5.0f}  {name:14} {tmax * 1e3:8.3f} {tmean * 1e3:8.3f} "
+        print(f"{label:13} {feed:5.0f}  {name:38} {tmax * 1e3:8.3f} {tmean * 1e3:8.3f} "
               f"{omax * 1e6:8.1f} {omean * 1e6:8.1f} {rtmax:5.1f}/{rtmean:5.1f} "
               f"{romax:5.1f}/{romean:5.1f}")

@@ -63,6 +63,7 @@ from .. import repo
 from ..checks.gcode import distance, joins, mirror_program, point_at, read_program, starts
 from ..engines.fmu_log import FmuLog
 from ..engines.master import closed_loop, set_value
+from ..loops.wiring import LOOPS
 from ..output_files import write_csv
 
 STEP = 1e-3
@@ -84,10 +85,10 @@ def default_program():
         return None
     return None if root is None else root / PROGRAM
 
-VARIANTS = [
-    ("no CCC", {"ccc.enable": False}),
-    ("fuzzy-PID CCC", {}),  # the FMU's defaults: the paper's fuzzy factors (1, 1.2, 87, 8.5, 4)
-]
+# No CCC, the fuzzy-PID CCC with the FMU's defaults (the paper's fuzzy factors 1, 1.2, 87,
+# 8.5, 4), feed-forward alone and both: the shipped loop (contour_fmu/loops/two_axis.ssd).
+VARIANTS = LOOPS["two_axis"].variants("fuzzy-PID CCC")
+COLOURS = ("tab:orange", "tab:blue", "tab:green", "tab:red")  # one per variant
 
 # --- the runs -----------------------------------------------------------------------------
 
@@ -246,7 +247,7 @@ def plot(out, result, magnify=20.0):
             dense.append(p.centre + p.radius * np.column_stack([np.cos(phi), np.sin(phi)]))
     dense = np.concatenate(dense)
     part_ax.plot(*dense.T, "k-", lw=1.0, label="programmed")
-    for r, colour in zip(result.runs, ("tab:orange", "tab:blue")):
+    for r, colour in zip(result.runs, COLOURS):
         pos = np.column_stack([r.before["plant.pos.x"], r.before["plant.pos.y"]])
         feet = _feet(pieces, pos)
         shown = feet + magnify * (pos - feet)
@@ -259,10 +260,10 @@ def plot(out, result, magnify=20.0):
     part_ax.set_title(f"{result.name}: the part and the tracking")
     part_ax.legend(fontsize=7, loc="center")
 
-    for r, colour in zip(result.runs, ("tab:orange", "tab:blue")):
+    for r, colour in zip(result.runs, COLOURS):
         order = np.argsort(r.before["time"])
         error_ax.plot(r.along[order], r.true[order] * 1e3, "-", color=colour, lw=0.8, label=r.label)
-    for r, colour in zip(result.mirrored_runs, ("tab:orange", "tab:blue")):
+    for r, colour in zip(result.mirrored_runs, COLOURS):
         error_ax.plot(r.along, r.true * 1e3, ":", color=colour, lw=0.8, label=f"{r.label}, mirror")
     seen = set()
     for s, kind in joins(pieces):
@@ -305,10 +306,10 @@ def print_table(result):
           f"(+{SETTLE:g} s settling); the reader skipped {len(result.warnings)} kinds of words")
     print("|true contour error| in um from the programmed part; est.: ContourCCC2D's contourError "
           "(estimator program, from the planned part); ref. off: the reference's own distance")
-    print(f"{'':6} {'controller':15} {'max':>8} {'mean':>8} {'est. max':>9} {'|est-true|':>10} "
+    print(f"{'':6} {'controller':38} {'max':>8} {'mean':>8} {'est. max':>9} {'|est-true|':>10} "
           f"{'ref. off':>8} {'max red. %':>10} {'mean red. %':>11}")
     for which, label, emax, emean, est, off, ref, rmax, rmean in result.rows():
-        print(f"{which:6} {label:15} {emax * 1e3:8.3f} {emean * 1e3:8.3f} {est * 1e3:9.3f} "
+        print(f"{which:6} {label:38} {emax * 1e3:8.3f} {emean * 1e3:8.3f} {est * 1e3:9.3f} "
               f"{off * 1e3:10.3f} {ref * 1e3:8.3f} {rmax:10.1f} {rmean:11.1f}")
     print(f"the mirrored program's reference against the original's mirrored: max "
           f"{result.mirror_mismatch:.3g} mm")

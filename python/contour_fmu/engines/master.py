@@ -194,7 +194,10 @@ CLOSED_LOOP_RECORD = [
 def closed_loop(fmu_dir, path="circle", feed=None, stop=2.0, step=1e-3, controller=None,
                 plant=None, scheme="gauss-seidel", interpolator=None):
     """Runs PathInterpolator2D -> ContourCCC2D <- XYServoPlant; returns (before, after).
-    `interpolator` holds further PathInterpolator2D start values (they override `path`)."""
+    `interpolator` holds further PathInterpolator2D start values (they override `path`).
+    The FMUs' own defaults apply where nothing is given: the paper's loop, without
+    feed-forward; `controller=LOOPS["two_axis"].feed_forward` (contour_fmu.loops.wiring)
+    adds the shipped loop's."""
     return _shipped_loop(TWO_AXIS, CLOSED_LOOP_RECORD, fmu_dir, path, feed, stop, step,
                          controller, plant, scheme, interpolator)
 

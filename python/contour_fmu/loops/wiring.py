@@ -79,6 +79,27 @@ class Loop:
         return self.structure.initial_copies
 
     @property
+    def feed_forward(self):
+        """The controller's feed-forward settings every parameter set of the loop's SSP file
+        holds: fitted to the loop's plant and step (docs/design/two-axis.md §4.12b)."""
+        shared = None
+        for values in self.structure.parameter_sets.values():
+            settings = {k: v for k, v in values.get("controller", {}).items()
+                        if k in ("feedForward", "accelerationFeedForward")}
+            shared = settings if shared is None else shared
+            if settings != shared:
+                raise ValueError(f"{self.structure.file}: the parameter sets differ in the "
+                                 f"controller's feed-forward ({shared} and {settings})")
+        return shared or {}
+
+    def variants(self, ccc_label="fuzzy CCC"):
+        """The four controllers the demos compare: (label, controller start values)."""
+        return [("no CCC", {"ccc.enable": False}),
+                (ccc_label, {}),
+                ("feed-forward", {"ccc.enable": False, **self.feed_forward}),
+                (f"{ccc_label} + feed-forward (shipped)", dict(self.feed_forward))]
+
+    @property
     def title(self):
         """E.g. "PathInterpolator2D -> ContourCCC2D <- XYServoPlant"."""
         file = {unit: Path(name).stem for unit, name in self.units.items()}
