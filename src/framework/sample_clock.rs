@@ -67,7 +67,8 @@ impl SampleClock {
         due
     }
 
-    /// When the latest sample taken was due (the start before the first).
+    /// When the latest sample [`SampleClock::take_before`] took was due (the start before
+    /// the first; not for a clock advanced by `take_until`).
     pub fn latest(&self) -> f64 {
         self.due(self.taken.saturating_sub(1))
     }

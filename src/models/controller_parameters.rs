@@ -143,7 +143,7 @@ where
     fn validate(&self, time: f64, _environment: &Environment) -> Result<(), String> {
         self.clock.validate_at(time)?;
         self.feed_forward
-            .validate()
+            .validate_at(time)
             .map_err(|e| format!("feed-forward: {e}"))?;
         let controller = &self.controller;
         controller

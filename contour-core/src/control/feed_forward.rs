@@ -53,8 +53,9 @@ impl<const D: usize> FeedForward<D> {
         self.acceleration_time
     }
 
-    /// Takes the inputs of a communication point at `time`. The acceleration's slope comes
-    /// from the previous reading when it is earlier (a repeated time keeps the old slope).
+    /// Takes the inputs of a communication point at `time` where the controller samples.
+    /// The acceleration's slope comes from the previous reading when it is earlier (a
+    /// repeated time keeps the old slope).
     pub fn read(&mut self, time: f64, velocity: Vector<D>, acceleration: Vector<D>) {
         if let Some(before) = self.input_time.filter(|&t| t < time) {
             self.acceleration_slope = (acceleration - self.acceleration) / (time - before);
@@ -73,11 +74,24 @@ impl<const D: usize> FeedForward<D> {
             + (self.acceleration + self.acceleration_slope * ahead) * self.acceleration_time
     }
 
-    /// Checks the gains and the memory of a restored state; the error names the value.
+    /// Checks the gains and the memory of a state restored at instance time `time`: the
+    /// inputs were read before it. The error names the value.
+    pub fn validate_at(&self, time: f64) -> Result<(), String> {
+        self.validate()?;
+        match self.input_time {
+            Some(t) if t >= time => Err(format!(
+                "inputs read at t = {t} s, not before the state's time {time} s"
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    /// Checks the gains (`feedForward`, `accelerationFeedForward`) and the memory; the
+    /// error names the value.
     pub fn validate(&self) -> Result<(), String> {
         for (name, value) in [
-            ("velocity gain", self.velocity_gain),
-            ("acceleration time", self.acceleration_time),
+            ("feedForward", self.velocity_gain),
+            ("accelerationFeedForward", self.acceleration_time),
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(format!("{name} = {value} must be finite and >= 0"));
@@ -87,7 +101,7 @@ impl<const D: usize> FeedForward<D> {
         if memory.iter().any(|v| v.iter().any(|x| !x.is_finite()))
             || self.input_time.is_some_and(|t| !t.is_finite())
         {
-            return Err("feed-forward memory holds a value that is not finite".into());
+            return Err("memory holds a value that is not finite".into());
         }
         Ok(())
     }
@@ -151,8 +165,11 @@ mod tests {
         assert!(FeedForward::<5>::new(-1.0, 0.0).is_err());
         assert!(FeedForward::<5>::new(1.0, f64::NAN)
             .unwrap_err()
-            .contains("acceleration time = NaN"));
+            .contains("accelerationFeedForward = NaN"));
         let mut ff = FeedForward::<2>::new(1.0, 0.003).unwrap();
+        ff.read(0.002, Vector2::zeros(), Vector2::zeros());
+        assert!(ff.validate_at(0.003).is_ok());
+        assert!(ff.validate_at(0.002).unwrap_err().contains("not before"));
         ff.acceleration_slope[1] = f64::INFINITY;
         assert!(ff.validate().is_err());
     }

@@ -82,9 +82,10 @@ def _initialized(fmu_path, name, start_values):
     md = read_model_description(str(fmu_path))
     variables = {v.name: v for v in md.modelVariables}
     directory = extract(str(fmu_path))
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=directory,
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
+    slave = None
     try:
+        slave = FMU2Slave(guid=md.guid, unzipDirectory=directory,
+                          modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
         slave.instantiate()
         slave.setupExperiment(startTime=0.0)
         slave.enterInitializationMode()
@@ -94,7 +95,8 @@ def _initialized(fmu_path, name, start_values):
         yield slave, variables
         slave.terminate()
     finally:
-        slave.freeInstance()
+        if slave is not None:
+            slave.freeInstance()
         shutil.rmtree(directory, ignore_errors=True)
 
 

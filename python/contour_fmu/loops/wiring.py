@@ -90,7 +90,10 @@ class Loop:
             if settings != shared:
                 raise ValueError(f"{self.structure.file}: the parameter sets differ in the "
                                  f"controller's feed-forward ({shared} and {settings})")
-        return shared or {}
+        if not shared:
+            raise ValueError(f"{self.structure.file}: no parameter set gives the controller "
+                             f"feedForward and accelerationFeedForward")
+        return shared
 
     def variants(self, ccc_label="fuzzy CCC"):
         """The four controllers the demos compare: (label, controller start values)."""

@@ -184,6 +184,28 @@ fn controller_states_with_bad_clock_pid_or_radius_are_refused() {
 }
 
 #[test]
+fn controller_states_with_bad_feed_forward_memory_are_refused() {
+    let (i, bytes) = controller_state(false);
+    let model = open_state(&bytes).1.model;
+    // The feed-forward last read its inputs at the 30th sample's communication point.
+    let read_at = 29.0 * TS;
+    let at = unique(&model, read_at);
+    refused(
+        &i,
+        &bytes,
+        |e| put_f64(&mut e.model, at, 30.0 * TS),
+        "feed-forward: inputs read at t = 0.0375 s, not before the state's time",
+    );
+    refused(
+        &i,
+        &bytes,
+        |e| put_f64(&mut e.model, at, f64::NAN),
+        "feed-forward: memory holds a value that is not finite",
+    );
+    assert_eq!(i.step(30.0 * TS, TS), OK, "{}", i.last_error());
+}
+
+#[test]
 fn an_arc_estimator_with_a_negative_radius_is_refused() {
     let (i, bytes) = controller_state(true);
     resealed_is_accepted(&i, &bytes);
