@@ -349,16 +349,12 @@ impl Model for ContourCCC2D {
         let reference = REF.vector(values);
         let actual = POS.vector(values);
         let (velocity, acceleration) = (VREF.vector(values), AREF.vector(values));
-        let mut unread = true;
         let ts = state.clock.period();
         while state.clock.take_before(time + step) {
-            if unread {
-                // Read at the communication points where samples are taken: a step
-                // shorter than Ts would otherwise see the input's staircase as a slope.
-                state.feed_forward.read(time, velocity, acceleration);
-                unread = false;
-            }
-            let feed_forward = state.feed_forward.command(state.clock.latest(), ts);
+            let feed_forward =
+                state
+                    .feed_forward
+                    .sample(time, velocity, acceleration, state.clock.latest(), ts);
             let out = state
                 .controller
                 .sample_with(reference, actual, feed_forward);

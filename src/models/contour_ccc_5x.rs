@@ -460,16 +460,12 @@ impl Model for ContourCCC5X {
         let reference = REF.vector(values);
         let actual = POS.vector(values);
         let (velocity, acceleration) = (VREF.vector(values), AREF.vector(values));
-        let mut unread = true;
         let ts = state.controller.config().ts;
         while state.clock.take_before(time + step) {
-            if unread {
-                // Read at the communication points where samples are taken: a step
-                // shorter than Ts would otherwise see the input's staircase as a slope.
-                state.feed_forward.read(time, velocity, acceleration);
-                unread = false;
-            }
-            let feed_forward = state.feed_forward.command(state.clock.latest(), ts);
+            let feed_forward =
+                state
+                    .feed_forward
+                    .sample(time, velocity, acceleration, state.clock.latest(), ts);
             // Inputs are finite (fmi2SetReal refuses others), so a sample cannot fail.
             // The inputs were set at this communication point and are held over it.
             let out = state

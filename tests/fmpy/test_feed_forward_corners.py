@@ -94,7 +94,11 @@ def test_the_shipped_acceleration_time_is_the_test_plants_hold_corrected_time_co
                 assert values["controller"] == LOOPS[name].feed_forward
 
 
-def _program_runs(fmu_dir, tmp_path, which):
+def _corners(fmu_dir, tmp_path, which="forward"):
+    """The corners part (`which`: forward, reversed, mirrored) written to a file: (the
+    interpolator's start values, the true error of positions, run(controller, plant,
+    limits, stop, step) -> the plant's positions), ContourCCC2D measuring against the
+    program."""
     text = {"forward": CORNERS, "reversed": CORNERS_REVERSED,
             "mirrored": mirror_program(CORNERS)}[which]
     file = tmp_path / f"corners_{which}.ngc"
@@ -106,22 +110,27 @@ def _program_runs(fmu_dir, tmp_path, which):
     def true_error(positions):
         return distance(pieces, positions)[0].max()
 
-    def run(controller, plant=None, interpolator=interpolator):
-        before, _ = closed_loop(fmu_dir, stop=STOP, interpolator=interpolator, plant=plant,
+    def run(controller, plant=None, limits=None, stop=STOP, step=TS):
+        before, _ = closed_loop(fmu_dir, stop=stop, step=step, plant=plant,
+                                interpolator={**interpolator, **(limits or {})},
                                 controller={**estimator, **controller})
-        return true_error(np.column_stack([before["plant.pos.x"], before["plant.pos.y"]]))
+        return np.column_stack([before["plant.pos.x"], before["plant.pos.y"]])
+    return interpolator, true_error, run
 
-    figures = {label: run(c) for label, c in LOOPS["two_axis"].variants()}
-    figures["swept"] = {t: run({"ccc.enable": False, "feedForward": 1.0,
-                                "accelerationFeedForward": t}) for t in SWEEP}
+
+def _program_runs(fmu_dir, tmp_path, which):
+    interpolator, true_error, run = _corners(fmu_dir, tmp_path, which)
+    figures = {label: true_error(run(c)) for label, c in LOOPS["two_axis"].variants()}
+    figures["swept"] = {t: true_error(run({"ccc.enable": False, "feedForward": 1.0,
+                                           "accelerationFeedForward": t})) for t in SWEEP}
     _, floor = floor_run(fmu_dir, "two_axis", interpolator, STOP)
     figures["floor"] = true_error(floor)
-    return figures, run
+    return figures
 
 
 @pytest.mark.parametrize("which", ["forward", "reversed", "mirrored"])
 def test_at_exact_stop_corners_the_shipped_loop_is_at_the_floor(fmu_dir, tmp_path, which):
-    figures, run = _program_runs(fmu_dir, tmp_path, which)
+    figures = _program_runs(fmu_dir, tmp_path, which)
     none, ccc = figures["no CCC"], figures["fuzzy CCC"]
     alone, shipped = figures["feed-forward"], figures["fuzzy CCC + feed-forward (shipped)"]
     best = min(figures["swept"].values())
@@ -147,32 +156,16 @@ def test_with_friction_and_a_current_limit_the_ccc_does_not_spoil_feed_forward(f
     friction = {f"{a}.{n}": v for a in "xy" for n, v in
                 (("coulomb", 0.5), ("stiction", 0.8), ("stribeckVelocity", 1.0),
                  ("currentMax", 42.0))}
-    _, run = _program_runs_cheap(fmu_dir, tmp_path)
+    _, true_error, run = _corners(fmu_dir, tmp_path)
     faster = {"accel": 4000.0, "jerk": 1e5}
     unlimited = {k: v for k, v in friction.items() if not k.endswith("currentMax")}
-    alone = run({"ccc.enable": False, **SHIPPED}, friction, faster)
-    both = run(dict(SHIPPED), friction, faster)
-    unsaturated = run({"ccc.enable": False, **SHIPPED}, unlimited, faster)
+    alone = true_error(run({"ccc.enable": False, **SHIPPED}, friction, faster))
+    both = true_error(run(dict(SHIPPED), friction, faster))
+    unsaturated = true_error(run({"ccc.enable": False, **SHIPPED}, unlimited, faster))
     print(f"friction and 42 A: feed-forward {alone * 1e3:.3f} um (without the limit "
           f"{unsaturated * 1e3:.3f}), with the CCC {both * 1e3:.3f}")
     assert alone != unsaturated  # the limit was reached
     assert both <= 1.1 * alone
-
-
-def _program_runs_cheap(fmu_dir, tmp_path):
-    """The forward part's runner without the table: (None, run(controller, plant, limits))."""
-    file = tmp_path / "corners.ngc"
-    file.write_text(CORNERS)
-    pieces = read_program(CORNERS)
-
-    def run(controller, plant, limits):
-        before, _ = closed_loop(fmu_dir, stop=STOP, plant=plant,
-                                interpolator={"path": str(file), **PLANNED, **limits},
-                                controller={"estimator": 4, "path": str(file),
-                                            "tolerance": 0.0, **controller})
-        positions = np.column_stack([before["plant.pos.x"], before["plant.pos.y"]])
-        return distance(pieces, positions)[0].max()
-    return None, run
 
 
 def _planar(xy):
@@ -363,16 +356,9 @@ def test_a_communication_step_shorter_than_ts_gives_the_same_loop(fmu_dir, tmp_p
     shipped loop on the corners part as at Ts, at the shared instants, to the plant's
     rounding: the feed-forward reads the acceleration's slope between the points where it
     samples, not between steps that see the interpolator's staircase."""
-    file = tmp_path / "corners.ngc"
-    file.write_text(CORNERS)
-    runs = {}
-    for step in (TS, TS / divisor):
-        before, _ = closed_loop(fmu_dir, stop=2.0, step=step,
-                                interpolator={"path": str(file), **PLANNED},
-                                controller={"estimator": 4, "path": str(file),
-                                            "tolerance": 0.0, **SHIPPED})
-        positions = np.column_stack([before["plant.pos.x"], before["plant.pos.y"]])
-        runs[step] = positions[::round(TS / step)]
+    _, _, run = _corners(fmu_dir, tmp_path)
+    runs = {step: run(dict(SHIPPED), stop=2.0, step=step)[::round(TS / step)]
+            for step in (TS, TS / divisor)}
     assert len(runs[TS]) == len(runs[TS / divisor])
     difference = np.abs(runs[TS] - runs[TS / divisor]).max()
     print(f"Ts/{divisor}: largest difference {difference:.3g} mm")

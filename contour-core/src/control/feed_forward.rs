@@ -19,8 +19,7 @@ use crate::geometry::Vector;
 pub struct FeedForward<const D: usize> {
     velocity_gain: f64,
     acceleration_time: f64,
-    /// The reference's velocity and acceleration read at `input_time`.
-    velocity: Vector<D>,
+    /// The reference's acceleration read at `input_time`.
     acceleration: Vector<D>,
     input_time: Option<f64>,
     /// How fast the acceleration input changed between the last two readings, per s.
@@ -34,7 +33,6 @@ impl<const D: usize> FeedForward<D> {
         let feed_forward = FeedForward {
             velocity_gain,
             acceleration_time,
-            velocity: Vector::zeros(),
             acceleration: Vector::zeros(),
             input_time: None,
             acceleration_slope: Vector::zeros(),
@@ -43,35 +41,28 @@ impl<const D: usize> FeedForward<D> {
         Ok(feed_forward)
     }
 
-    /// The share of the reference velocity fed forward (`feedForward`).
-    pub fn velocity_gain(&self) -> f64 {
-        self.velocity_gain
-    }
-
-    /// The acceleration time T_a, s (`accelerationFeedForward`).
-    pub fn acceleration_time(&self) -> f64 {
-        self.acceleration_time
-    }
-
-    /// Takes the inputs of a communication point at `time` where the controller samples.
-    /// The acceleration's slope comes from the previous reading when it is earlier (a
-    /// repeated time keeps the old slope).
-    pub fn read(&mut self, time: f64, velocity: Vector<D>, acceleration: Vector<D>) {
+    /// The command to add for a sample taken at `at` and held for `hold` s, from the
+    /// inputs of the communication point at `time`: the velocity gain times `velocity`,
+    /// plus the acceleration time times `acceleration` extrapolated to the middle of the
+    /// hold. The slope comes from the previous communication point that had a sample (the
+    /// interpolator's outputs step once per Ts, so a shorter step between them would read
+    /// a staircase); the samples of one step read the same point once.
+    pub fn sample(
+        &mut self,
+        time: f64,
+        velocity: Vector<D>,
+        acceleration: Vector<D>,
+        at: f64,
+        hold: f64,
+    ) -> Vector<D> {
         if let Some(before) = self.input_time.filter(|&t| t < time) {
             self.acceleration_slope = (acceleration - self.acceleration) / (time - before);
         }
-        self.velocity = velocity;
         self.acceleration = acceleration;
         self.input_time = Some(time);
-    }
-
-    /// The command to add for a sample taken at `at` and held for `hold` s: the velocity
-    /// gain times the velocity read, plus the acceleration time times the acceleration
-    /// extrapolated to the middle of the hold.
-    pub fn command(&self, at: f64, hold: f64) -> Vector<D> {
-        let ahead = at + hold / 2.0 - self.input_time.unwrap_or(at);
-        self.velocity * self.velocity_gain
-            + (self.acceleration + self.acceleration_slope * ahead) * self.acceleration_time
+        let ahead = at + hold / 2.0 - time;
+        velocity * self.velocity_gain
+            + (acceleration + self.acceleration_slope * ahead) * self.acceleration_time
     }
 
     /// Checks the gains and the memory of a state restored at instance time `time`: the
@@ -97,7 +88,7 @@ impl<const D: usize> FeedForward<D> {
                 return Err(format!("{name} = {value} must be finite and >= 0"));
             }
         }
-        let memory = [&self.velocity, &self.acceleration, &self.acceleration_slope];
+        let memory = [&self.acceleration, &self.acceleration_slope];
         if memory.iter().any(|v| v.iter().any(|x| !x.is_finite()))
             || self.input_time.is_some_and(|t| !t.is_finite())
         {
@@ -124,18 +115,16 @@ mod tests {
         let decay = crate::math::exp(-ts / tau);
         let reference = |t: f64| (jerk * t * t / 2.0, jerk * t); // velocity, acceleration
         let (v_before, a_before) = reference(-ts);
-        ff.read(
-            -ts,
-            Vector2::new(v_before, -v_before),
-            Vector2::new(a_before, -a_before),
-        );
+        let at = |v: f64, a: f64| (Vector2::new(v, -v), Vector2::new(a, -a));
+        let (vb, ab) = at(v_before, a_before);
+        ff.sample(-ts, vb, ab, -ts, ts);
         let mut v = 0.0;
         let mut worst: f64 = 0.0;
         for k in 0..40 {
             let t = k as f64 * ts;
             let (vr, ar) = reference(t);
-            ff.read(t, Vector2::new(vr, -vr), Vector2::new(ar, -ar));
-            let u = ff.command(t, ts);
+            let (velocity, acceleration) = at(vr, ar);
+            let u = ff.sample(t, velocity, acceleration, t, ts);
             assert_eq!(u[1], -u[0]);
             v = u[0] + (v - u[0]) * decay;
             worst = worst.max((v - reference(t + ts).0).abs());
@@ -148,16 +137,24 @@ mod tests {
     #[test]
     fn the_slope_scales_with_the_time_between_readings() {
         let mut ff = FeedForward::<2>::new(0.0, 1.0).unwrap();
-        ff.read(0.0, Vector2::zeros(), Vector2::new(1.0, 0.0));
-        assert_eq!(ff.command(0.0, 0.002), Vector2::new(1.0, 0.0)); // no slope yet
-        ff.read(0.004, Vector2::zeros(), Vector2::new(3.0, 0.0));
+        let (zero, one, three) = (
+            Vector2::zeros(),
+            Vector2::new(1.0, 0.0),
+            Vector2::new(3.0, 0.0),
+        );
+        // No slope yet.
+        assert_eq!(ff.sample(0.0, zero, one, 0.0, 0.002), one);
         // 500 /s² per s: at the middle of a 2 ms hold, 1 ms ahead: 3.5.
-        assert_eq!(ff.command(0.004, 0.002), Vector2::new(3.5, 0.0));
-        // A second sample inside the same communication step is 2 ms later: 4.5.
-        assert_eq!(ff.command(0.006, 0.002), Vector2::new(4.5, 0.0));
-        // A repeated time keeps the slope.
-        ff.read(0.004, Vector2::zeros(), Vector2::new(3.0, 0.0));
-        assert_eq!(ff.command(0.004, 0.002), Vector2::new(3.5, 0.0));
+        assert_eq!(
+            ff.sample(0.004, zero, three, 0.004, 0.002),
+            Vector2::new(3.5, 0.0)
+        );
+        // A second sample inside the same communication step is 2 ms later: 4.5, and
+        // reading the same point again keeps the slope.
+        assert_eq!(
+            ff.sample(0.004, zero, three, 0.006, 0.002),
+            Vector2::new(4.5, 0.0)
+        );
     }
 
     #[test]
@@ -167,7 +164,7 @@ mod tests {
             .unwrap_err()
             .contains("accelerationFeedForward = NaN"));
         let mut ff = FeedForward::<2>::new(1.0, 0.003).unwrap();
-        ff.read(0.002, Vector2::zeros(), Vector2::zeros());
+        ff.sample(0.002, Vector2::zeros(), Vector2::zeros(), 0.002, 0.001);
         assert!(ff.validate_at(0.003).is_ok());
         assert!(ff.validate_at(0.002).unwrap_err().contains("not before"));
         ff.acceleration_slope[1] = f64::INFINITY;

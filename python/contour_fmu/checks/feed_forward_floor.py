@@ -16,16 +16,13 @@ drives the plant FMU with it: its contour error is what no feed-forward on these
 can remove, the floor the shipped loop is measured against.
 """
 
-import shutil
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
-from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
+from fmpy import read_model_description
 from scipy.linalg import expm
 
-from ..engines.master import set_value
+from ..engines.master import Master, Unit
 
 
 def axis_matrices(J, B, CT, Kvp, Kvi, h):
@@ -75,40 +72,14 @@ def drive_parameters(fmu_path, axes, values=None):
     return {a: {p: start[f"{a}.{p}"] for p in ("J", "B", "CT", "Kvp", "Kvi")} for a in axes}
 
 
-@contextmanager
-def _initialized(fmu_path, name, start_values):
-    """One FMU instance out of initialization with `start_values` set: (slave, variables
-    by name); terminated and freed on exit."""
-    md = read_model_description(str(fmu_path))
-    variables = {v.name: v for v in md.modelVariables}
-    directory = extract(str(fmu_path))
-    slave = None
-    try:
-        slave = FMU2Slave(guid=md.guid, unzipDirectory=directory,
-                          modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
-        slave.instantiate()
-        slave.setupExperiment(startTime=0.0)
-        slave.enterInitializationMode()
-        for variable, value in start_values.items():
-            set_value(slave, variables[variable], value)
-        slave.exitInitializationMode()
-        yield slave, variables
-        slave.terminate()
-    finally:
-        if slave is not None:
-            slave.freeInstance()
-        shutil.rmtree(directory, ignore_errors=True)
-
-
 def _record_reference(fmu_path, start_values, names, h, steps):
     """Runs the interpolator FMU alone: its outputs `names` at t_0 .. t_steps."""
-    with _initialized(fmu_path, "reference", start_values) as (slave, variables):
-        refs = [variables[n].valueReference for n in names]
-        rows = [slave.getReal(refs)]
-        for k in range(steps):
-            slave.doStep(currentCommunicationPoint=k * h, communicationStepSize=h)
-            rows.append(slave.getReal(refs))
-        return np.array(rows)
+    units = [Unit("reference", str(fmu_path), start_values)]
+    with Master(units, [], h, steps * h) as master:
+        before, after = master.run([("reference", n) for n in names])
+    columns = [f"reference.{n}" for n in names]
+    first = np.array([[before[c][0] for c in columns]])
+    return np.vstack([first, np.column_stack([after[c] for c in columns])])
 
 
 def floor_run(fmu_dir, loop, interpolator, stop, h=1e-3, position_gain=28.5, plant=None):
@@ -131,7 +102,9 @@ def floor_run(fmu_dir, loop, interpolator, stop, h=1e-3, position_gain=28.5, pla
     feed_forward = np.column_stack([ideal_commands(velocity[:, i], drives[a], h)
                                     for i, a in enumerate(names)])
     start = {**(plant or {}), **{f"pos0.{a}": reference[0, i] for i, a in enumerate(names)}}
-    with _initialized(fmu_dir / f"{plant_fmu}.fmu", "plant", start) as (slave, variables):
+    units = [Unit("plant", str(fmu_dir / f"{plant_fmu}.fmu"), start)]
+    with Master(units, [], h, stop) as master:
+        slave, variables = master.slaves["plant"], master.variables["plant"]
         position = [variables[f"pos.{a}"].valueReference for a in names]
         command = [variables[f"u.{a}"].valueReference for a in names]
         rows = [slave.getReal(position)]
@@ -140,4 +113,4 @@ def floor_run(fmu_dir, loop, interpolator, stop, h=1e-3, position_gain=28.5, pla
             slave.setReal(command, list(u))
             slave.doStep(currentCommunicationPoint=k * h, communicationStepSize=h)
             rows.append(slave.getReal(position))
-        return reference, np.array(rows)
+    return reference, np.array(rows)
