@@ -85,7 +85,20 @@ pub fn with_factors(base: &ControllerConfig, factors: &[f64]) -> ControllerConfi
 impl ContourObjective {
     /// The default fuzzy-PID CCC on `path` at `feed` with the named plant preset.
     pub fn new(path: Path, feed: f64, plant: &str, fitness: Fitness) -> Result<Self, String> {
-        let config = SimConfig::new(path, feed).with_plant(plant_preset(plant)?);
+        Self::lasting(path, feed, plant, fitness, None)
+    }
+
+    /// [`new`](Self::new) with a run of `duration` seconds instead of the path end at
+    /// the constant feed (the length of a planned run made elsewhere, which this one judges).
+    pub fn lasting(
+        path: Path,
+        feed: f64,
+        plant: &str,
+        fitness: Fitness,
+        duration: Option<f64>,
+    ) -> Result<Self, String> {
+        let mut config = SimConfig::new(path, feed).with_plant(plant_preset(plant)?);
+        config.duration = duration;
         let base = config.effective_controller();
         let simulator = Simulator::new(config).map_err(|e| e.to_string())?;
         Ok(ContourObjective {

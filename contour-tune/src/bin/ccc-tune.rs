@@ -13,7 +13,7 @@ use contour_core::path::planar::Path;
 use contour_core::sim::preset_feed;
 use contour_cosim::fmi2::Activity;
 use contour_cosim::{System, SystemStructure};
-use contour_tune::fmu_objective::FmuObjective;
+use contour_tune::fmu_objective::{FmuObjective, LoopSettings};
 use contour_tune::objective::{ContourObjective, Fitness, FACTOR_NAMES, LOWER, UPPER};
 use contour_tune::{minimize, Algorithm, PsoSettings};
 use serde_json::json;
@@ -22,7 +22,8 @@ const USAGE: &str = "\
 usage: ccc-tune [--path circle|infinity|trident|FILE] [--feed MM_PER_S] [--swarm 50]
                 [--iters 100] [--algorithm improved|standard] [--seed 1] [--out tuned.json]
                 [--lower a,b,c,d,e] [--upper a,b,c,d,e] [--plant paper|mismatched|PLANT.fmu]
-                [--loop LOOP.ssd|LOOP.ssp] [--fitness mean|max] [--threads N]
+                [--loop LOOP.ssd|LOOP.ssp] [--parameter-set NAME] [--start UNIT.VAR=VALUE]...
+                [--settle 0.25] [--fitness mean|max] [--threads N]
 
 Minimises the mean (or max) |true contour error| of the closed loop interpolator -> fuzzy-PID CCC
 -> XYServoPlant over the factors (ke, kde, kp, ki, kd) of ContourCCC2D. The feed defaults
@@ -32,7 +33,13 @@ By default the loop runs in process, with the test plant's paper or mismatched d
 --loop runs every candidate through the FMUs of an SSP file instead (units interpolator,
 controller, plant; contour-cosim, instances reused per thread); --plant PLANT.fmu runs them
 through the shipped two-axis loop with that plant (the loop of --loop, by default
-two_axis.ssd in the fmu folder beside this program's: target/fmu).";
+two_axis.ssd in the fmu folder beside this program's: target/fmu). Through FMUs,
+--parameter-set applies one of the loop's parameter sets first (the shipped loops' sets
+carry feed-forward and, on two axes, a planned reference), --start sets any variable last
+(repeatable); the interpolator and the controller get --path. With a planned reference
+(interpolator.accel > 0) a run lasts until the reference ends plus --settle seconds, and
+the true error is taken against the path as followed (blended with interpolator.tolerance):
+the way to tune the CCC on top of feed-forward, on a part program with corners.";
 
 struct Options {
     path: String,
@@ -46,6 +53,9 @@ struct Options {
     upper: Vec<f64>,
     plant: String,
     loop_file: Option<PathBuf>,
+    parameter_set: Option<String>,
+    starts: Vec<String>,
+    settle: f64,
     fitness: Fitness,
     threads: Option<usize>,
 }
@@ -77,6 +87,9 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
         upper: UPPER.to_vec(),
         plant: "paper".into(),
         loop_file: None,
+        parameter_set: None,
+        starts: Vec::new(),
+        settle: 0.25,
         fitness: Fitness::Mean,
         threads: None,
     };
@@ -112,6 +125,9 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
             "--upper" => o.upper = parse_list(value, "--upper")?,
             "--plant" => o.plant = value.clone(),
             "--loop" => o.loop_file = Some(PathBuf::from(value)),
+            "--parameter-set" => o.parameter_set = Some(value.clone()),
+            "--start" => o.starts.push(value.clone()),
+            "--settle" => o.settle = number("--settle")?,
             "--fitness" => o.fitness = value.parse()?,
             "--threads" => o.threads = Some(count("--threads")?),
             other => return Err(format!("unknown option '{other}'")),
@@ -141,8 +157,16 @@ fn run(o: Options) -> Result<(), String> {
     } else {
         o.plant.as_str()
     };
-    let objective = ContourObjective::new(path, feed, preset, o.fitness)?;
     let through_fmus = o.loop_file.is_some() || plant_fmu.is_some();
+    if !through_fmus && (o.parameter_set.is_some() || !o.starts.is_empty()) {
+        return Err("--parameter-set and --start need a loop of FMUs (--loop or --plant)".into());
+    }
+    if !(o.settle.is_finite() && o.settle >= 0.0) {
+        return Err(format!(
+            "--settle must be zero or more seconds, not {}",
+            o.settle
+        ));
+    }
     let loop_file = match (&o.loop_file, through_fmus) {
         (Some(file), _) => Some(file.clone()),
         (None, true) => Some(default_loop()?),
@@ -160,8 +184,15 @@ fn run(o: Options) -> Result<(), String> {
         None
     };
     let objective = match &system {
-        Some(system) => Objective::Fmus(FmuObjective::new(system, objective, &o.path, feed)?),
-        None => Objective::InProcess(objective),
+        Some(system) => Objective::Fmus(FmuObjective::new(
+            system,
+            &o.path,
+            feed,
+            preset,
+            o.fitness,
+            &loop_settings(&o, system)?,
+        )?),
+        None => Objective::InProcess(ContourObjective::new(path, feed, preset, o.fitness)?),
     };
     let settings = PsoSettings {
         algorithm: o.algorithm,
@@ -231,6 +262,15 @@ fn run(o: Options) -> Result<(), String> {
     });
     if let Some(loop_file) = &loop_file {
         document["settings"]["loop"] = json!(loop_file.display().to_string());
+        if let Some(set) = &o.parameter_set {
+            document["settings"]["parameter_set"] = json!(set);
+        }
+        if !o.starts.is_empty() {
+            document["settings"]["starts"] = json!(o.starts);
+        }
+        document["settings"]["settle_s"] = json!(o.settle);
+        document["settings"]["run_s"] =
+            json!(objective.reference().simulator().samples() as f64 * objective.reference().ts());
     }
     let text = serde_json::to_string_pretty(&document).map_err(|e| e.to_string())? + "\n";
     // Written beside the target and renamed into place: a failed write leaves nothing.
@@ -272,6 +312,38 @@ impl Objective<'_> {
             Objective::Fmus(o) => o.reference(),
         }
     }
+}
+
+/// The loop's start values the options give: the parameter set's, then --start's.
+fn loop_settings(o: &Options, system: &System) -> Result<LoopSettings, String> {
+    let parameter_set = match &o.parameter_set {
+        Some(name) => system
+            .structure
+            .parameter_set(name)
+            .map_err(|e| format!("--parameter-set: {e}"))?
+            .clone(),
+        None => Vec::new(),
+    };
+    let starts = o
+        .starts
+        .iter()
+        .map(|assignment| {
+            let (target, text) = assignment
+                .split_once('=')
+                .ok_or_else(|| format!("--start {assignment:?} is not UNIT.VARIABLE=VALUE"))?;
+            let (unit, name) = target
+                .split_once('.')
+                .ok_or_else(|| format!("--start {assignment:?} is not UNIT.VARIABLE=VALUE"))?;
+            system
+                .parse_start_value(unit, name, text)
+                .map_err(|e| format!("--start: {e}"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(LoopSettings {
+        parameter_set,
+        starts,
+        settle: o.settle,
+    })
 }
 
 /// The shipped two-axis loop beside this program's build: <target>/fmu/two_axis.ssd.
