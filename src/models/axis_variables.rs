@@ -53,6 +53,30 @@ pub const REFERENCE_VELOCITY_IN: AxisTemplate = AxisTemplate::input(
 )
 .unit(AxisUnit::VELOCITY);
 
+/// An interpolator's look-ahead: `ahead.<axis>`, the reference's mean acceleration over
+/// the coming period.
+pub const ACCELERATION_AHEAD_OUT: AxisTemplate = AxisTemplate::output(
+    ("ahead.", ""),
+    (
+        "Mean reference acceleration over the coming period, ",
+        AxisWord::Name,
+        ": (v(t+Ts) - v(t))/Ts, the interpolator's look-ahead (for feed-forward)",
+    ),
+)
+.unit(AxisUnit::ACCELERATION);
+
+/// A controller's look-ahead input: `ahead.<axis>`.
+pub const ACCELERATION_AHEAD_IN: AxisTemplate = AxisTemplate::input(
+    ("ahead.", ""),
+    (
+        "Mean reference acceleration over the coming period, ",
+        AxisWord::Name,
+        ", from the interpolator's ahead (feed-forward with feedForwardLookAhead; 0 when \
+         unconnected)",
+    ),
+)
+.unit(AxisUnit::ACCELERATION);
+
 /// A controller's reference input: `ref.<axis>`.
 pub const REFERENCE_IN: AxisTemplate = AxisTemplate::input(
     ("ref.", ""),

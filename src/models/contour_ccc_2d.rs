@@ -4,8 +4,8 @@
 //! `fmi2DoStep` on the inputs held over the step, whatever the communication step.
 
 use super::axis_variables::{
-    COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN, REFERENCE_ACCELERATION_IN, REFERENCE_IN,
-    REFERENCE_VELOCITY_IN,
+    ACCELERATION_AHEAD_IN, COMMAND_OUT, FOLLOWING_ERROR_OUT, MEASURED_IN,
+    REFERENCE_ACCELERATION_IN, REFERENCE_IN, REFERENCE_VELOCITY_IN,
 };
 use super::controller_parameters::{
     self, axis_gain, nonnegative, ControllerState, SavedController,
@@ -138,6 +138,15 @@ variable_table! {
     OPTIONAL_STOP: Bool = path_parameter::OPTIONAL_STOP;
     HOME: Reals<3> = path_parameter::HOME;
     TOOL_RADII: Str = path_parameter::TOOL_RADII;
+    AHEAD: Reals<2> = axis_block(&XY, &[ACCELERATION_AHEAD_IN]);
+    LOOK_AHEAD: Bool = Variable::parameter(
+        "feedForwardLookAhead",
+        Start::Boolean(false),
+        "Acceleration feed-forward from the interpolator's look-ahead: \
+         accelerationFeedForward times ahead (the mean acceleration over the coming period, \
+         exact over each hold whatever the jerk does) instead of aref extrapolated to the \
+         middle of the hold; needs an interpolator that gives ahead",
+    );
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -349,12 +358,16 @@ impl Model for ContourCCC2D {
         let reference = REF.vector(values);
         let actual = POS.vector(values);
         let (velocity, acceleration) = (VREF.vector(values), AREF.vector(values));
+        let (look_ahead, ahead) = (LOOK_AHEAD.get(values), AHEAD.vector(values));
         let ts = state.clock.period();
         while state.clock.take_before(time + step) {
-            let feed_forward =
+            let feed_forward = if look_ahead {
+                state.feed_forward.over_hold(velocity, ahead)
+            } else {
                 state
                     .feed_forward
-                    .sample(time, velocity, acceleration, state.clock.latest(), ts);
+                    .sample(time, velocity, acceleration, state.clock.latest(), ts)
+            };
             let out = state
                 .controller
                 .sample_with(reference, actual, feed_forward);

@@ -3,11 +3,15 @@
 //! one sample every `Ts`; `ref.x`, `ref.y` hold the latest sample between samples. With
 //! `accel` = 0 at the constant `feed` (the paper's interpolator); with `accel` > 0 a
 //! program, a line or an arc is planned at initialization within the speeds, the
-//! acceleration and the jerk, corners blended (docs/design/two-axis.md §4.9).
+//! acceleration and the jerk, corners blended (docs/design/two-axis.md §4.9). For
+//! feed-forward it gives the sample's velocity and acceleration and its look-ahead, the
+//! mean acceleration over the coming period (§4.12b).
 
 use std::f64::consts::PI;
 
-use super::axis_variables::{REFERENCE_ACCELERATION_OUT, REFERENCE_OUT, REFERENCE_VELOCITY_OUT};
+use super::axis_variables::{
+    ACCELERATION_AHEAD_OUT, REFERENCE_ACCELERATION_OUT, REFERENCE_OUT, REFERENCE_VELOCITY_OUT,
+};
 use super::{line_arc_parameters, path_parameter};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
@@ -82,6 +86,7 @@ variable_table! {
     OPTIONAL_STOP: Bool = path_parameter::OPTIONAL_STOP;
     HOME: Reals<3> = path_parameter::HOME;
     TOOL_RADII: Str = path_parameter::TOOL_RADII;
+    AHEAD: Reals<2> = axis_block(&XY, &[ACCELERATION_AHEAD_OUT]);
 }
 
 pub static INFO: ModelInfo = ModelInfo {
@@ -130,6 +135,8 @@ pub static INFO: ModelInfo = ModelInfo {
         (VREF.at(1).vr(), &DURATION_KNOWNS),
         (AREF.at(0).vr(), &DURATION_KNOWNS),
         (AREF.at(1).vr(), &DURATION_KNOWNS),
+        (AHEAD.at(0).vr(), &DURATION_KNOWNS),
+        (AHEAD.at(1).vr(), &DURATION_KNOWNS),
     ],
     create: |environment: &Environment| {
         Box::new(PathInterpolator2D {
@@ -275,31 +282,35 @@ fn path(values: &Values, environment: &Environment) -> Result<Path, String> {
 impl PathInterpolator2D {
     fn write_outputs(&self, values: &mut Values) {
         let Some(state) = &self.state else { return };
-        let (point, done, speed, duration, velocity, acceleration) = match &state.reference {
-            Reference::ConstantFeed(it) => {
-                let sample = it.current();
-                let speed = if sample.done { 0.0 } else { it.feed() };
-                (
-                    sample.point,
-                    sample.done,
-                    speed,
-                    it.path().length() / it.feed(),
-                    it.velocity(),
-                    it.acceleration(),
-                )
-            }
-            Reference::Planned(planned) => {
-                let sample = planned.current();
-                (
-                    sample.point,
-                    planned.done(),
-                    sample.speed,
-                    planned.duration(),
-                    sample.direction * sample.speed,
-                    sample.acceleration,
-                )
-            }
-        };
+        let (point, done, speed, duration, velocity, acceleration, next_velocity) =
+            match &state.reference {
+                Reference::ConstantFeed(it) => {
+                    let sample = it.current();
+                    let speed = if sample.done { 0.0 } else { it.feed() };
+                    (
+                        sample.point,
+                        sample.done,
+                        speed,
+                        it.path().length() / it.feed(),
+                        it.velocity(),
+                        it.acceleration(),
+                        it.next_velocity(),
+                    )
+                }
+                Reference::Planned(planned) => {
+                    let (sample, next) = (planned.current(), planned.peek());
+                    (
+                        sample.point,
+                        planned.done(),
+                        sample.speed,
+                        planned.duration(),
+                        sample.direction * sample.speed,
+                        sample.acceleration,
+                        next.direction * next.speed,
+                    )
+                }
+            };
+        AHEAD.set(values, &((next_velocity - velocity) / state.clock.period()));
         REF.set(values, &point);
         VREF.set(values, &velocity);
         AREF.set(values, &acceleration);

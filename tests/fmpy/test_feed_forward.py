@@ -15,6 +15,9 @@ part the second central difference (p(t+Ts) - 2 p(t) + p(t-Ts))/Ts^2, which diff
 the acceleration by an acceleration jump da inside the window times at most 1/2 (da <=
 jerk*Ts where the curvature jumps) and a jerk jump dj (at most 2*jerk, where the
 S-curve's phases meet) times at most Ts/6 each side: within jerk*Ts*(1/2 + 1/3).
+
+`ahead.*`, the look-ahead: the mean acceleration over the coming period, the next sample's
+vref less this one's over Ts, on both (exact to rounding).
 """
 
 import numpy as np
@@ -31,7 +34,8 @@ def interpolate(fmu_dir, steps, **parameters):
     try:
         s.set(**parameters)
         s.fmu.exitInitializationMode()
-        names = ["ref.x", "ref.y", "vref.x", "vref.y", "feedRate", "aref.x", "aref.y"]
+        names = ["ref.x", "ref.y", "vref.x", "vref.y", "feedRate", "aref.x", "aref.y",
+                 "ahead.x", "ahead.y"]
         rows = [s.reals(names)]
         for k in range(steps):
             s.fmu.doStep(currentCommunicationPoint=k * TS, communicationStepSize=TS)
@@ -51,6 +55,12 @@ def test_vref_on_the_circle_is_the_feed_along_the_tangent(fmu_dir):
     centre = np.array([-10.0, 0.0])
     centripetal = -(feed / 10.0) ** 2 * (rows[:, :2] - centre)
     assert np.max(np.abs(rows[:, 5:7] - centripetal)) < 1e-9
+    assert_ahead_is_the_next_velocity(rows)
+
+
+def assert_ahead_is_the_next_velocity(rows):
+    mean = (rows[1:, 2:4] - rows[:-1, 2:4]) / TS
+    assert np.max(np.abs(rows[:-1, 7:9] - mean)) < 1e-6
 
 
 def test_vref_of_a_planned_part_is_the_derivative_of_its_samples(fmu_dir, tmp_path):
@@ -71,6 +81,8 @@ def test_vref_of_a_planned_part_is_the_derivative_of_its_samples(fmu_dir, tmp_pa
     print(f"max |second difference - aref| = {error:.3g} mm/s2 (bound {bound:.3g})")
     assert error <= bound
     assert np.abs(rows[:, 5:7]).max() > 1000.0  # it accelerated
+    assert_ahead_is_the_next_velocity(rows)
+    assert np.all(rows[-1, 7:9] == 0.0)  # at the end, at rest
 
 
 def test_feed_forward_removes_the_lag_and_the_ccc_the_rest(fmu_dir):

@@ -72,11 +72,11 @@ def test_dependencies_are_explicit_no_feedthrough_and_initial_values_from_parame
         "XYServoPlant": {"pos.x": ["pos0.x"], "pos.y": ["pos0.y"], "vel.x": [], "vel.y": []},
         "ContourCCC2D": {name: [] for name in CONTROLLER_OUTPUTS},
     }
-    # The velocity and acceleration of the first sample: the feed along the start's
-    # tangent (feed² times its curvature) without a plan, at rest with one: they follow
-    # what the duration does.
+    # The velocity and acceleration of the first sample (and the look-ahead over the
+    # first period): the feed along the start's tangent (feed² times its curvature)
+    # without a plan, at rest with one: they follow what the duration does.
     for axis in ("x", "y"):
-        for name in ("vref", "aref"):
+        for name in ("vref", "aref", "ahead"):
             expected_initial["PathInterpolator2D"][f"{name}.{axis}"] = (
                 expected_initial["PathInterpolator2D"]["plannedDuration"])
     for model, initial in expected_initial.items():

@@ -65,6 +65,15 @@ impl<const D: usize> FeedForward<D> {
             + (acceleration + self.acceleration_slope * ahead) * self.acceleration_time
     }
 
+    /// The command to add for a hold over which the reference's mean acceleration is
+    /// known in advance (an interpolator's look-ahead, (v(t+Ts) − v(t))/Ts): the velocity
+    /// gain times `velocity` plus the acceleration time times `mean_acceleration`. For a
+    /// first-order velocity loop this lands on the reference's velocity at the end of the
+    /// hold whatever the jerk does inside it; the memory is not used.
+    pub fn over_hold(&self, velocity: Vector<D>, mean_acceleration: Vector<D>) -> Vector<D> {
+        velocity * self.velocity_gain + mean_acceleration * self.acceleration_time
+    }
+
     /// Checks the gains and the memory of a state restored at instance time `time`: the
     /// inputs were read before it. The error names the value.
     pub fn validate_at(&self, time: f64) -> Result<(), String> {
@@ -132,6 +141,51 @@ mod tests {
         // Without the extrapolation every hold would end jerk·Ts²/2·T_a/Ts = 0.093 mm/s
         // short; with it only rounding is left.
         assert!(worst < 1e-12, "{worst}");
+    }
+
+    /// A jerk-limited reference whose jerk switches inside holds (every 2.5 samples):
+    /// the look-ahead's mean acceleration over each hold lands the first-order loop on
+    /// the reference velocity at the end of every hold; the acceleration extrapolated
+    /// from the samples misses each switch.
+    #[test]
+    fn the_look_ahead_lands_on_the_reference_velocity_where_the_jerk_switches() {
+        let (tau, ts, jerk) = (1.0 / 314.0, 1e-3, 5e4);
+        let time = ts / -crate::math::expm1(-ts / tau);
+        let decay = crate::math::exp(-ts / tau);
+        // Jerk +j, −j, −j, +j repeating every 2.5 ms: velocity and acceleration at t.
+        let reference = |t: f64| {
+            let (period, mut v, mut a, mut at) = (2.5e-3, 0.0, 0.0, 0.0);
+            let signs = [1.0, -1.0, -1.0, 1.0];
+            let mut i = 0;
+            while at < t {
+                let dt = (t - at).min(period);
+                let j = signs[i % 4] * jerk;
+                v += a * dt + j * dt * dt / 2.0;
+                a += j * dt;
+                at += dt;
+                i += 1;
+            }
+            (v, a)
+        };
+        let one = |v: f64| Vector2::new(v, 0.0);
+        let mut worst = [0.0f64; 2];
+        for (law, worst) in worst.iter_mut().enumerate() {
+            let mut ff = FeedForward::<2>::new(1.0, time).unwrap();
+            let mut v = 0.0;
+            for k in 0..40 {
+                let t = k as f64 * ts;
+                let (vr, ar) = reference(t);
+                let u = if law == 0 {
+                    ff.over_hold(one(vr), one((reference(t + ts).0 - vr) / ts))[0]
+                } else {
+                    ff.sample(t, one(vr), one(ar), t, ts)[0]
+                };
+                v = u + (v - u) * decay;
+                *worst = worst.max((v - reference(t + ts).0).abs());
+            }
+        }
+        assert!(worst[0] < 1e-12, "{worst:?}");
+        assert!(worst[1] > 0.01, "{worst:?}");
     }
 
     #[test]

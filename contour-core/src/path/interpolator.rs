@@ -173,8 +173,21 @@ impl<const D: usize, C: Curve<D>> Interpolator<D, C> {
     /// The reference's velocity at the current sample, mm/s: the feed along the curve's
     /// tangent there; zero at the end (and where the curve has no tangent).
     pub fn velocity(&self) -> Vector<D> {
-        match geometry::unit(&self.cur.d1) {
-            Some(t) if !self.done => t * self.feed,
+        self.feed_along(&self.cur, self.done)
+    }
+    /// The reference's velocity at the next sample, mm/s, the interpolator unchanged (its
+    /// look-ahead); zero once the next sample is the end.
+    pub fn next_velocity(&self) -> Vector<D> {
+        if self.done {
+            return Vector::zeros();
+        }
+        let (_, next, done) = self.next_point();
+        self.feed_along(&next, done)
+    }
+    /// The feed along the tangent at `point`; zero at the end or without a tangent.
+    fn feed_along(&self, point: &CurvePoint<D>, done: bool) -> Vector<D> {
+        match geometry::unit(&point.d1) {
+            Some(t) if !done => t * self.feed,
             _ => Vector::zeros(),
         }
     }
@@ -315,6 +328,22 @@ mod tests {
     use crate::math;
     use crate::path::planar::builtin;
     use crate::path::Nurbs;
+
+    /// The look-ahead velocity is the next sample's, bit for bit, up to the end (zero
+    /// from the sample before it).
+    #[test]
+    fn next_velocity_is_the_velocity_after_the_step() {
+        let mut it = Interpolator::new(builtin::by_name("infinity").unwrap(), 50.0, 1e-3).unwrap();
+        let mut steps = 0;
+        while !it.is_done() {
+            let ahead = it.next_velocity();
+            it.step();
+            assert_eq!(ahead, it.velocity(), "sample {steps}");
+            steps += 1;
+        }
+        assert!(steps > 100);
+        assert_eq!(it.next_velocity(), Vector2::zeros());
+    }
 
     /// Worst relative chord deviation over the whole run (last clamped sample excluded)
     /// and the sample count.

@@ -25,6 +25,8 @@ FIVE_AXIS_JOINTS = ("X", "Y", "Z", "A", "C")
 FIVE_AXIS_CONNECTIONS = FIVE_AXIS.connections
 # The plant starts at the path's start joints.
 FIVE_AXIS_PATH_START = FIVE_AXIS.initial_copies
+# The controller's parameters that make up a loop's feed-forward.
+FEED_FORWARD_SETTINGS = ("feedForward", "accelerationFeedForward", "feedForwardLookAhead")
 
 
 # NC -> drive -> the user's mechanics, for each of X and Y: the interpolator and the
@@ -81,11 +83,12 @@ class Loop:
     @property
     def feed_forward(self):
         """The controller's feed-forward settings every parameter set of the loop's SSP file
-        holds: fitted to the loop's plant and step (docs/design/two-axis.md §4.12b)."""
+        holds: fitted to the loop's plant and step, and where the controller has it, the
+        interpolator's look-ahead (docs/design/two-axis.md §4.12b)."""
         shared = None
         for values in self.structure.parameter_sets.values():
             settings = {k: v for k, v in values.get("controller", {}).items()
-                        if k in ("feedForward", "accelerationFeedForward")}
+                        if k in FEED_FORWARD_SETTINGS}
             shared = settings if shared is None else shared
             if settings != shared:
                 raise ValueError(f"{self.structure.file}: the parameter sets differ in the "

@@ -62,6 +62,15 @@ impl XyReference {
         self.current
     }
 
+    /// The sample one period ahead, the reference unchanged (the plan's look-ahead).
+    pub fn peek(&self) -> XyPoint {
+        let mut cursor = self.cursor;
+        self.plan.at(
+            self.k.saturating_add(1) as f64 * self.limits.ts,
+            &mut cursor,
+        )
+    }
+
     /// The plan has reached the path's end.
     pub fn done(&self) -> bool {
         self.k as f64 * self.limits.ts >= self.plan.duration()
@@ -110,5 +119,42 @@ impl<'de> Deserialize<'de> for XyReference {
             ));
         }
         XyReference::at_sample(data.path, data.limits, data.k).map_err(serde::de::Error::custom)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::path::planar::Program;
+
+    /// The look-ahead is the next step, bit for bit, on a program with an exact stop, a
+    /// tight arc and its end, and peeking moves nothing.
+    #[test]
+    fn peek_is_the_next_sample_and_leaves_the_reference_where_it_was() {
+        let program = Program::parse_gcode(
+            "G21 G90 G61\nG1 X5 Y0 F600\nG3 X5.4 Y0.4 R0.4\nG1 X5.4 Y3\nM30\n",
+            "peek",
+        )
+        .unwrap();
+        let limits = XyLimits {
+            feed: 10.0,
+            rapid: 100.0,
+            accel: 2000.0,
+            jerk: 5e4,
+            tolerance: 0.0,
+            ts: 1e-3,
+        };
+        let mut reference = XyReference::new(Path::Program(program), limits).unwrap();
+        let mut steps = 0;
+        while !reference.done() || steps < 3 {
+            let before = reference.clone();
+            let peeked = reference.peek();
+            assert_eq!(reference, before);
+            assert_eq!(reference.step(), peeked, "sample {steps}");
+            steps += 1;
+        }
+        assert!(steps > 500, "{steps}");
+        // At the end the look-ahead is the end at rest.
+        assert_eq!(reference.peek().speed, 0.0);
     }
 }
