@@ -15,10 +15,11 @@
 //! a loop with an FMU that allows one instance per process runs one candidate at a time,
 //! and one whose FMU returned fmi2Fatal scores every later candidate as a failed run.
 
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use contour_core::geometry::Vector;
 use contour_core::path::planar::Path;
+use contour_cosim::fmi2::Activity;
 use contour_cosim::simulation::End;
 use contour_cosim::ssp::StartValues;
 use contour_cosim::system::Resolved;
@@ -73,6 +74,7 @@ pub struct FmuObjective<'a> {
     factors: Vec<Resolved>,
     idle: Mutex<Vec<Simulation<'a>>>,
     one_at_a_time: Option<Mutex<()>>,
+    activity: Arc<Activity>,
 }
 
 impl<'a> FmuObjective<'a> {
@@ -81,7 +83,7 @@ impl<'a> FmuObjective<'a> {
     /// and `fitness` judges: the interpolator and the controller (for its program
     /// estimator) get the path, the controller the factors; the plant's `pos.x`, `pos.y`
     /// are judged. A loop without these variables is refused, and so is a planned
-    /// reference that does not end.
+    /// reference that does not end. Every FMU call counts in `activity` (a watchdog's).
     pub fn new(
         system: &'a System,
         path: &str,
@@ -89,6 +91,7 @@ impl<'a> FmuObjective<'a> {
         plant: &str,
         fitness: Fitness,
         settings: &LoopSettings,
+        activity: Arc<Activity>,
     ) -> Result<Self, String> {
         let in_loop = |e: contour_cosim::Error| format!("the loop: {e}");
         let named = |unit: &str, name: &str| system.resolve(unit, name).map_err(in_loop);
@@ -138,6 +141,7 @@ impl<'a> FmuObjective<'a> {
             factors: factors.clone(),
             idle: Mutex::new(Vec::new()),
             one_at_a_time: system.once_per_process().then(|| Mutex::new(())),
+            activity,
         };
         let ts = objective.reference.ts();
         let planned = settings.real(INTERPOLATOR, "accel").unwrap_or(0.0) > 0.0;
@@ -214,8 +218,13 @@ impl<'a> FmuObjective<'a> {
         let taken = self.idle.lock().map_err(|e| e.to_string())?.pop();
         let mut simulation = match taken {
             Some(s) => s,
-            None => Simulation::new(self.system, Scheme::GaussSeidel, false)
-                .map_err(|e| e.to_string())?,
+            None => Simulation::watched(
+                self.system,
+                Scheme::GaussSeidel,
+                false,
+                self.activity.clone(),
+            )
+            .map_err(|e| e.to_string())?,
         };
         let mut start = self.fixed.clone();
         start.extend(

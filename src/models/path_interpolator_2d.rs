@@ -280,43 +280,42 @@ fn path(values: &Values, environment: &Environment) -> Result<Path, String> {
 }
 
 impl PathInterpolator2D {
+    /// The outputs of the current sample. The planned duration is written once, at
+    /// initialization: a path's length costs its whole length to measure, which a step
+    /// must not.
     fn write_outputs(&self, values: &mut Values) {
         let Some(state) = &self.state else { return };
-        let (point, done, speed, duration, velocity, acceleration, next_velocity) =
-            match &state.reference {
-                Reference::ConstantFeed(it) => {
-                    let sample = it.current();
-                    let speed = if sample.done { 0.0 } else { it.feed() };
-                    (
-                        sample.point,
-                        sample.done,
-                        speed,
-                        it.path().length() / it.feed(),
-                        it.velocity(),
-                        it.acceleration(),
-                        it.next_velocity(),
-                    )
-                }
-                Reference::Planned(planned) => {
-                    let (sample, next) = (planned.current(), planned.peek());
-                    (
-                        sample.point,
-                        planned.done(),
-                        sample.speed,
-                        planned.duration(),
-                        sample.direction * sample.speed,
-                        sample.acceleration,
-                        next.direction * next.speed,
-                    )
-                }
-            };
+        let (point, done, speed, velocity, acceleration, next_velocity) = match &state.reference {
+            Reference::ConstantFeed(it) => {
+                let sample = it.current();
+                let speed = if sample.done { 0.0 } else { it.feed() };
+                (
+                    sample.point,
+                    sample.done,
+                    speed,
+                    it.velocity(),
+                    it.acceleration(),
+                    it.next_velocity(),
+                )
+            }
+            Reference::Planned(planned) => {
+                let (sample, next) = (planned.current(), planned.peek());
+                (
+                    sample.point,
+                    planned.done(),
+                    sample.speed,
+                    sample.direction * sample.speed,
+                    sample.acceleration,
+                    next.direction * next.speed,
+                )
+            }
+        };
         AHEAD.set(values, &((next_velocity - velocity) / state.clock.period()));
         REF.set(values, &point);
         VREF.set(values, &velocity);
         AREF.set(values, &acceleration);
         DONE.set(values, done);
         FEED_RATE.set(values, speed);
-        DURATION.set(values, duration);
     }
 }
 
@@ -353,6 +352,11 @@ impl Model for PathInterpolator2D {
             let path = path.blended(tolerance);
             Reference::ConstantFeed(Interpolator::new(path, feed, ts).map_err(|e| e.to_string())?)
         };
+        let duration = match &reference {
+            Reference::ConstantFeed(it) => it.path().length() / it.feed(),
+            Reference::Planned(planned) => planned.duration(),
+        };
+        DURATION.set(values, duration);
         self.state = Some(State {
             reference,
             clock: SampleClock::new(start_time, ts),

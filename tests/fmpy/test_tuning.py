@@ -189,3 +189,39 @@ def test_the_ccc_tunes_on_top_of_feed_forward_on_a_planned_part_through_the_fmus
     # The shipped loop's own factors (the paper's) leave 0.381 um at the exact stops; the
     # swarm's best is no worse.
     assert tuned <= largest_error(PAPER) < 0.4e-3
+
+
+def test_a_candidate_whose_plant_hangs_is_ended_recorded_and_the_tuning_goes_on(ccc_tune, tmp_path):
+    """A C plant FMU that spins forever in every third run of its process: each hung
+    candidate's worker ends after --timeout, the candidate scores as a run that cannot
+    start (twice the divergence penalty, above any run), the JSON lists it with the
+    worker's message, and the tuning goes on with a new worker to a finite best."""
+    from helpers import faulty_fmu
+
+    faulty_fmu.build(tmp_path)
+    out = tmp_path / "tuned.json"
+    done = tune(ccc_tune, out, "--plant", tmp_path / "Faulty.fmu", "--path", "circle",
+                "--start", "plant.fault=5", "--start", "plant.fault_time=0.5",
+                "--timeout", 0.5, "--swarm", 4, "--iters", 3, "--seed", 7, "--threads", 1)
+    assert done.returncode == 0, done.stderr
+    document = json.loads(out.read_text())
+    failed = document["failed_candidates"]
+    # 12 candidates, one worker at a time: runs 3, 6, 9 and 12 of a worker hang, and each
+    # hang starts a new worker: candidates 3, 6, 9 and 12 hang.
+    assert len(failed) == 4, failed
+    for f in failed:
+        assert f["reason"] == "timeout: an FMU call did not return within 0.5 s", f
+        assert len(f["factors"]) == 5
+    assert document["settings"]["timeout_s"] == 0.5
+    assert 0 < document["fitness_mm"] < 1.0  # mm: a real run's, not the penalty
+    assert document["history_mm"][-1] == document["fitness_mm"]
+
+
+@pytest.mark.parametrize("timeout", ["0", "-1", "nan", "inf"])
+def test_a_timeout_that_is_no_time_is_refused(ccc_tune, fmu_dir, tmp_path, timeout):
+    out = tmp_path / "tuned.json"
+    done = tune(ccc_tune, out, "--loop", fmu_dir / "two_axis.ssd", "--timeout", timeout,
+                "--swarm", 2, "--iters", 1)
+    assert done.returncode != 0
+    assert "--timeout must be a positive number of seconds" in done.stderr, done.stderr
+    assert list(tmp_path.iterdir()) == []

@@ -7,12 +7,15 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Instant;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use contour_core::path::planar::Path;
 use contour_core::sim::preset_feed;
-use contour_cosim::fmi2::Activity;
+use contour_cosim::fmi2::{self, Activity};
+use contour_cosim::watchdog::Watchdog;
 use contour_cosim::{System, SystemStructure};
+use contour_tune::candidate_process::{serve, Workers, WORKER_FLAG};
 use contour_tune::fmu_objective::{FmuObjective, LoopSettings};
 use contour_tune::objective::{ContourObjective, Fitness, FACTOR_NAMES, LOWER, UPPER};
 use contour_tune::{minimize, Algorithm, PsoSettings};
@@ -23,7 +26,7 @@ usage: ccc-tune [--path circle|infinity|trident|FILE] [--feed MM_PER_S] [--swarm
                 [--iters 100] [--algorithm improved|standard] [--seed 1] [--out tuned.json]
                 [--lower a,b,c,d,e] [--upper a,b,c,d,e] [--plant paper|mismatched|PLANT.fmu]
                 [--loop LOOP.ssd|LOOP.ssp] [--parameter-set NAME] [--start UNIT.VAR=VALUE]...
-                [--settle 0.25] [--fitness mean|max] [--threads N]
+                [--settle 0.25] [--timeout 60] [--fitness mean|max] [--threads N]
 
 Minimises the mean (or max) |true contour error| of the closed loop interpolator -> fuzzy-PID CCC
 -> XYServoPlant over the factors (ke, kde, kp, ki, kd) of ContourCCC2D. The feed defaults
@@ -39,7 +42,11 @@ carry feed-forward and, on two axes, a planned reference), --start sets any vari
 (repeatable); the interpolator and the controller get --path. With a planned reference
 (interpolator.accel > 0) a run lasts until the reference ends plus --settle seconds, and
 the true error is taken against the path as followed (blended with interpolator.tolerance):
-the way to tune the CCC on top of feed-forward, on a part program with corners.";
+the way to tune the CCC on top of feed-forward, on a part program with corners.
+Through FMUs the candidates run in worker processes (this program again, one per thread):
+an FMU call longer than --timeout seconds ends its worker, and a candidate whose worker
+ended (a hang, a crash) scores as a run that cannot start and is listed in the JSON's
+failed_candidates; the tuning goes on with a new worker.";
 
 struct Options {
     path: String,
@@ -56,6 +63,8 @@ struct Options {
     parameter_set: Option<String>,
     starts: Vec<String>,
     settle: f64,
+    timeout: f64,
+    worker: bool,
     fitness: Fitness,
     threads: Option<usize>,
 }
@@ -90,6 +99,8 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
         parameter_set: None,
         starts: Vec::new(),
         settle: 0.25,
+        timeout: 60.0,
+        worker: false,
         fitness: Fitness::Mean,
         threads: None,
     };
@@ -97,6 +108,10 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
     while let Some(flag) = it.next() {
         if flag == "-h" || flag == "--help" {
             return Ok(None);
+        }
+        if flag == WORKER_FLAG {
+            o.worker = true;
+            continue;
         }
         let value = it.next().ok_or_else(|| format!("{flag} needs a value"))?;
         let number = |what: &str| -> Result<f64, String> {
@@ -128,6 +143,7 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
             "--parameter-set" => o.parameter_set = Some(value.clone()),
             "--start" => o.starts.push(value.clone()),
             "--settle" => o.settle = number("--settle")?,
+            "--timeout" => o.timeout = number("--timeout")?,
             "--fitness" => o.fitness = value.parse()?,
             "--threads" => o.threads = Some(count("--threads")?),
             other => return Err(format!("unknown option '{other}'")),
@@ -136,8 +152,8 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
     Ok(Some(o))
 }
 
-fn run(o: Options) -> Result<(), String> {
-    if let Some(threads) = o.threads {
+fn run(o: Options, args: &[String]) -> Result<(), String> {
+    if let Some(threads) = o.threads.filter(|_| !o.worker) {
         if threads == 0 {
             return Err("--threads must be at least 1".into());
         }
@@ -172,26 +188,22 @@ fn run(o: Options) -> Result<(), String> {
         (None, true) => Some(default_loop()?),
         (None, false) => None,
     };
-    let system = if let Some(loop_file) = &loop_file {
-        let mut structure = SystemStructure::read(loop_file).map_err(|e| format!("--loop: {e}"))?;
-        if let Some(plant) = &plant_fmu {
-            structure
-                .replace_source("plant", plant)
-                .map_err(|e| format!("--plant: {e}"))?;
+    if !(o.timeout.is_finite() && o.timeout > 0.0) {
+        return Err(format!(
+            "--timeout must be a positive number of seconds, not {}",
+            o.timeout
+        ));
+    }
+    let objective = match &loop_file {
+        Some(loop_file) if o.worker => {
+            return work(&o, loop_file, plant_fmu.as_deref(), feed, preset);
         }
-        Some(System::from_structure(structure, &Activity::default()).map_err(|e| e.to_string())?)
-    } else {
-        None
-    };
-    let objective = match &system {
-        Some(system) => Objective::Fmus(FmuObjective::new(
-            system,
-            &o.path,
-            feed,
-            preset,
-            o.fitness,
-            &loop_settings(&o, system)?,
-        )?),
+        Some(_) => {
+            let program =
+                std::env::current_exe().map_err(|e| format!("cannot find this program: {e}"))?;
+            Objective::Workers(Workers::start(program, args.to_vec())?)
+        }
+        None if o.worker => return Err(format!("{WORKER_FLAG} needs a loop of FMUs")),
         None => Objective::InProcess(ContourObjective::new(path, feed, preset, o.fitness)?),
     };
     let settings = PsoSettings {
@@ -250,7 +262,7 @@ fn run(o: Options) -> Result<(), String> {
             "feed_mm_per_s": feed,
             "plant": o.plant,
             "fitness": o.fitness,
-            "ts_s": objective.reference().ts(),
+            "ts_s": objective.ts(),
             "algorithm": settings.algorithm,
             "swarm": settings.swarm,
             "iterations": settings.iterations,
@@ -269,8 +281,16 @@ fn run(o: Options) -> Result<(), String> {
             document["settings"]["starts"] = json!(o.starts);
         }
         document["settings"]["settle_s"] = json!(o.settle);
-        document["settings"]["run_s"] =
-            json!(objective.reference().simulator().samples() as f64 * objective.reference().ts());
+        document["settings"]["timeout_s"] = json!(o.timeout);
+        document["settings"]["run_s"] = json!(objective.samples() as f64 * objective.ts());
+    }
+    if let Objective::Workers(workers) = &objective {
+        let failed: Vec<_> = workers
+            .failures()
+            .into_iter()
+            .map(|f| json!({ "factors": f.factors, "reason": f.reason }))
+            .collect();
+        document["failed_candidates"] = json!(failed);
     }
     let text = serde_json::to_string_pretty(&document).map_err(|e| e.to_string())? + "\n";
     // Written beside the target and renamed into place: a failed write leaves nothing.
@@ -292,26 +312,81 @@ fn run(o: Options) -> Result<(), String> {
     Ok(())
 }
 
-/// The in-process objective, or the same through FMUs.
-enum Objective<'a> {
+/// The in-process objective, or the same through FMUs in worker processes.
+#[allow(clippy::large_enum_variant)] // one per run
+enum Objective {
     InProcess(ContourObjective),
-    Fmus(FmuObjective<'a>),
+    Workers(Workers),
 }
 
-impl Objective<'_> {
+impl Objective {
     fn evaluate(&self, factors: &[f64]) -> f64 {
         match self {
             Objective::InProcess(o) => o.evaluate(factors),
-            Objective::Fmus(o) => o.evaluate(factors),
+            Objective::Workers(w) => w.evaluate(factors),
         }
     }
 
-    fn reference(&self) -> &ContourObjective {
+    fn ts(&self) -> f64 {
         match self {
-            Objective::InProcess(o) => o,
-            Objective::Fmus(o) => o.reference(),
+            Objective::InProcess(o) => o.ts(),
+            Objective::Workers(w) => w.greeting().ts,
         }
     }
+
+    fn samples(&self) -> usize {
+        match self {
+            Objective::InProcess(o) => o.simulator().samples(),
+            Objective::Workers(w) => w.greeting().samples,
+        }
+    }
+}
+
+/// A worker's life (`--worker`): loads the loop with every FMU call watched, then scores
+/// the candidates its parent sends (contour_tune::candidate_process).
+fn work(
+    o: &Options,
+    loop_file: &std::path::Path,
+    plant_fmu: Option<&std::path::Path>,
+    feed: f64,
+    preset: &str,
+) -> Result<(), String> {
+    // Watched from the start, as contour-cosim's runs: loading runs the libraries'
+    // initialisers. The hung call keeps its thread, so only ending the process frees it.
+    let activity = Arc::new(Activity::default());
+    let timeout = o.timeout;
+    let _watchdog = Watchdog::start(
+        activity.clone(),
+        Duration::from_secs_f64(timeout),
+        move || {
+            eprintln!("ccc-tune: timeout: an FMU call did not return within {timeout} s");
+            fmi2::abandon_process(TIMEOUT_STATUS);
+        },
+    );
+    // The answers go to a descriptor of their own: what an FMU prints goes to stderr.
+    let answers =
+        fmi2::private_stdout().map_err(|e| format!("cannot set the standard output aside: {e}"))?;
+    let mut structure = SystemStructure::read(loop_file).map_err(|e| format!("--loop: {e}"))?;
+    if let Some(plant) = plant_fmu {
+        structure
+            .replace_source("plant", plant)
+            .map_err(|e| format!("--plant: {e}"))?;
+    }
+    let system = System::from_structure(structure, &activity).map_err(|e| e.to_string())?;
+    let objective = FmuObjective::new(
+        &system,
+        &o.path,
+        feed,
+        preset,
+        o.fitness,
+        &loop_settings(o, &system)?,
+        activity,
+    )?;
+    serve(
+        &objective,
+        std::io::stdin().lock(),
+        std::io::BufWriter::new(answers),
+    )
 }
 
 /// The loop's start values the options give: the parameter set's, then --start's.
@@ -346,6 +421,9 @@ fn loop_settings(o: &Options, system: &System) -> Result<LoopSettings, String> {
     })
 }
 
+/// A worker's exit status when an FMU call hung (contour-cosim's too).
+const TIMEOUT_STATUS: i32 = 3;
+
 /// The shipped two-axis loop beside this program's build: <target>/fmu/two_axis.ssd.
 fn default_loop() -> Result<PathBuf, String> {
     let exe = std::env::current_exe().map_err(|e| format!("cannot find this program: {e}"))?;
@@ -363,7 +441,7 @@ fn main() -> ExitCode {
             println!("{USAGE}");
             ExitCode::SUCCESS
         }
-        Ok(Some(options)) => match run(options) {
+        Ok(Some(options)) => match run(options, &args) {
             Ok(()) => ExitCode::SUCCESS,
             Err(message) => {
                 eprintln!("ccc-tune: {message}");

@@ -4,7 +4,8 @@ campaign takes it as the plant): velocity commands `u.x`, `u.y` in, positions `p
 `pos.y` out (ideal axes: pos += u·h), starting at `pos0.*`. At `fault_time` its fmi2DoStep
 does what the Integer parameter `fault` says: 0 nothing, 1 dereferences NULL (SIGSEGV), 2
 spins forever, 3 prints a line on standard output at every step from then on, 4 returns
-fmi2Fatal. Every other fmi2 function a master may look up exists and returns fmi2Error
+fmi2Fatal, 5 spins forever in every third run of its process (runs counted by
+fmi2ExitInitializationMode: a tuner's candidates hang now and then). Every other fmi2 function a master may look up exists and returns fmi2Error
 where it does nothing."""
 
 import subprocess
@@ -12,7 +13,7 @@ import zipfile
 from pathlib import Path
 
 GUID = "{5c0e5a77-1c4e-4d0c-9a44-000000000fa1}"
-NONE, SEGFAULT, HANG, CHATTY, FATAL = 0, 1, 2, 3, 4
+NONE, SEGFAULT, HANG, CHATTY, FATAL, HANG_EVERY_THIRD_RUN = 0, 1, 2, 3, 4, 5
 
 SOURCE = r"""
 #include <stdio.h>
@@ -35,8 +36,10 @@ EXPORT C fmi2Instantiate(const char *name, int type, const char *guid, const cha
 EXPORT void fmi2FreeInstance(C c) { free(c); }
 EXPORT int fmi2SetupExperiment(C c, int td, double tol, double start, int sd, double stop) { return OK; }
 EXPORT int fmi2EnterInitializationMode(C c) { return OK; }
+static int runs = 0;
 EXPORT int fmi2ExitInitializationMode(C c) {
     M *m = c;
+    runs++;
     m->r[2] = m->r[4];
     m->r[3] = m->r[5];
     return OK;
@@ -77,6 +80,7 @@ EXPORT int fmi2DoStep(C c, double t, double h, int no_prior) {
         if (m->fault == 2) { volatile int spin = 1; while (spin) {} }
         if (m->fault == 3) { printf("chatty FMU at t = %g\\n", t); }
         if (m->fault == 4) { return 4; }
+        if (m->fault == 5 && runs % 3 == 0) { volatile int spin = 1; while (spin) {} }
     }
     m->r[2] += m->r[0] * h;
     m->r[3] += m->r[1] * h;
