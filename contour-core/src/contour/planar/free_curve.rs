@@ -157,10 +157,14 @@ impl ContourEstimator for FreeCurveEstimator {
             _ => {}
         }
         // Walk back from the command point while the distance decreases.
+        // Back from the latest reference while the distance falls: newest to oldest is
+        // the ring's front part backwards, then its back part backwards.
+        let (front, back) = self.buf.split_at(self.head + 1);
+        let mut older = front.iter().rev().chain(back.iter().rev()).take(self.len);
         let mut k = 0;
-        let mut d = geometry::dist2(&actual, &self.get(0));
-        while k + 1 < self.len {
-            let dn = geometry::dist2(&actual, &self.get(k + 1));
+        let mut d = older.next().map_or(0.0, |r| geometry::dist2(&actual, r));
+        for r in older {
+            let dn = geometry::dist2(&actual, r);
             if dn < d {
                 d = dn;
                 k += 1;

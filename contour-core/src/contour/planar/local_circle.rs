@@ -30,9 +30,16 @@ pub(crate) fn circle_error(p: Vector2, a: Vector2, t: Vector2, kappa: f64) -> Co
 
 /// Signed curvature of the circle through three points in travel order `a → b → c`
 /// (κ = 2·(b − a)×(c − b) / (|b − a||c − b||c − a|)); 0 when degenerate.
+#[cfg(test)]
 pub(crate) fn curvature3(a: Vector2, b: Vector2, c: Vector2) -> f64 {
-    let (ab, bc, ac) = ((b - a), (c - b), (c - a));
-    let den = geometry::norm(&ab) * geometry::norm(&bc) * geometry::norm(&ac);
+    let (ab, bc) = ((b - a), (c - b));
+    curvature_of(ab, bc, geometry::norm(&ab), geometry::norm(&bc), &(c - a))
+}
+
+/// [`curvature3`] from the chords `ab`, `bc` whose lengths the caller has (a triple
+/// needs them again for its tangents).
+fn curvature_of(ab: Vector2, bc: Vector2, ab_len: f64, bc_len: f64, ac: &Vector2) -> f64 {
+    let den = ab_len * bc_len * geometry::norm(ac);
     let k = 2.0 * geometry::cross(&ab, &bc) / den;
     if den > 0.0 && k.is_finite() {
         k
@@ -41,11 +48,10 @@ pub(crate) fn curvature3(a: Vector2, b: Vector2, c: Vector2) -> f64 {
     }
 }
 
-/// Unit tangent at an end of the chord `x → y` of a circle of curvature `kappa`: the
-/// chord direction turned back (at `x`) or forward (at `y`) by half the subtended angle.
-pub(crate) fn chord_tangent(x: Vector2, y: Vector2, kappa: f64, at_end: bool) -> Vector2 {
-    let c = y - x;
-    let len = geometry::norm(&c);
+/// Unit tangent at an end of the chord `c` (length `len`) of a circle of curvature
+/// `kappa`: the chord direction turned back (at its start) or forward (at its end,
+/// `at_end`) by half the subtended angle.
+fn chord_tangent(c: Vector2, len: f64, kappa: f64, at_end: bool) -> Vector2 {
     if len == 0.0 {
         return Vector2::zeros();
     }
@@ -57,16 +63,18 @@ pub(crate) fn chord_tangent(x: Vector2, y: Vector2, kappa: f64, at_end: bool) ->
 }
 
 /// Estimate against the circle through `a → b → c` at whichever of the three is `anchor`
-/// (0 = a, 1 = b, 2 = c).
+/// (0 = a, 1 = b, 2 = c). Each chord's length is measured once.
 pub(crate) fn triple_error(p: Vector2, pts: [Vector2; 3], anchor: usize) -> ContourEstimate {
     let [a, b, c] = pts;
-    let k = curvature3(a, b, c);
+    let (ab, bc) = (b - a, c - b);
+    let (ab_len, bc_len) = (geometry::norm(&ab), geometry::norm(&bc));
+    let k = curvature_of(ab, bc, ab_len, bc_len, &(c - a));
     let t = match anchor {
-        0 => chord_tangent(a, b, k, false),
-        2 => chord_tangent(b, c, k, true),
+        0 => chord_tangent(ab, ab_len, k, false),
+        2 => chord_tangent(bc, bc_len, k, true),
         _ => {
-            let t1 = chord_tangent(a, b, k, true);
-            let t2 = chord_tangent(b, c, k, false);
+            let t1 = chord_tangent(ab, ab_len, k, true);
+            let t2 = chord_tangent(bc, bc_len, k, false);
             let s = t1 + t2;
             let l = geometry::norm(&s);
             if l > 0.0 {
