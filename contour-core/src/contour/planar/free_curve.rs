@@ -43,7 +43,7 @@ struct FreeCurveData {
 }
 
 /// Two-circle free-curve estimator over a ring buffer of reference samples.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(try_from = "FreeCurveData", into = "FreeCurveData")]
 pub struct FreeCurveEstimator {
     buf: Vec<Vector2>,
@@ -51,6 +51,16 @@ pub struct FreeCurveEstimator {
     head: usize,
     /// Number of valid samples.
     len: usize,
+    /// `chords[i]`: the length of the chord from the sample before `buf[i]` to it, as
+    /// `push` measured it. Each chord serves up to four circles, so it is measured once;
+    /// derived from the samples, so neither saved nor compared.
+    chords: Vec<f64>,
+}
+
+impl PartialEq for FreeCurveEstimator {
+    fn eq(&self, other: &Self) -> bool {
+        (&self.buf, self.head, self.len) == (&other.buf, other.head, other.len)
+    }
 }
 
 impl TryFrom<FreeCurveData> for FreeCurveEstimator {
@@ -59,11 +69,18 @@ impl TryFrom<FreeCurveData> for FreeCurveEstimator {
         if d.buf.len() < MIN_CAPACITY || d.head >= d.buf.len() || d.len > d.buf.len() {
             return Err("corrupt free-curve estimator state".into());
         }
-        Ok(FreeCurveEstimator {
+        let mut estimator = FreeCurveEstimator {
+            chords: vec![0.0; d.buf.len()],
             buf: d.buf,
             head: d.head,
             len: d.len,
-        })
+        };
+        // The chords again, from the samples, as `push` measured them.
+        for k in 0..estimator.len.saturating_sub(1) {
+            let i = estimator.index(k);
+            estimator.chords[i] = geometry::dist(&estimator.get(k), &estimator.get(k + 1));
+        }
+        Ok(estimator)
     }
 }
 
@@ -93,6 +110,7 @@ impl FreeCurveEstimator {
             buf: vec![Vector2::zeros(); cap],
             head: 0,
             len: 0,
+            chords: vec![0.0; cap],
         }
     }
 
@@ -111,24 +129,39 @@ impl FreeCurveEstimator {
         self.len == 0
     }
 
-    /// The `k`-th newest stored sample (0 = newest); `k < len`.
-    fn get(&self, k: usize) -> Vector2 {
+    /// Where the `k`-th newest stored sample is in the ring (0 = newest); `k < len`.
+    fn index(&self, k: usize) -> usize {
         // No `%` on the hot path: k < len ≤ capacity and head < capacity.
-        let i = if k <= self.head {
+        if k <= self.head {
             self.head - k
         } else {
             (self.head + self.buf.len()).wrapping_sub(k)
-        };
-        self.buf.get(i).copied().unwrap_or_default()
+        }
+    }
+
+    /// The `k`-th newest stored sample (0 = newest); `k < len`.
+    fn get(&self, k: usize) -> Vector2 {
+        self.buf.get(self.index(k)).copied().unwrap_or_default()
+    }
+
+    /// The length of the chord from the `k + 1`-th latest sample to the `k`-th.
+    fn chord(&self, k: usize) -> f64 {
+        self.chords.get(self.index(k)).copied().unwrap_or_default()
     }
 
     fn push(&mut self, r: Vector2) {
-        if self.len > 0 && geometry::dist(&r, &self.get(0)) <= MIN_SPACING {
+        let chord = if self.len > 0 {
+            geometry::dist(&r, &self.get(0))
+        } else {
+            0.0
+        };
+        if self.len > 0 && chord <= MIN_SPACING {
             return;
         }
         let cap = self.buf.len();
         self.head = (self.head + 1) % cap;
         self.buf[self.head] = r;
+        self.chords[self.head] = chord;
         self.len = (self.len + 1).min(cap);
     }
 
@@ -139,7 +172,13 @@ impl FreeCurveEstimator {
             return None;
         }
         let pts = [self.get(m + 1), self.get(m), self.get(m - 1)];
-        Some(local_circle::triple_error(p, pts, m + 1 - k))
+        let chords = [self.chord(m), self.chord(m - 1)];
+        Some(local_circle::triple_error_with_chords(
+            p,
+            pts,
+            chords,
+            m + 1 - k,
+        ))
     }
 }
 
@@ -226,6 +265,33 @@ mod tests {
     /// With a lag longer than the buffer the walk stops at the oldest sample, where only
     /// the circle on the newer side exists; on a circle that circle is still the path, so
     /// the estimate stays exact (the fallback branch of `estimate`).
+    /// The chords are not saved: a restored estimator measures them again, as `push`
+    /// did, and goes on bit for bit (also after the ring wrapped).
+    #[test]
+    fn a_restored_estimator_goes_on_bit_for_bit() {
+        let c = |t: f64| Vector2::new(20.0 * math::cos(t), 7.0 * math::sin(2.0 * t));
+        let mut original = FreeCurveEstimator::new(8);
+        let run = |e: &mut FreeCurveEstimator, from: usize, to: usize| -> Vec<(u64, u64, u64)> {
+            (from..to)
+                .map(|i| {
+                    let t = i as f64 * 0.01;
+                    let r = e.estimate(c(t), c(t - 0.035) * 1.001);
+                    (
+                        r.error.to_bits(),
+                        r.normal[0].to_bits(),
+                        r.normal[1].to_bits(),
+                    )
+                })
+                .collect()
+        };
+        run(&mut original, 0, 21);
+        // postcard, as the FMUs' saved states.
+        let bytes = postcard::to_stdvec(&original).unwrap();
+        let mut restored: FreeCurveEstimator = postcard::from_bytes(&bytes).unwrap();
+        assert_eq!(restored, original);
+        assert_eq!(run(&mut restored, 21, 60), run(&mut original, 21, 60));
+    }
+
     #[test]
     fn a_lag_beyond_the_buffer_uses_the_oldest_circle() {
         let c = |t: f64| Vector2::new(20.0 * math::cos(t), 20.0 * math::sin(t));

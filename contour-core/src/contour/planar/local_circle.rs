@@ -63,11 +63,24 @@ fn chord_tangent(c: Vector2, len: f64, kappa: f64, at_end: bool) -> Vector2 {
 }
 
 /// Estimate against the circle through `a → b → c` at whichever of the three is `anchor`
-/// (0 = a, 1 = b, 2 = c). Each chord's length is measured once.
+/// (0 = a, 1 = b, 2 = c).
 pub(crate) fn triple_error(p: Vector2, pts: [Vector2; 3], anchor: usize) -> ContourEstimate {
     let [a, b, c] = pts;
+    let chords = [geometry::norm(&(b - a)), geometry::norm(&(c - b))];
+    triple_error_with_chords(p, pts, chords, anchor)
+}
+
+/// [`triple_error`] given the lengths of the chords a → b and b → c, |b − a| and |c − b|
+/// as [`geometry::norm`] measures them (a caller that keeps them measures each once).
+pub(crate) fn triple_error_with_chords(
+    p: Vector2,
+    pts: [Vector2; 3],
+    chords: [f64; 2],
+    anchor: usize,
+) -> ContourEstimate {
+    let [a, b, c] = pts;
     let (ab, bc) = (b - a, c - b);
-    let (ab_len, bc_len) = (geometry::norm(&ab), geometry::norm(&bc));
+    let [ab_len, bc_len] = chords;
     let k = curvature_of(ab, bc, ab_len, bc_len, &(c - a));
     let t = match anchor {
         0 => chord_tangent(ab, ab_len, k, false),
