@@ -306,19 +306,28 @@ impl Instance {
     /// does, returning `Some`; `None`, having changed nothing, for any other call.
     #[inline]
     pub fn set_free_reals(&mut self, vrs: &[u32], values: &[f64]) -> Option<()> {
-        // Finite in the model's units too: a finite value in m can overflow in mm.
+        // Finite in the model's units too: a finite value in m can overflow in mm. An
+        // interface that converts nothing divides by nothing (x / 1 is x).
+        let model_value = |vr: u32, x: f64| {
+            if self.converts {
+                x / self.scale[vr as usize]
+            } else {
+                x
+            }
+        };
         let free = vrs.len() == values.len()
-            && vrs.iter().zip(values).all(|(&vr, x)| {
+            && vrs.iter().zip(values).all(|(&vr, &x)| {
                 self.access
                     .get(vr as usize)
                     .is_some_and(|a| a.has(Access::FREE_REAL_INPUT))
-                    && (x / self.scale[vr as usize]).is_finite()
+                    && model_value(vr, x).is_finite()
             });
         if !free {
             return None;
         }
         for (&vr, &x) in vrs.iter().zip(values) {
-            self.values.set_real(vr as Vr, x / self.scale[vr as usize]);
+            let value = model_value(vr, x);
+            self.values.set_real(vr as Vr, value);
         }
         if self.mode != Mode::StepComplete {
             self.needs_initialize = true;
