@@ -54,6 +54,10 @@ pub struct Workers {
 
 struct Worker {
     child: Child,
+    /// The worker's temporary folder (its TMPDIR, TMP and TEMP): the FMUs it unpacks go
+    /// there, and the folder goes when the worker does, however it ended (a worker that
+    /// an FMU call hung ends at once, without cleaning up).
+    _scratch: tempfile::TempDir,
     /// Closed to end the worker: it then frees its instances and unpacked FMUs.
     input: Option<ChildStdin>,
     output: BufReader<ChildStdout>,
@@ -140,9 +144,16 @@ impl Workers {
 
 impl Worker {
     fn spawn(program: &PathBuf, args: &[String]) -> Result<Worker, String> {
+        let scratch = tempfile::Builder::new()
+            .prefix("ccc-tune-worker-")
+            .tempdir()
+            .map_err(|e| format!("cannot make a folder for a worker: {e}"))?;
         let mut child = Command::new(program)
             .args(args)
             .arg(WORKER_FLAG)
+            .env("TMPDIR", scratch.path())
+            .env("TMP", scratch.path())
+            .env("TEMP", scratch.path())
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
@@ -171,6 +182,7 @@ impl Worker {
         });
         Ok(Worker {
             child,
+            _scratch: scratch,
             input: Some(input),
             output: BufReader::new(output),
             stderr,

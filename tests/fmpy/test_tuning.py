@@ -2,6 +2,7 @@
 to the ContourCCC2D FMU in the fmpy closed loop."""
 
 import json
+import os
 import subprocess
 
 import numpy as np
@@ -200,10 +201,16 @@ def test_a_candidate_whose_plant_hangs_is_ended_recorded_and_the_tuning_goes_on(
 
     faulty_fmu.build(tmp_path)
     out = tmp_path / "tuned.json"
-    done = tune(ccc_tune, out, "--plant", tmp_path / "Faulty.fmu", "--path", "circle",
-                "--start", "plant.fault=5", "--start", "plant.fault_time=0.5",
-                "--timeout", 0.5, "--swarm", 4, "--iters", 3, "--seed", 7, "--threads", 1)
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    args = ["--plant", tmp_path / "Faulty.fmu", "--path", "circle", "--start", "plant.fault=5",
+            "--start", "plant.fault_time=0.5", "--timeout", 0.5, "--swarm", 4, "--iters", 3,
+            "--seed", 7, "--threads", 1, "--out", out]
+    done = subprocess.run([ccc_tune, *map(str, args)], capture_output=True, text=True,
+                          env={**os.environ, "TMPDIR": str(scratch)})
     assert done.returncode == 0, done.stderr
+    # The hung workers ended at once, without cleaning up; their folders went with them.
+    assert list(scratch.iterdir()) == []
     document = json.loads(out.read_text())
     failed = document["failed_candidates"]
     # 12 candidates, one worker at a time: runs 3, 6, 9 and 12 of a worker hang, and each
