@@ -651,6 +651,11 @@ pub fn private_stdout() -> std::io::Result<std::fs::File> {
     // own standard descriptors; the duplicate is owned by the returned File alone (on
     // Windows its descriptor is never closed, so the handle is not closed twice).
     unsafe {
+        // Close-on-exec on Unix: a process an FMU starts must not hold the results'
+        // pipe open (its reader would wait for an end that never comes).
+        #[cfg(unix)]
+        let duplicate = libc::fcntl(1, libc::F_DUPFD_CLOEXEC, 0);
+        #[cfg(windows)]
         let duplicate = libc::dup(1);
         if duplicate < 0 || libc::dup2(2, 1) < 0 {
             return Err(std::io::Error::last_os_error());

@@ -61,6 +61,8 @@ struct Worker {
     /// Closed to end the worker: it then frees its instances and unpacked FMUs.
     input: Option<ChildStdin>,
     output: BufReader<ChildStdout>,
+    /// The tail of what the worker wrote to standard error since its current request
+    /// (since its start, before the first).
     stderr: Arc<Mutex<Vec<u8>>>,
 }
 
@@ -91,17 +93,17 @@ impl Workers {
     /// The fitness (mm) of these factors; a candidate whose worker ends (an FMU call that
     /// hangs past the timeout, a crash) scores as a run that cannot start and is recorded.
     pub fn evaluate(&self, factors: &[f64]) -> f64 {
-        let taken = self.idle.lock().ok().and_then(|mut idle| idle.pop());
+        // An idle worker that died while it waited (killed from outside) is not this
+        // candidate's fault: it is replaced, and so is a worker that failed to start, once.
+        let taken = self
+            .idle
+            .lock()
+            .ok()
+            .and_then(|mut idle| idle.pop())
+            .and_then(|mut w| w.is_alive().then_some(w));
         let worker = match taken {
             Some(worker) => Ok(worker),
-            None => Worker::spawn(&self.program, &self.args).and_then(|mut w| {
-                // Every worker loads the same loop: its greeting must be the first's.
-                match w.greeting() {
-                    Ok(g) if g == self.greeting => Ok(w),
-                    Ok(g) => Err(w.ended(&format!("a worker found another loop: {g:?}"))),
-                    Err(e) => Err(w.ended(&e)),
-                }
-            }),
+            None => self.spawn().or_else(|_| self.spawn()),
         };
         let outcome = worker.and_then(|mut w| match w.score(factors) {
             Ok(fitness) => Ok((w, fitness)),
@@ -123,6 +125,16 @@ impl Workers {
                 }
                 2.0 * PENALTY_MM
             }
+        }
+    }
+
+    /// A new worker that greets as the first did (every worker loads the same loop).
+    fn spawn(&self) -> Result<Worker, String> {
+        let mut worker = Worker::spawn(&self.program, &self.args)?;
+        match worker.greeting() {
+            Ok(g) if g == self.greeting => Ok(worker),
+            Ok(g) => Err(worker.ended(&format!("a worker found another loop: {g:?}"))),
+            Err(e) => Err(worker.ended(&e)),
         }
     }
 
@@ -213,6 +225,9 @@ impl Worker {
     }
 
     fn score(&mut self, factors: &[f64]) -> Result<f64, String> {
+        if let Ok(mut kept) = self.stderr.lock() {
+            kept.clear();
+        }
         let request: Vec<String> = factors.iter().map(|&f| to_hex(f)).collect();
         let input = self.input.as_mut().ok_or("the worker's input is closed")?;
         writeln!(input, "{}", request.join(" "))
@@ -239,20 +254,38 @@ impl Worker {
             .lock()
             .map(|b| String::from_utf8_lossy(&b).into_owned())
             .unwrap_or_default();
-        let last = text.lines().rev().find(|l| !l.trim().is_empty());
-        match (last, status) {
-            (Some(line), _) => line
-                .strip_prefix("ccc-tune: ")
-                .unwrap_or(line)
-                .trim()
-                .to_string(),
-            (None, Ok(status)) => format!("{what} ({status})"),
-            (None, Err(e)) => format!("{what} ({e})"),
+        let status = match status {
+            Ok(status) => status.to_string(),
+            Err(e) => e.to_string(),
+        };
+        // The worker's own last words (a timeout, a loop it cannot load) say it all;
+        // otherwise how it ended, with the last thing it (or an FMU in it) printed.
+        let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+        if let Some(own) = lines
+            .iter()
+            .rev()
+            .find_map(|l| l.strip_prefix("ccc-tune: "))
+        {
+            return own.trim().to_string();
+        }
+        // A panic: where, and its message on the line after.
+        if let Some(at) = lines.iter().position(|l| l.contains("panicked at")) {
+            let message = lines.get(at + 1).map_or("", |l| l.trim());
+            return format!("{what} ({status}): {} {message}", lines[at].trim());
+        }
+        match lines.last() {
+            Some(last) => format!("{what} ({status}); it last wrote: {}", last.trim()),
+            None => format!("{what} ({status})"),
         }
     }
 }
 
 impl Worker {
+    /// Whether the worker still runs.
+    fn is_alive(&mut self) -> bool {
+        matches!(self.child.try_wait(), Ok(None))
+    }
+
     /// Closes the worker's input and waits a moment for it to end by itself (freeing its
     /// instances and the FMUs it unpacked) before it is killed; its exit status.
     fn finish(&mut self) -> std::io::Result<std::process::ExitStatus> {

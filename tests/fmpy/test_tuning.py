@@ -232,3 +232,34 @@ def test_a_timeout_that_is_no_time_is_refused(ccc_tune, fmu_dir, tmp_path, timeo
     assert done.returncode != 0
     assert "--timeout must be a positive number of seconds" in done.stderr, done.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_plant_that_prints_cannot_corrupt_the_answers_and_one_that_crashes_fails_the_run(
+        ccc_tune, tmp_path):
+    """The workers answer on a standard output set aside before any FMU loads: a C plant
+    that prints a line on standard output at every step tunes as a quiet one would (the
+    same factors, fitness and history: its ideal axes do not depend on the printing). A
+    plant that dies of SIGSEGV in every run fails every candidate: ccc-tune then writes
+    nothing and says how the first one ended."""
+    from helpers import faulty_fmu
+
+    faulty_fmu.build(tmp_path)
+    plant = ["--plant", tmp_path / "Faulty.fmu", "--path", "circle", "--swarm", 3, "--iters", 2,
+             "--seed", 4, "--threads", 2]
+    documents = {}
+    for name, fault in (("quiet", faulty_fmu.NONE), ("chatty", faulty_fmu.CHATTY)):
+        out = tmp_path / f"{name}.json"
+        done = tune(ccc_tune, out, *plant, "--start", f"plant.fault={fault}",
+                    "--start", "plant.fault_time=0.1")
+        assert done.returncode == 0, done.stderr
+        documents[name] = json.loads(out.read_text())
+    for key in ("factors", "fitness_mm", "history_mm", "failed_candidates"):
+        assert documents["chatty"][key] == documents["quiet"][key], key
+    assert documents["quiet"]["failed_candidates"] == []
+    out = tmp_path / "crashed.json"
+    done = tune(ccc_tune, out, *plant, "--start", f"plant.fault={faulty_fmu.SEGFAULT}",
+                "--start", "plant.fault_time=0.1")
+    assert done.returncode != 0
+    assert "every candidate failed; the first: the worker ended" in done.stderr, done.stderr
+    assert "SIGSEGV" in done.stderr, done.stderr
+    assert not out.exists()

@@ -247,6 +247,16 @@ fn run(o: Options, args: &[String]) -> Result<(), String> {
     )?;
     bar.finish_and_clear();
     let elapsed = started.elapsed().as_secs_f64();
+    if let Objective::Workers(workers) = &objective {
+        // Not one candidate ran: no result to write, only why.
+        let failures = workers.failures();
+        if failures.len() >= settings.swarm * settings.iterations {
+            return Err(format!(
+                "every candidate failed; the first: {}",
+                failures.first().map_or("", |f| f.reason.as_str())
+            ));
+        }
+    }
 
     let factors: serde_json::Map<String, serde_json::Value> = FACTOR_NAMES
         .iter()

@@ -195,9 +195,8 @@ impl ContourEstimator for FreeCurveEstimator {
             }
             _ => {}
         }
-        // Walk back from the command point while the distance decreases.
-        // Back from the latest reference while the distance falls: newest to oldest is
-        // the ring's front part backwards, then its back part backwards.
+        // Walk back from the command point while the distance decreases: newest to
+        // oldest is the ring's front part backwards, then its back part backwards.
         let (front, back) = self.buf.split_at(self.head + 1);
         let mut older = front.iter().rev().chain(back.iter().rev()).take(self.len);
         let mut k = 0;
@@ -262,9 +261,6 @@ mod tests {
         assert_eq!(e.len(), 16);
     }
 
-    /// With a lag longer than the buffer the walk stops at the oldest sample, where only
-    /// the circle on the newer side exists; on a circle that circle is still the path, so
-    /// the estimate stays exact (the fallback branch of `estimate`).
     /// The chords are not saved: a restored estimator measures them again, as `push`
     /// did, and goes on bit for bit (also after the ring wrapped).
     #[test]
@@ -292,6 +288,9 @@ mod tests {
         assert_eq!(run(&mut restored, 21, 60), run(&mut original, 21, 60));
     }
 
+    /// With a lag longer than the buffer the walk stops at the oldest sample, where only
+    /// the circle on the newer side exists; on a circle that circle is still the path, so
+    /// the estimate stays exact (the fallback branch of `estimate`).
     #[test]
     fn a_lag_beyond_the_buffer_uses_the_oldest_circle() {
         let c = |t: f64| Vector2::new(20.0 * math::cos(t), 20.0 * math::sin(t));
