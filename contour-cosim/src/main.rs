@@ -51,8 +51,6 @@ line without a run id); 3 timeout (batch: of the first run without its result li
 4 (batch) an FMU returned fmi2Fatal in the last run answered: it may not be called again
 in this process, so the next runs need a new one."#;
 
-/// Exit status of a timeout (the run's other statuses: 0 done, 1 failed, 2 refused).
-const TIMEOUT_STATUS: i32 = 3;
 /// Exit status of a batch that stopped after a run in which an FMU returned fmi2Fatal.
 const FATAL_STATUS: i32 = 4;
 
@@ -165,11 +163,11 @@ fn setup(options: &Options, system: &System) -> Result<Setup, Error> {
         None => Vec::new(),
     };
     for assignment in &options.starts {
-        let (target, text) = assignment.split_once('=').ok_or_else(|| {
-            Error::Refused(format!("--start {assignment:?} is not UNIT.VARIABLE=VALUE"))
-        })?;
-        let (unit, name) = port(target)?;
-        starts.push(system.parse_start_value(&unit, &name, text)?);
+        starts.push(
+            system
+                .parse_assignment(assignment)
+                .map_err(|e| Error::Refused(format!("--start {e}")))?,
+        );
     }
     system.start_values(&starts)?;
     let file = system.structure.file.display().to_string();
@@ -212,15 +210,7 @@ fn run(options: &Options) -> Result<Outcome, Error> {
     // instantiation comes before any result; the watchdog is dropped last.
     let activity = Arc::new(Activity::default());
     let timeout = Duration::from_secs_f64(options.timeout.max(1e-3));
-    let _watchdog = Watchdog::start(activity.clone(), timeout, move || {
-        eprintln!(
-            "contour-cosim: timeout: an FMU call did not return within {} s",
-            timeout.as_secs_f64()
-        );
-        // The hung call keeps its thread, and may hold locks that exit handlers need:
-        // only ending the process at once frees it.
-        fmi2::abandon_process(TIMEOUT_STATUS);
-    });
+    let _watchdog = Watchdog::ending_process(activity.clone(), timeout, "contour-cosim");
     // Results go to a descriptor of their own: what an FMU prints goes to stderr.
     let mut output: Box<dyn Write> = match &options.output {
         Some(path) => Box::new(

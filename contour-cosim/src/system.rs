@@ -251,6 +251,15 @@ impl System {
             .collect()
     }
 
+    /// A command line's `UNIT.VARIABLE=TEXT` (the unit's name up to the first dot), read
+    /// as [`System::parse_start_value`] reads it.
+    pub fn parse_assignment(&self, assignment: &str) -> Result<(String, String, Value), Error> {
+        let malformed = || Error::Refused(format!("{assignment:?} is not UNIT.VARIABLE=VALUE"));
+        let (target, text) = assignment.split_once('=').ok_or_else(malformed)?;
+        let (unit, name) = target.split_once('.').ok_or_else(malformed)?;
+        self.parse_start_value(unit, name, text)
+    }
+
     /// A start value given as text (a command line's unit.variable=text), read as the
     /// variable's type.
     pub fn parse_start_value(

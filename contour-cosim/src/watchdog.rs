@@ -52,6 +52,26 @@ impl Watchdog {
     }
 }
 
+/// The exit status of a process a hung FMU call ended ([`Watchdog::ending_process`]).
+pub const TIMEOUT_STATUS: i32 = 3;
+
+impl Watchdog {
+    /// A watchdog that ends this process with [`TIMEOUT_STATUS`] when a call of
+    /// `activity` hangs for `timeout`, saying so on standard error as `program`: the hung
+    /// call keeps its thread and may hold locks that exit handlers need, so only ending
+    /// the process at once frees it.
+    pub fn ending_process(activity: Arc<Activity>, timeout: Duration, program: &str) -> Watchdog {
+        let program = program.to_string();
+        Watchdog::start(activity, timeout, move || {
+            eprintln!(
+                "{program}: timeout: an FMU call did not return within {} s",
+                timeout.as_secs_f64()
+            );
+            crate::fmi2::abandon_process(TIMEOUT_STATUS);
+        })
+    }
+}
+
 impl Drop for Watchdog {
     fn drop(&mut self) {
         drop(self.stop.take());

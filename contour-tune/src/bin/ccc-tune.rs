@@ -362,16 +362,12 @@ fn work(
     preset: &str,
 ) -> Result<(), String> {
     // Watched from the start, as contour-cosim's runs: loading runs the libraries'
-    // initialisers. The hung call keeps its thread, so only ending the process frees it.
+    // initialisers.
     let activity = Arc::new(Activity::default());
-    let timeout = o.timeout;
-    let _watchdog = Watchdog::start(
+    let _watchdog = Watchdog::ending_process(
         activity.clone(),
-        Duration::from_secs_f64(timeout),
-        move || {
-            eprintln!("ccc-tune: timeout: an FMU call did not return within {timeout} s");
-            fmi2::abandon_process(TIMEOUT_STATUS);
-        },
+        Duration::from_secs_f64(o.timeout),
+        "ccc-tune",
     );
     // The answers go to a descriptor of their own: what an FMU prints goes to stderr.
     let answers =
@@ -413,15 +409,9 @@ fn loop_settings(o: &Options, system: &System) -> Result<LoopSettings, String> {
         .starts
         .iter()
         .map(|assignment| {
-            let (target, text) = assignment
-                .split_once('=')
-                .ok_or_else(|| format!("--start {assignment:?} is not UNIT.VARIABLE=VALUE"))?;
-            let (unit, name) = target
-                .split_once('.')
-                .ok_or_else(|| format!("--start {assignment:?} is not UNIT.VARIABLE=VALUE"))?;
             system
-                .parse_start_value(unit, name, text)
-                .map_err(|e| format!("--start: {e}"))
+                .parse_assignment(assignment)
+                .map_err(|e| format!("--start {e}"))
         })
         .collect::<Result<Vec<_>, _>>()?;
     Ok(LoopSettings {
@@ -430,9 +420,6 @@ fn loop_settings(o: &Options, system: &System) -> Result<LoopSettings, String> {
         settle: o.settle,
     })
 }
-
-/// A worker's exit status when an FMU call hung (contour-cosim's too).
-const TIMEOUT_STATUS: i32 = 3;
 
 /// The shipped two-axis loop beside this program's build: <target>/fmu/two_axis.ssd.
 fn default_loop() -> Result<PathBuf, String> {
