@@ -15,3 +15,4 @@ pub mod pose_error;
 pub mod reference_shape;
 pub mod run_evaluation;
 pub mod viterbi;
+pub mod window_costs;

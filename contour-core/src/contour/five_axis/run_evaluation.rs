@@ -17,9 +17,10 @@
 use std::fmt;
 
 use super::evaluation::{self, Evaluation};
-use super::hmm::{state_cost, HmmParams, ReferencePolyline};
+use super::hmm::{HmmParams, ReferencePolyline};
 use super::reference_shape::{foot_error, ReferenceShape};
 use super::viterbi::{self, BackTable};
+use super::window_costs::{CostScratch, SegmentTable};
 use crate::geometry::slerp;
 use crate::geometry::{self, Vector};
 use crate::kinematics::{Joints, Pose, TableTiltingAc};
@@ -29,8 +30,9 @@ const CHECK_EVERY: usize = 1024;
 
 /// The windowed offline Viterbi decoder, fed one observation at a time.
 #[derive(Clone, Debug)]
-pub struct WindowedViterbi<'a> {
-    reference: &'a ReferencePolyline,
+pub struct WindowedViterbi {
+    /// The reference's segments, as the window's costs read them.
+    segments: SegmentTable,
     params: HmmParams,
     width: usize,
     /// First segment of the newest row's window.
@@ -38,6 +40,9 @@ pub struct WindowedViterbi<'a> {
     /// C(k, lo + s) of the newest sample.
     cost: Vec<f64>,
     next: Vec<f64>,
+    /// c(k, lo + s) of the newest sample, and the work space computing them.
+    state_costs: Vec<f64>,
+    scratch: CostScratch,
     /// Back-pointers of the undecided samples (from the first undecided one), as bytes.
     back: BackTable<u8>,
     decided: Vec<usize>,
@@ -47,23 +52,25 @@ pub struct WindowedViterbi<'a> {
     next_check: usize,
 }
 
-impl<'a> WindowedViterbi<'a> {
+impl WindowedViterbi {
     /// A decoder over `reference` with `window` candidate segments per sample (at least
     /// `max_skip + 1`, at most the segment count). `None` when the reference has no
     /// segment or `max_skip` exceeds 255 (the back-pointers are bytes).
-    pub fn new(reference: &'a ReferencePolyline, params: HmmParams, window: usize) -> Option<Self> {
+    pub fn new(reference: &ReferencePolyline, params: HmmParams, window: usize) -> Option<Self> {
         let m = reference.segments();
         if m == 0 || params.max_skip > u8::MAX as usize {
             return None;
         }
         let width = window.max(params.max_skip + 1).min(m);
         Some(WindowedViterbi {
-            reference,
+            segments: SegmentTable::new(reference),
             params,
             width,
             lo: 0,
             cost: vec![f64::INFINITY; width],
             next: vec![f64::INFINITY; width],
+            state_costs: vec![0.0; width],
+            scratch: CostScratch::default(),
             back: BackTable::new(width),
             decided: Vec::new(),
             samples: 0,
@@ -103,40 +110,56 @@ impl<'a> WindowedViterbi<'a> {
 
     /// Adds the next observation: tool tip and second point (L mm up the tool axis).
     pub fn push(&mut self, tip: &Vector<3>, second: &Vector<3>) {
-        let (m, w, skip) = (self.reference.segments(), self.width, self.params.max_skip);
+        let (m, w, skip) = (self.segments.segments(), self.width, self.params.max_skip);
         let motion = self.previous_tip.map_or(Vector::zeros(), |p| tip - p);
         if self.samples == 0 {
             // The first sample may be anywhere: one full scan places the window.
-            let zero = Vector::zeros();
-            let best = (0..m)
-                .map(|j| state_cost(self.reference, &self.params, j, tip, second, &zero))
+            let mut all = vec![0.0; m];
+            let observation = [tip, second, &motion];
+            let scratch = &mut self.scratch;
+            self.segments
+                .costs(&self.params, 0, observation, &mut all, scratch);
+            let best = all
+                .iter()
                 .enumerate()
                 .fold(
                     (0, f64::INFINITY),
-                    |b, (j, c)| if c < b.1 { (j, c) } else { b },
+                    |b, (j, &c)| if c < b.1 { (j, c) } else { b },
                 )
                 .0;
             self.lo = best.saturating_sub(w / 2).min(m - w);
             let (lo, cost) = (self.lo, &mut self.cost);
             let mut row = self.back.push_row(lo);
-            let c = |j| state_cost(self.reference, &self.params, j, tip, second, &zero);
-            viterbi::start(lo..lo + w, c, |j, cj, i| {
-                cost[j - lo] = cj;
-                row.set(j, i);
-            });
+            viterbi::start(
+                lo..lo + w,
+                |j| all[j],
+                |j, cj, i| {
+                    cost[j - lo] = cj;
+                    row.set(j, i);
+                },
+            );
         } else {
             let previous_lo = self.lo;
             let best = self.best();
             // The window never moves back: nothing below the previous one is reachable.
             self.lo = best.saturating_sub(w / 2).max(previous_lo).min(m - w);
-            let (lo, cost, next) = (self.lo, &self.cost, &mut self.next);
+            let observation = [tip, second, &motion];
+            let (lo, state_costs) = (self.lo, &mut self.state_costs);
+            self.segments.costs(
+                &self.params,
+                lo,
+                observation,
+                state_costs,
+                &mut self.scratch,
+            );
+            let (cost, next) = (&self.cost, &mut self.next);
             let mut row = self.back.push_row(lo);
             let previous = |i: usize| cost[i - previous_lo];
             // A state without a finite predecessor (the window moved past them all) stays
             // out of reach, whatever its own cost.
-            let score = |j, best: f64| {
+            let score = |j: usize, best: f64| {
                 if best.is_finite() {
-                    best + state_cost(self.reference, &self.params, j, tip, second, &motion)
+                    best + state_costs[j - lo]
                 } else {
                     f64::INFINITY
                 }
