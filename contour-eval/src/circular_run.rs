@@ -107,7 +107,7 @@ pub fn parse(args: &[String]) -> Result<CircularOptions, String> {
 
 /// One run's samples within the window: (time, point).
 fn read_run(file: &std::path::Path, from: f64, to: f64) -> Result<Vec<(f64, Vector2)>, String> {
-    let run = measured::read(file)?;
+    let run = measured::read(file, measured::default_threads())?;
     let Samples::Planar(points) = run.samples else {
         return Err(format!(
             "{}: a five-axis run: the circular test takes a run of the XY table (time,X,Y)",

@@ -12,6 +12,7 @@
 //! place only when everything succeeded ([`staged`]): a failed run leaves existing files
 //! as they were.
 
+use std::fmt;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -33,6 +34,7 @@ use staged::{commit, Staged};
 
 mod circular_run;
 mod circular_test;
+mod csv_lines;
 mod measured;
 mod planar;
 mod planar_run;
@@ -45,17 +47,19 @@ usage: contour-eval --path PART.cl|PART.apt|PART.ngc|PART.json|tilted_helix|figu
                     --measured RUN.csv --out ERR.csv [--out-reference REF.csv]
                     [--plot ERR.png] [--tool-length 100] [--pivot-a Y,Z] [--pivot-c X,Y]
                     [--max-skip K] [--angle-weight 0.1] [--window W]
-                    [--reference straight|smooth] [--tool-radii D:R,...]
+                    [--reference straight|smooth] [--tool-radii D:R,...] [--threads N]
        contour-eval --path PART.ngc|NURBS.json|line|arc|circle|infinity|trident
                     --measured RUN.csv --out ERR.csv [--tolerance P] [--home X,Y,Z]
                     [--tool-radii D:R,...] [--against compensated|programmed]
-                    [--plot ERR.png]
+                    [--plot ERR.png] [--threads N]
        contour-eval --circle CX,CY,R --measured RUN.csv [--reverse RUN.csv]
                     [--from T0] [--to T1] [--out DEV.csv] [--plot BALLBAR.png]
                     [--magnification M] [--figures FIG.json]
 
 The run's columns say what it is: time,X,Y,Z,A,C a five-axis run, time,X,Y and none of
-Z, A, C a run of the XY table. A --path of the other kind is refused.
+Z, A, C a run of the XY table. A --path of the other kind is refused. --threads N: the
+threads to use (default: as many as the machine runs at once; 1 runs on one); the
+outputs are the same with any number.
 
 Five axes: maps every measured sample to a segment of the reference (HMM, Viterbi) and
 reports the tool-tip and orientation contour errors of a table-tilting A-C machine.
@@ -143,6 +147,8 @@ struct Options {
     against_programmed: bool,
     /// The five-axis-only options given, in order.
     five_axis_only: Vec<String>,
+    /// --threads: threads to read, evaluate and write with.
+    threads: usize,
 }
 
 /// Exit 2: the command line or an input is wrong; exit 1: the run or a write failed.
@@ -201,6 +207,7 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
         tools: ToolTable::default(),
         against_programmed: false,
         five_axis_only: Vec::new(),
+        threads: defaults.threads,
     };
     let mut it = args.iter();
     while let Some(flag) = it.next() {
@@ -263,6 +270,13 @@ fn parse(args: &[String]) -> Result<Option<Options>, String> {
             }
             "--angle-weight" => o.settings.params.angle_weight = number("--angle-weight")?,
             "--window" => o.window = Some(count("--window")?),
+            "--threads" => {
+                o.threads = count("--threads")?;
+                if o.threads == 0 {
+                    return Err("--threads must be at least 1, got 0".to_string());
+                }
+                o.settings.threads = o.threads;
+            }
             "--reference" => {
                 o.settings.reference = value
                     .parse::<ReferenceShape>()
@@ -288,12 +302,16 @@ fn write_errors(
     staged: &Staged,
     times: &[f64],
     result: &RunEvaluation,
+    threads: usize,
 ) -> Result<(), std::io::Error> {
     let mut w = staged.create().map_err(std::io::Error::other)?;
     writeln!(w, "time,segment,tip,orientation")?;
-    for (t, s) in times.iter().zip(&result.samples) {
-        writeln!(w, "{t},{},{},{}", s.segment, s.tip, s.orientation)?;
-    }
+    let line = |text: &mut String, k: usize| {
+        let s = &result.samples[k];
+        let line = format_args!("{},{},{},{}\n", times[k], s.segment, s.tip, s.orientation);
+        fmt::Write::write_fmt(text, line).expect("a String takes every write");
+    };
+    csv_lines::write(&mut w, result.samples.len(), threads, line)?;
     w.into_inner().map_err(|e| e.into_error())?.sync_all()
 }
 
@@ -322,7 +340,7 @@ fn write_reference(
 /// Reads the run, then the reference of its kind, and evaluates it.
 fn run(o: Options) -> Result<(), Failure> {
     let started = Instant::now();
-    let measured = measured::read(&o.measured).map_err(Failure::Input)?;
+    let measured = measured::read(&o.measured, o.threads).map_err(Failure::Input)?;
     let kind = match measured.samples {
         Samples::Planar(_) => Kind::Planar,
         Samples::FiveAxis(_) => Kind::FiveAxis,
@@ -354,6 +372,7 @@ fn run(o: Options) -> Result<(), Failure> {
                 plot: o.plot.clone(),
                 tolerance: o.tolerance.unwrap_or(0.0),
                 offsets,
+                threads: o.threads,
             };
             planar_run::run(&options, path, &measured.times, &points, started)
         }
@@ -402,7 +421,7 @@ fn five_axis(
     bar.finish_and_clear();
 
     let mut staged = vec![Staged::new(&o.out)];
-    let mut written = write_errors(&staged[0], times, &result)
+    let mut written = write_errors(&staged[0], times, &result, o.threads)
         .map_err(|e| format!("cannot write {}: {e}", o.out.display()));
     if let (Ok(()), Some(target)) = (&written, &o.out_reference) {
         staged.push(Staged::new(target));
@@ -478,7 +497,7 @@ fn main() -> ExitCode {
     let parsed = if args.iter().any(|a| a == "--circle") && !help {
         circular_run::parse(&args).map(|o| Some(Mode::Circular(o)))
     } else {
-        parse(&args).map(|o| o.map(Mode::Contour))
+        parse(&args).map(|o| o.map(|o| Mode::Contour(Box::new(o))))
     };
     match parsed {
         Ok(None) => {
@@ -486,7 +505,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Ok(Some(Mode::Circular(options))) => finish(circular_run::run(options)),
-        Ok(Some(Mode::Contour(options))) => finish(run(options)),
+        Ok(Some(Mode::Contour(options))) => finish(run(*options)),
         Err(message) => {
             eprintln!("contour-eval: {message}\n{USAGE}");
             ExitCode::from(2)
@@ -497,7 +516,7 @@ fn main() -> ExitCode {
 /// What the command line asks for.
 enum Mode {
     /// A run's contour errors against its path.
-    Contour(Options),
+    Contour(Box<Options>),
     /// The circular test of ISO 230-4.
     Circular(circular_run::CircularOptions),
 }

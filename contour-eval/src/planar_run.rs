@@ -2,6 +2,7 @@
 //! sample evaluated ([`crate::planar`]), `ERR.csv` and the plot written all or nothing,
 //! the summary on stdout.
 
+use std::fmt;
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -11,7 +12,7 @@ use contour_core::path::planar::Path;
 
 use crate::planar::{evaluate, Geometry, PlanarSample, Statistics};
 use crate::staged::{commit, Staged};
-use crate::{plot, Failure};
+use crate::{csv_lines, plot, Failure};
 
 /// What an XY run is asked for.
 pub struct PlanarOptions {
@@ -24,14 +25,24 @@ pub struct PlanarOptions {
     /// With `--against programmed`: each programmed move's offset, subtracted from the
     /// signed errors of the samples whose foot is on it (the part's edge).
     pub offsets: Option<Vec<f64>>,
+    /// Threads to write with (`--threads`).
+    pub threads: usize,
 }
 
-fn write_errors(staged: &Staged, times: &[f64], samples: &[PlanarSample]) -> std::io::Result<()> {
+fn write_errors(
+    staged: &Staged,
+    times: &[f64],
+    samples: &[PlanarSample],
+    threads: usize,
+) -> std::io::Result<()> {
     let mut w = staged.create().map_err(std::io::Error::other)?;
     writeln!(w, "time,segment,contour,contour_planned")?;
-    for (t, s) in times.iter().zip(samples) {
-        writeln!(w, "{t},{},{},{}", s.segment, s.contour, s.planned)?;
-    }
+    let line = |text: &mut String, k: usize| {
+        let s = &samples[k];
+        let line = format_args!("{},{},{},{}\n", times[k], s.segment, s.contour, s.planned);
+        fmt::Write::write_fmt(text, line).expect("a String takes every write");
+    };
+    csv_lines::write(&mut w, samples.len(), threads, line)?;
     w.into_inner().map_err(|e| e.into_error())?.sync_all()
 }
 
@@ -97,7 +108,7 @@ pub fn run(
     }
 
     let mut staged = vec![Staged::new(&o.out)];
-    let mut written = write_errors(&staged[0], times, &samples)
+    let mut written = write_errors(&staged[0], times, &samples, o.threads)
         .map_err(|e| format!("cannot write {}: {e}", o.out.display()));
     if let (Ok(()), Some(target)) = (&written, &o.plot) {
         staged.push(Staged::new(target));

@@ -177,20 +177,14 @@ fn a_displaced_helix_gives_its_displacement() {
         dir.join("err.png"),
     );
     std::fs::write(&run, csv).unwrap();
-    let mut args = vec![
-        "--path",
-        "tilted_helix",
-        "--measured",
-        s(&run),
-        "--out",
-        s(&err),
-        "--out-reference",
-        s(&reference),
-        "--plot",
-        s(&plot),
-    ];
-    args.extend(PIVOTS);
-    let out = contour_eval(&args);
+    let evaluate = |err: &Path, reference: &Path, options: &[&str]| {
+        let mut args = vec!["--path", "tilted_helix", "--measured", s(&run)];
+        args.extend(["--out", s(err), "--out-reference", s(reference)]);
+        args.extend(options);
+        args.extend(PIVOTS);
+        contour_eval(&args)
+    };
+    let out = evaluate(&err, &reference, &["--plot", s(&plot)]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),
@@ -214,6 +208,12 @@ fn a_displaced_helix_gives_its_displacement() {
     // Nothing else left in the folder.
     let names = entries(&dir);
     assert_eq!(names, ["err.csv", "err.png", "ref.csv", "run.csv"]);
+    // On one thread: the same files, byte for byte.
+    let (err_1, reference_1) = (dir.join("err_1.csv"), dir.join("ref_1.csv"));
+    let out = evaluate(&err_1, &reference_1, &["--threads", "1"]);
+    assert!(out.status.success());
+    assert!(std::fs::read(&err).unwrap() == std::fs::read(&err_1).unwrap());
+    assert!(std::fs::read(&reference).unwrap() == std::fs::read(&reference_1).unwrap());
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -377,19 +377,15 @@ fn bad_inputs_fail_naming_the_cause_and_write_nothing() {
         &["--path", "tilted_helix", "--out", s(&out_file)],
         &["--measured is required"],
     );
-    check(
-        &[
-            "--path",
-            "tilted_helix",
-            "--measured",
-            s(&good_run),
-            "--out",
-            s(&out_file),
-            "--pivot-a",
-            "1",
-        ],
-        &["--pivot-a needs two"],
-    );
+    let on_the_good_run = |options: &[&str], expected: &[&str]| {
+        let mut args = vec!["--path", "tilted_helix", "--measured", s(&good_run)];
+        args.extend(["--out", s(&out_file)]);
+        args.extend(options);
+        check(&args, expected);
+    };
+    on_the_good_run(&["--pivot-a", "1"], &["--pivot-a needs two"]);
+    on_the_good_run(&["--threads", "0"], &["--threads must be at least 1"]);
+    on_the_good_run(&["--threads", "two"], &["--threads 'two'"]);
     // Only the inputs and the untouched output remain: no temporary files.
     let names = entries(&dir);
     assert_eq!(

@@ -14,5 +14,6 @@ pub mod hmm_online;
 pub mod pose_error;
 pub mod reference_shape;
 pub mod run_evaluation;
+pub mod run_mapping;
 pub mod viterbi;
 pub mod window_costs;

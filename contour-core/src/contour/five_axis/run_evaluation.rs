@@ -15,10 +15,12 @@
 //! [`viterbi_offline`](super::hmm::viterbi_offline)'s.
 
 use std::fmt;
+use std::sync::Arc;
 
 use super::evaluation::{self, Evaluation};
 use super::hmm::{HmmParams, ReferencePolyline};
 use super::reference_shape::{foot_error, ReferenceShape};
+use super::run_mapping::{map_run, Observer};
 use super::viterbi::{self, BackTable};
 use super::window_costs::{CostScratch, SegmentTable};
 use crate::geometry::slerp;
@@ -31,8 +33,9 @@ const CHECK_EVERY: usize = 1024;
 /// The windowed offline Viterbi decoder, fed one observation at a time.
 #[derive(Clone, Debug)]
 pub struct WindowedViterbi {
-    /// The reference's segments, as the window's costs read them.
-    segments: SegmentTable,
+    /// The reference's segments, as the window's costs read them (shared with a thread
+    /// that computes costs ahead, [`super::run_mapping`]).
+    segments: Arc<SegmentTable>,
     params: HmmParams,
     width: usize,
     /// First segment of the newest row's window.
@@ -63,7 +66,7 @@ impl WindowedViterbi {
         }
         let width = window.max(params.max_skip + 1).min(m);
         Some(WindowedViterbi {
-            segments: SegmentTable::new(reference),
+            segments: Arc::new(SegmentTable::new(reference)),
             params,
             width,
             lo: 0,
@@ -93,6 +96,16 @@ impl WindowedViterbi {
         self.width
     }
 
+    /// The reference's segments as the decoder costs them.
+    pub fn segments(&self) -> Arc<SegmentTable> {
+        Arc::clone(&self.segments)
+    }
+
+    /// The mapping's model.
+    pub fn params(&self) -> &HmmParams {
+        &self.params
+    }
+
     /// Samples whose mapping is still open (their back-pointer rows are held).
     pub fn pending(&self) -> usize {
         self.samples - self.back.first()
@@ -110,50 +123,100 @@ impl WindowedViterbi {
 
     /// Adds the next observation: tool tip and second point (L mm up the tool axis).
     pub fn push(&mut self, tip: &Vector<3>, second: &Vector<3>) {
-        let (m, w, skip) = (self.segments.segments(), self.width, self.params.max_skip);
+        self.push_costed(tip, second, None);
+    }
+
+    /// The segments of the next sample's window: centred on the newest sample's best
+    /// segment, never below the newest window (nothing below it is reachable), within the
+    /// reference; `None` before the first sample (which scans every segment).
+    fn next_window(&self) -> Option<std::ops::Range<usize>> {
+        let (m, w) = (self.segments.segments(), self.width);
+        (self.samples > 0).then(|| {
+            let lo = self.best().saturating_sub(w / 2).max(self.lo).min(m - w);
+            lo..lo + w
+        })
+    }
+
+    /// [`push`](Self::push), with the costs c(k, j) of the segments `band.0 ..` given as
+    /// `band.1` where they were computed already (by [`SegmentTable::costs`] for this
+    /// observation): used where they cover the window (the result says whether they
+    /// did), computed here otherwise.
+    pub fn push_costed(
+        &mut self,
+        tip: &Vector<3>,
+        second: &Vector<3>,
+        band: Option<(usize, &[f64])>,
+    ) -> bool {
         let motion = self.previous_tip.map_or(Vector::zeros(), |p| tip - p);
-        if self.samples == 0 {
-            // The first sample may be anywhere: one full scan places the window.
-            let mut all = vec![0.0; m];
-            let observation = [tip, second, &motion];
-            let scratch = &mut self.scratch;
-            self.segments
-                .costs(&self.params, 0, observation, &mut all, scratch);
-            let best = all
-                .iter()
-                .enumerate()
-                .fold(
-                    (0, f64::INFINITY),
-                    |b, (j, &c)| if c < b.1 { (j, c) } else { b },
-                )
-                .0;
-            self.lo = best.saturating_sub(w / 2).min(m - w);
-            let (lo, cost) = (self.lo, &mut self.cost);
-            let mut row = self.back.push_row(lo);
-            viterbi::start(
-                lo..lo + w,
-                |j| all[j],
-                |j, cj, i| {
-                    cost[j - lo] = cj;
-                    row.set(j, i);
-                },
-            );
+        let observation = [tip, second, &motion];
+        let covered = if self.samples == 0 {
+            self.start(observation);
+            false
         } else {
-            let previous_lo = self.lo;
-            let best = self.best();
-            // The window never moves back: nothing below the previous one is reachable.
-            self.lo = best.saturating_sub(w / 2).max(previous_lo).min(m - w);
-            let observation = [tip, second, &motion];
-            let (lo, state_costs) = (self.lo, &mut self.state_costs);
-            self.segments.costs(
-                &self.params,
-                lo,
-                observation,
-                state_costs,
-                &mut self.scratch,
-            );
-            let (cost, next) = (&self.cost, &mut self.next);
-            let mut row = self.back.push_row(lo);
+            self.step(observation, band)
+        };
+        self.samples += 1;
+        self.previous_tip = Some(*tip);
+        self.commit_now_and_then();
+        covered
+    }
+
+    /// The first sample, which may be anywhere: one full scan places the window.
+    fn start(&mut self, observation: [&Vector<3>; 3]) {
+        let (m, w) = (self.segments.segments(), self.width);
+        let mut all = vec![0.0; m];
+        let scratch = &mut self.scratch;
+        self.segments
+            .costs(&self.params, 0, observation, &mut all, scratch);
+        let best = all
+            .iter()
+            .enumerate()
+            .fold(
+                (0, f64::INFINITY),
+                |b, (j, &c)| if c < b.1 { (j, c) } else { b },
+            )
+            .0;
+        self.lo = best.saturating_sub(w / 2).min(m - w);
+        let (lo, cost) = (self.lo, &mut self.cost);
+        let mut row = self.back.push_row(lo);
+        viterbi::start(
+            lo..lo + w,
+            |j| all[j],
+            |j, cj, i| {
+                cost[j - lo] = cj;
+                row.set(j, i);
+            },
+        );
+    }
+
+    /// A later sample: the window moved, its costs taken from `band` where it covers the
+    /// window (whether it did), the recursion's step.
+    fn step(&mut self, observation: [&Vector<3>; 3], band: Option<(usize, &[f64])>) -> bool {
+        let (w, skip) = (self.width, self.params.max_skip);
+        let previous_lo = self.lo;
+        self.lo = self.next_window().expect("a sample was pushed").start;
+        let lo = self.lo;
+        let given = band.and_then(|(first, costs)| {
+            let from = lo.checked_sub(first)?;
+            costs.get(from..from + w)
+        });
+        let covered = given.is_some();
+        let state_costs = match given {
+            Some(costs) => costs,
+            None => {
+                let (costs, scratch) = (&mut self.state_costs, &mut self.scratch);
+                self.segments
+                    .costs(&self.params, lo, observation, costs, scratch);
+                &self.state_costs
+            }
+        };
+        let (cost, next) = (&self.cost, &mut self.next);
+        let mut row = self.back.push_row(lo);
+        if skip == 1 {
+            step_adjacent(cost, lo - previous_lo, state_costs, next, |s, skip| {
+                row.set(lo + s, lo + s - skip)
+            });
+        } else {
             let previous = |i: usize| cost[i - previous_lo];
             // A state without a finite predecessor (the window moved past them all) stays
             // out of reach, whatever its own cost.
@@ -169,10 +232,13 @@ impl WindowedViterbi {
                 next[j - lo] = cj;
                 row.set(j, i);
             });
-            std::mem::swap(&mut self.cost, &mut self.next);
         }
-        self.samples += 1;
-        self.previous_tip = Some(*tip);
+        std::mem::swap(&mut self.cost, &mut self.next);
+        covered
+    }
+
+    /// Commits what the survivors agree on, every so often.
+    fn commit_now_and_then(&mut self) {
         if self.samples >= self.next_check {
             let before = self.pending();
             self.commit_merged();
@@ -230,6 +296,46 @@ impl WindowedViterbi {
     }
 }
 
+/// [`viterbi::step`] for `max_skip` = 1 over the window (the windowed decoder's usual
+/// case: a reference coarser than the measurement), the same costs and predecessors
+/// without the general step's range arithmetic per state: `previous` the last sample's
+/// costs from its window's first state, `shift` how far the window moved since, `costs`
+/// c(k, ·) of the new window, `next` its C(k, ·); `set(s, skip)` records state `s`'s
+/// predecessor as `skip` (0 or 1) states back.
+fn step_adjacent(
+    previous: &[f64],
+    shift: usize,
+    costs: &[f64],
+    next: &mut [f64],
+    mut set: impl FnMut(usize, usize),
+) {
+    let w = costs.len();
+    for (s, (c, n)) in costs.iter().zip(next.iter_mut()).enumerate() {
+        let p = s + shift;
+        let back = if (1..=w).contains(&p) {
+            previous[p - 1]
+        } else {
+            f64::INFINITY
+        };
+        let here = if p < w { previous[p] } else { f64::INFINITY };
+        // As best_predecessor: one back first, the state itself on a strictly lower cost;
+        // a state without a finite predecessor stays out of reach.
+        let (mut best, mut skip) = (f64::INFINITY, 0);
+        if back < best {
+            (best, skip) = (back, 1);
+        }
+        if here < best {
+            (best, skip) = (here, 0);
+        }
+        *n = if best.is_finite() {
+            best + c
+        } else {
+            f64::INFINITY
+        };
+        set(s, skip);
+    }
+}
+
 /// [`WindowedViterbi`] over whole slices: the same mapping as
 /// [`viterbi_offline`](super::hmm::viterbi_offline) when the window covers what matters.
 /// Empty for an empty run or a reference without segments (or `max_skip` > 255).
@@ -261,12 +367,17 @@ pub struct RunSettings {
     /// What the per-sample errors are measured against: the points' straight moves or a
     /// smooth curve through them.
     pub reference: ReferenceShape,
+    /// Threads the evaluation may use: with 2 or more the mapping's costs are computed
+    /// ahead by a second thread and the per-sample errors in two halves; the results are
+    /// the same with any number.
+    pub threads: usize,
 }
 
 impl Default for RunSettings {
     /// K = 4 (a reference sampled up to 4× finer than the measurement), w = 0.1 mm/rad
     /// (the motion direction only breaks near-ties: measured motion per sample is µm
-    /// and its direction is noisy), L = 100 mm, 64 candidate segments, straight moves.
+    /// and its direction is noisy), L = 100 mm, 64 candidate segments, straight moves, as
+    /// many threads as the machine runs at once.
     fn default() -> Self {
         RunSettings {
             params: HmmParams {
@@ -276,6 +387,7 @@ impl Default for RunSettings {
             tool_length: 100.0,
             window: 64,
             reference: ReferenceShape::Straight,
+            threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
         }
     }
 }
@@ -390,47 +502,75 @@ pub fn evaluate_run(
         }
     };
 
-    // Pass 1: the mapping (poses recomputed rather than held: 48 bytes a sample saved).
+    // Pass 1: the mapping (poses recomputed rather than held: 48 bytes a sample saved),
+    // its costs computed ahead by a second thread where there is a second core.
     let tips: Vec<Vector<3>> = reference.iter().map(|p| p.tip).collect();
     let axes: Vec<Vector<3>> = reference.iter().map(|p| p.axis).collect();
     let polyline = ReferencePolyline::new(&tips, &axes, length);
-    let mut decoder = WindowedViterbi::new(&polyline, settings.params, settings.window)
-        .expect("checked: segments and max skip");
-    for q in measured {
-        let pose = machine.forward(q);
-        decoder.push(&pose.tip, &(pose.tip + pose.axis * length));
-        done += 1;
-        tick(done);
-    }
-    let mapping = decoder.finish();
+    let run = Observer {
+        machine,
+        measured,
+        length,
+    };
+    let helper = settings.threads > 1;
+    let (mapping, _) = map_run(
+        &polyline,
+        settings.params,
+        settings.window,
+        run,
+        helper,
+        &mut tick,
+    )
+    .expect("checked: segments and max skip");
+    done += n;
 
     // Pass 2: per-sample errors, and the nearest sample to each reference point among
     // those mapped to the K segments either side of it (K = max_skip: samples up to one
     // step away; for K = 1 the two segments meeting there, as §5.3 has it — a reference
     // finer than the measurement has points with no sample on either neighbour).
     let reach = settings.params.max_skip.max(1);
-    let mut nearest: Vec<Option<(f64, usize)>> = vec![None; points];
-    let mut samples = Vec::with_capacity(n);
-    for (k, (q, &j)) in measured.iter().zip(&mapping).enumerate() {
-        let pose = machine.forward(q);
-        // The mapping picks the branch; the foot is the nearest point of the reference
-        // (as settings.reference reads it) near there, the axis taken at the same point.
-        let e = foot_error(settings.reference, &reference, j, &pose)
-            .expect("checked: finite poses, no opposite axes");
-        samples.push(SampleContourError {
-            segment: j,
-            tip: geometry::norm(&e.tip),
-            orientation: e.orientation,
-        });
-        for i in j.saturating_sub(reach - 1)..=(j + reach).min(points - 1) {
-            let d = geometry::dist2(&pose.tip, &reference[i].tip);
-            if nearest[i].is_none_or(|(best, _)| d < best) {
-                nearest[i] = Some((d, k));
+    let errors = |samples: std::ops::Range<usize>, tick: &mut dyn FnMut(usize)| {
+        let mut nearest: Vec<Option<(f64, usize)>> = vec![None; points];
+        let mut errors = Vec::with_capacity(samples.len());
+        for k in samples {
+            let (pose, j) = (machine.forward(&measured[k]), mapping[k]);
+            // The mapping picks the branch; the foot is the nearest point of the reference
+            // (as settings.reference reads it) near there, the axis taken at the same point.
+            let e = foot_error(settings.reference, &reference, j, &pose)
+                .expect("checked: finite poses, no opposite axes");
+            errors.push(SampleContourError {
+                segment: j,
+                tip: geometry::norm(&e.tip),
+                orientation: e.orientation,
+            });
+            for i in j.saturating_sub(reach - 1)..=(j + reach).min(points - 1) {
+                let d = geometry::dist2(&pose.tip, &reference[i].tip);
+                if nearest[i].is_none_or(|(best, _)| d < best) {
+                    nearest[i] = Some((d, k));
+                }
+            }
+            tick(k + 1);
+        }
+        (errors, nearest)
+    };
+    // The later half on a second thread where there is one: its nearest samples replace
+    // the earlier half's only where strictly nearer, as one pass in order would.
+    let half = if helper { n / 2 } else { n };
+    let (samples, nearest) = std::thread::scope(|scope| {
+        let later = scope.spawn(|| errors(half..n, &mut |_| {}));
+        let mut earlier = errors(0..half, &mut |k| tick(done + k));
+        let (later_errors, later_nearest) = later.join().expect("no panic in the errors");
+        earlier.0.extend(later_errors);
+        for (e, l) in earlier.1.iter_mut().zip(later_nearest) {
+            if let Some((d, k)) = l {
+                if e.is_none_or(|(best, _)| d < best) {
+                    *e = Some((d, k));
+                }
             }
         }
-        done += 1;
-        tick(done);
-    }
+        earlier
+    });
+    done += n;
 
     // Pass 3: the evaluation function at each reference point.
     let ratio = evaluation::mm_per_rad(&reference);

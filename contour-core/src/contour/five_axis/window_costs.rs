@@ -39,6 +39,13 @@ impl Columns {
         columns
     }
 
+    /// The distance of `p` to segment `j` (as [`Columns::add_distances`] computes it).
+    fn distance(&self, j: usize, p: &Vector<3>) -> f64 {
+        let mut out = [0.0];
+        self.add_distances(j, p, &mut out);
+        out[0]
+    }
+
     /// `out[s] += distance of p to segment first + s`, for every slot of `out`
     /// (hmm::segment_distance's operations in its order).
     fn add_distances(&self, first: usize, p: &Vector<3>, out: &mut [f64]) {
@@ -90,6 +97,12 @@ impl SegmentTable {
     /// Number of segments.
     pub fn segments(&self) -> usize {
         self.tips.length2.len()
+    }
+
+    /// The tip's and the second point's distances to segment `j`, summed: c(k, j) without
+    /// its angle term.
+    pub fn distances(&self, j: usize, tip: &Vector<3>, second: &Vector<3>) -> f64 {
+        self.tips.distance(j, tip) + self.seconds.distance(j, second)
     }
 
     /// `out[s]` = c(k, first + s) for every slot of `out`: the cost of segment `first + s`
