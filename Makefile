@@ -171,7 +171,7 @@ bindings: libclang
 BENCH_REPORT := $(or $(CARGO_TARGET_DIR),target)/bench-report
 CRITERION    := --warm-up-time 1 --measurement-time 3 --sample-size 50 --noplot
 
-bench: fmus ccc-tune $(VENV)/.test-installed
+bench: fmus ccc-tune contour-eval $(VENV)/.test-installed
 	$(PYTHON) benches/report.py --start
 	-PYTHON=$(PYTHON) benches/c_harness/run.sh --json $(BENCH_REPORT)/c_harness.json
 	-PYTHON=$(PYTHON) benches/c_harness/run.sh --callgrind --json $(BENCH_REPORT)/c_harness_callgrind.json
@@ -185,6 +185,7 @@ bench: fmus ccc-tune $(VENV)/.test-installed
 	-$(CARGO) build --release -p contour-fmu --example closed_loop_timing
 	-$(PYTHON) benches/native_throughput.py --json $(BENCH_REPORT)/native_throughput.json
 	-$(PYTHON) benches/campaign_scaling.py --json $(BENCH_REPORT)/campaign_scaling.json
+	-$(PYTHON) benches/contour_eval_speed.py --json $(BENCH_REPORT)/contour_eval_speed.json
 	$(PYTHON) benches/report.py
 
 # Every model's life cycle 10 000 times under valgrind's full memcheck: leaks and

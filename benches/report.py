@@ -3,7 +3,8 @@
 Reads what the bench parts leave in <target>/bench-report/ (<target> is $CARGO_TARGET_DIR,
 else target/): fmu_abi.json (benches/fmu_abi.rs), c_harness.json and
 c_harness_callgrind.json (benches/c_harness/run.sh), fuzzy_vs_skfuzzy.json,
-tuning_vs_pyswarms_fmu.json, pso_tables.json, native_throughput.json and campaign_scaling.json (the Python
+tuning_vs_pyswarms_fmu.json, pso_tables.json, native_throughput.json, campaign_scaling.json and
+contour_eval_speed.json (the Python
 benches' --json), plus
 criterion's own estimates in <target>/criterion/. Prints the page and writes it to
 <target>/bench-report/report.md. A figure that is missing, or older than the run's start
@@ -105,6 +106,7 @@ def page():
     campaign = load("campaign_scaling.json")
     throughput = load("native_throughput.json")
     harness = load("c_harness.json")
+    evaluation = load("contour_eval_speed.json")
     instructions = load("c_harness_callgrind.json").get("instructions_per_sample") or {}
     med = lambda name: dig(abi, "median_s_per_sample", name)  # noqa: E731
 
@@ -212,6 +214,20 @@ def page():
                      f"per row file, {seconds(campaign['per_row_s'])} per row; a 1 M-run campaign: "
                      f"{million['tasks']} tasks, {million['hours_2_local_workers']:.2f} h on 2 local workers, "
                      f"{million['hours_64_workers'] * 60:.1f} min on 64 workers")
+
+    samples = evaluation.get("samples")
+    lines.append(f"\ncontour-eval on a five-axis run ({samples:,} samples, {evaluation.get('reference_points', 0):,} CL points), "
+                 "medians" if samples else "\ncontour-eval on a five-axis run")
+    base = evaluation.get("baseline_rev", "the baseline")
+    over = dig(evaluation, "over_baseline")
+    same = evaluation.get("identical_outputs")
+    lines.append(line(f"this build / {base}", over,
+                      (f"{seconds(dig(evaluation, 'median_s', 'this build'))} vs "
+                       f"{seconds(dig(evaluation, 'median_s', f'baseline {base}'))}; target <= 0.45x: "
+                       + ("met" if over <= 0.45 else "MISSED")
+                       + f"; outputs identical: {'yes' if same else 'NO'}") if over else "", "{:.3f}x"))
+    lines.append(line(f"this build on one thread (--threads 1) / {base}", dig(evaluation, "one_thread_over_baseline"),
+                      "", "{:.3f}x"))
 
     small = [("fuzzy eval", criterion("fuzzy_evaluate_three_outputs")),
              ("2-axis sample", criterion("controller_sample_fuzzy")),
