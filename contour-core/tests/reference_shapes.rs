@@ -238,7 +238,7 @@ fn each_reading_of_a_figure_eight_cl_file_matches_its_brute_force() {
     let reference = &case.reference;
     let last = (reference.len() - 1) as f64;
     let mut settings = RunSettings::default();
-    settings.params.max_skip = suggested_max_skip(&case.machine, reference, &case.measured);
+    settings.params.max_skip = suggested_max_skip(&case.machine, reference, &case.measured, 2);
     settings.window = settings.window.max(8 * settings.params.max_skip);
 
     // The reading the evaluation used before: the foot on the chord at the fraction

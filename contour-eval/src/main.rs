@@ -396,7 +396,7 @@ fn five_axis(
 ) -> Result<(), Failure> {
     let max_skip = o
         .max_skip
-        .unwrap_or_else(|| suggested_max_skip(&o.machine, reference, joints));
+        .unwrap_or_else(|| suggested_max_skip(&o.machine, reference, joints, o.threads));
     o.settings.params.max_skip = max_skip;
     // Room for a few moves of K either side of the best segment.
     o.settings.window = o.window.unwrap_or(o.settings.window.max(8 * max_skip));

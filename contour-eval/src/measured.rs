@@ -83,6 +83,16 @@ struct Rows {
 }
 
 impl Rows {
+    fn reserve(&mut self, rows: usize) {
+        let more = rows.saturating_sub(self.times.len());
+        self.times.reserve(more);
+        match () {
+            _ if !self.planar.is_empty() => self.planar.reserve(more),
+            _ if !self.joints.is_empty() => self.joints.reserve(more),
+            _ => {}
+        }
+    }
+
     fn append(&mut self, mut other: Rows) {
         self.times.append(&mut other.times);
         self.planar.append(&mut other.planar);
@@ -223,8 +233,9 @@ fn read_blocks(file: &Path, threads: usize, block: usize) -> Result<Measured, St
         needed,
     };
     let mut rows = Rows::default();
+    let size = reader.get_ref().metadata().map_or(0, |m| m.len() as usize);
     // Whole lines of up to BLOCK bytes at a time; a line cut by the block waits for the next.
-    let (mut buffer, mut line) = (Vec::new(), 2);
+    let (mut buffer, mut line, mut read) = (Vec::new(), 2, 0);
     loop {
         let got = (&mut reader)
             .take(block as u64)
@@ -245,6 +256,12 @@ fn read_blocks(file: &Path, threads: usize, block: usize) -> Result<Measured, St
             layout.parse(text, &mut rows)
         };
         line += parsed.map_err(|(at, message)| format!("{name}:{}: {message}", line + at))?;
+        if read == 0 && end > 0 {
+            // Room for the whole run at the first block's bytes a row, so that a long
+            // run's columns are not copied as they grow.
+            rows.reserve(size / end * rows.times.len() + rows.times.len());
+        }
+        read += end;
         buffer.drain(..end);
         if got == 0 {
             break;

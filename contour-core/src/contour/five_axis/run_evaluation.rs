@@ -603,10 +603,12 @@ pub fn evaluate_run(
 /// A `max_skip` for a run: the largest tip move between consecutive measured samples
 /// over the median reference segment, with half again as margin (at least 1, at most
 /// 255). A reference sampled finer than the measurement needs skips of several segments.
+/// With `threads` > 1 the run's two halves are measured at once.
 pub fn suggested_max_skip(
     machine: &TableTiltingAc,
     reference: &[Pose],
     measured: &[Joints],
+    threads: usize,
 ) -> usize {
     let mut lengths: Vec<f64> = reference
         .windows(2)
@@ -618,15 +620,29 @@ pub fn suggested_max_skip(
     }
     let middle = lengths.len() / 2;
     let median = *lengths.select_nth_unstable_by(middle, f64::total_cmp).1;
-    let mut step: f64 = 0.0;
-    let mut previous: Option<Vector<3>> = None;
-    for q in measured {
-        let tip = machine.forward(q).tip;
-        if let Some(p) = previous {
-            step = step.max(geometry::dist(&tip, &p));
+    let largest_step = |run: &[Joints]| {
+        let mut step: f64 = 0.0;
+        let mut previous: Option<Vector<3>> = None;
+        for q in run {
+            let tip = machine.forward(q).tip;
+            if let Some(p) = previous {
+                step = step.max(geometry::dist(&tip, &p));
+            }
+            previous = Some(tip);
         }
-        previous = Some(tip);
-    }
+        step
+    };
+    // The halves share the sample between them, so every step is in one of them.
+    let half = measured.len() / 2;
+    let step = if threads > 1 && half > 0 {
+        std::thread::scope(|scope| {
+            let later = scope.spawn(|| largest_step(&measured[half - 1..]));
+            let earlier = largest_step(&measured[..half]);
+            earlier.max(later.join().expect("no panic measuring steps"))
+        })
+    } else {
+        largest_step(measured)
+    };
     let skips = (1.5 * step / median).ceil();
     if skips.is_finite() {
         (skips as usize).clamp(1, u8::MAX as usize)

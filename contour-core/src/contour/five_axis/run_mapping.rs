@@ -30,6 +30,8 @@ use crate::kinematics::{Joints, TableTiltingAc};
 const CHUNK: usize = 2048;
 /// Segments a band adds either side of the predicted window.
 const MARGIN: usize = 4;
+/// Samples between the helper's looks at the nearest segment in the decoder's chunks.
+const FOLLOW_EVERY: usize = 8;
 
 /// Who costs a chunk.
 const FREE: u8 = 0;
@@ -160,8 +162,11 @@ impl Helper<'_> {
         while let Some(c) = self.claim(last) {
             last = c;
             let samples = c * CHUNK..((c + 1) * CHUNK).min(self.run.measured.len());
-            // Follow the nearest segment through the decoder's chunks up to this one.
-            for k in followed..samples.start {
+            // Follow the nearest segment through the decoder's chunks up to this one, every
+            // FOLLOW_EVERY samples (walking downhill covers the gaps), and the last.
+            let skipped = followed..samples.start;
+            let last = skipped.end.checked_sub(1).filter(|l| skipped.contains(l));
+            for k in skipped.clone().step_by(FOLLOW_EVERY).chain(last) {
                 let (tip, second) = self.run.at(k);
                 nearest.follow(self.table, &tip, &second);
                 previous_tip = tip;
