@@ -176,6 +176,19 @@ fn fuzz_environment() -> Environment {
     }
 }
 
+/// `model.guid()`, computed once per model (it hashes the variable table).
+fn guid_of(index: usize, model: &'static ModelInfo) -> String {
+    thread_local! {
+        static GUIDS: RefCell<Vec<Option<String>>> = const { RefCell::new(Vec::new()) };
+    }
+    GUIDS.with_borrow_mut(|guids| {
+        if guids.len() <= index {
+            guids.resize(index + 1, None);
+        }
+        guids[index].get_or_insert_with(|| model.guid()).clone()
+    })
+}
+
 /// Straight into the model: `check_state`, then `restore_state`, a few steps and a save.
 fn through_model(model: &'static ModelInfo, bytes: &[u8]) {
     let mut m = (model.create)(&fuzz_environment());
@@ -257,7 +270,7 @@ fuzz_target!(
             2 => {
                 let snapshot = Snapshot {
                     library: "fuzz".into(),
-                    guid: model.guid(),
+                    guid: guid_of(index, model),
                     mode: Mode::StepComplete,
                     time: 0.0,
                     stop_time: None,

@@ -11,9 +11,9 @@
 
 use contour_core::contour::planar::TrueErrorIndex;
 use contour_core::geometry::{Vector, Vector2};
+use contour_core::part_program::cutter_compensation::compensate;
 use contour_core::part_program::cutter_compensation::ToolTable;
 use contour_core::part_program::gcode::{parse_gcode, Dialect, GcodeOptions};
-use contour_core::part_program::cutter_compensation::compensate;
 use contour_core::path::five_axis::{ToolPath, GCODE_ARC_SAG};
 use contour_core::path::planar::{Path, Program, XyLimits, XyReference};
 use contour_core::path::{Curve, Interpolator};

@@ -258,6 +258,7 @@ pub mod envelope {
         pub stop_time: Option<f64>,
         pub needs_initialize: bool,
         pub values: Values,
+        #[serde(with = "contour_fmu::framework::saved_state::bytes")]
         pub model: Vec<u8>,
     }
 

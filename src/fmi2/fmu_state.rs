@@ -54,6 +54,7 @@ pub struct Snapshot {
     pub needs_initialize: bool,
     pub values: Values,
     /// The model's own state, from `Model::save_state`.
+    #[serde(with = "crate::framework::saved_state::bytes")]
     pub model: Vec<u8>,
 }
 

@@ -559,6 +559,15 @@ impl Instance {
     /// envelope (magic, format, checksum), the GUID, every variable value like a `fmi2Set`
     /// would, and the model's internal state (its layout version, then its values).
     pub fn check_snapshot(&self, bytes: &[u8]) -> Outcome<Snapshot> {
+        let snapshot = self.check_envelope(bytes)?;
+        self.model
+            .check_state(&snapshot.model, snapshot.time)
+            .map_err(|e| invalid_model_state(&snapshot, e))?;
+        Ok(snapshot)
+    }
+
+    /// [`Instance::check_snapshot`] without the model's internal state.
+    fn check_envelope(&self, bytes: &[u8]) -> Outcome<Snapshot> {
         let snapshot = fmu_state::decode(bytes).map_err(Failure::error)?;
         if snapshot.guid != self.guid {
             return Err(Failure::error(format!(
@@ -597,14 +606,6 @@ impl Instance {
                 snapshot.time, snapshot.stop_time
             )));
         }
-        self.model
-            .check_state(&snapshot.model, snapshot.time)
-            .map_err(|e| {
-                Failure::error(format!(
-                    "the FMU state is invalid (saved by contour-fmu {}): {e}",
-                    snapshot.library
-                ))
-            })?;
         Ok(snapshot)
     }
 
@@ -614,10 +615,12 @@ impl Instance {
     /// `--initial-fmu-state-file`), and an instance that set a state continues exactly as
     /// the one that saved it. Nothing changes when it is refused.
     pub fn restore(&mut self, bytes: &[u8]) -> Outcome {
-        let snapshot = self.check_snapshot(bytes)?;
+        // The model's state is decoded once: restore_state checks what check_state would
+        // and changes nothing when it refuses.
+        let snapshot = self.check_envelope(bytes)?;
         self.model
             .restore_state(&snapshot.model, snapshot.time)
-            .map_err(Failure::error)?;
+            .map_err(|e| invalid_model_state(&snapshot, e))?;
         self.values = snapshot.values;
         self.mode = snapshot.mode;
         self.time = snapshot.time;
@@ -656,6 +659,14 @@ impl Instance {
         );
         failure.status
     }
+}
+
+/// The refusal of a snapshot whose model state is invalid, naming the build that saved it.
+fn invalid_model_state(snapshot: &Snapshot, e: String) -> Failure {
+    Failure::error(format!(
+        "the FMU state is invalid (saved by contour-fmu {}): {e}",
+        snapshot.library
+    ))
 }
 
 #[cfg(test)]

@@ -234,10 +234,11 @@ const ALL_KNOWNS: [usize; KNOWN_COUNT + 1] = {
 /// built-in by name (see `JointReference`'s saved form). Version 3: the reference is
 /// constant-feed or planned (a plan saved as its inputs and the place on it). Version 4:
 /// the reference keeps the previous sample's joints (`vref.*`'s central difference).
-/// Version 5: a plan's inputs carry the program's speeds move by move.
+/// Version 5: a plan's inputs carry the program's speeds move by move. Version 6: a plan
+/// is saved with its inputs' fingerprint and the plan's summary, checked on restore.
 const LAYOUT: StateLayout = StateLayout {
     model: "PathInterpolator5X",
-    version: 5,
+    version: 6,
 };
 
 #[derive(Clone, serde::Serialize)]

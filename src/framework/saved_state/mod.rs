@@ -5,6 +5,7 @@
 //! and the state methods of a sampled model written once (`sampled_state_methods!`).
 //! The FMI side (the snapshot around it, handles, ownership) is `crate::fmi2::fmu_state`.
 
+pub mod bytes;
 mod walk;
 
 pub use walk::{all_finite, all_positive};

@@ -21,7 +21,7 @@ macro_rules! ignore_scalars {
 /// (`element` for positional values, `field` for named ones).
 macro_rules! compound_impl {
     ($trait:ident, $method:ident, element) => {
-        impl ser::$trait for Compound<'_> {
+        impl ser::$trait for Compound<'_, '_> {
             type Ok = ();
             type Error = WalkError;
             fn $method<T: Serialize + ?Sized>(&mut self, value: &T) -> Done {
@@ -33,7 +33,7 @@ macro_rules! compound_impl {
         }
     };
     ($trait:ident, $method:ident, field) => {
-        impl ser::$trait for Compound<'_> {
+        impl ser::$trait for Compound<'_, '_> {
             type Ok = ();
             type Error = WalkError;
             fn $method<T: Serialize + ?Sized>(&mut self, key: &'static str, value: &T) -> Done {
@@ -46,9 +46,15 @@ macro_rules! compound_impl {
     };
 }
 
-/// Every floating-point value of `value` with its field path, in serialisation order.
-pub fn floats<T: Serialize + ?Sized>(value: &T) -> Vec<(String, f64)> {
-    let mut walker = Walker::default();
+/// The floating-point values of `value` that `keep(path, x)`, with their field paths, in
+/// serialisation order: only those are copied out (a restore checks every number of a
+/// state, and nearly all pass).
+fn walk<T: Serialize + ?Sized>(value: &T, keep: &dyn Fn(&str, f64) -> bool) -> Vec<(String, f64)> {
+    let mut walker = Walker {
+        path: String::new(),
+        found: Vec::new(),
+        keep,
+    };
     // The walker itself never fails; a `Serialize` implementation that does (a custom
     // one refusing its own value) only shortens the list, and the decoder accepted it.
     let _ = value.serialize(&mut walker);
@@ -57,7 +63,7 @@ pub fn floats<T: Serialize + ?Sized>(value: &T) -> Vec<(String, f64)> {
 
 /// Refuses a non-finite number anywhere in `value`, naming the first one.
 pub fn all_finite<T: Serialize + ?Sized>(value: &T) -> Result<(), String> {
-    match floats(value).into_iter().find(|(_, x)| !x.is_finite()) {
+    match walk(value, &|_, x| !x.is_finite()).into_iter().next() {
         Some((path, x)) => Err(format!("{path} = {x} is not finite")),
         None => Ok(()),
     }
@@ -65,30 +71,41 @@ pub fn all_finite<T: Serialize + ?Sized>(value: &T) -> Result<(), String> {
 
 /// Refuses a value ≤ 0 (or NaN) in any field named `field` (e.g. every `radius`).
 pub fn all_positive<T: Serialize + ?Sized>(value: &T, field: &str) -> Result<(), String> {
-    let wanted = |path: &str| path == field || path.ends_with(&format!(".{field}"));
-    match floats(value)
-        .into_iter()
-        .find(|(path, x)| wanted(path) && (x.is_nan() || *x <= 0.0))
-    {
+    let wanted = |path: &str| {
+        path.strip_suffix(field)
+            .is_some_and(|head| head.is_empty() || head.ends_with('.'))
+    };
+    let bad = |path: &str, x: f64| (x.is_nan() || x <= 0.0) && wanted(path);
+    match walk(value, &bad).into_iter().next() {
         Some((path, x)) => Err(format!("{path} = {x} must be > 0")),
         None => Ok(()),
     }
 }
 
-#[derive(Default)]
-struct Walker {
+struct Walker<'k> {
     path: String,
     found: Vec<(String, f64)>,
+    keep: &'k dyn Fn(&str, f64) -> bool,
 }
 
-impl Walker {
-    /// Runs `f` with `segment` appended to the path (`.name` or `[i]`).
-    fn nested<R>(&mut self, segment: &str, f: impl FnOnce(&mut Self) -> R) -> R {
+impl Walker<'_> {
+    /// Runs `f` with the field `name` appended to the path (`.name`).
+    fn nested<R>(&mut self, name: &str, f: impl FnOnce(&mut Self) -> R) -> R {
         let len = self.path.len();
-        if !segment.starts_with('[') && !self.path.is_empty() {
+        if !self.path.is_empty() {
             self.path.push('.');
         }
-        self.path.push_str(segment);
+        self.path.push_str(name);
+        let result = f(self);
+        self.path.truncate(len);
+        result
+    }
+
+    /// Runs `f` with the element `[index]` appended to the path.
+    fn indexed<R>(&mut self, index: usize, f: impl FnOnce(&mut Self) -> R) -> R {
+        let len = self.path.len();
+        fmt::Write::write_fmt(&mut self.path, format_args!("[{index}]"))
+            .expect("a String takes every write");
         let result = f(self);
         self.path.truncate(len);
         result
@@ -116,18 +133,18 @@ type Done = Result<(), WalkError>;
 
 /// Sequences, tuples and variants' fields: elements are `[i]`, named fields `.name`; a
 /// variant's name was pushed when it started and is popped at its end.
-pub struct Compound<'a> {
-    walker: &'a mut Walker,
+pub struct Compound<'a, 'k> {
+    walker: &'a mut Walker<'k>,
     index: usize,
     /// Path length to restore at the end (the variant name's segment), if any.
     restore: Option<usize>,
 }
 
-impl Compound<'_> {
+impl Compound<'_, '_> {
     fn element<T: Serialize + ?Sized>(&mut self, value: &T) -> Done {
-        let segment = format!("[{}]", self.index);
+        let index = self.index;
         self.index += 1;
-        self.walker.nested(&segment, |w| value.serialize(w))
+        self.walker.indexed(index, |w| value.serialize(w))
     }
 
     fn field<T: Serialize + ?Sized>(&mut self, key: &'static str, value: &T) -> Done {
@@ -142,8 +159,8 @@ impl Compound<'_> {
     }
 }
 
-impl<'a> Walker {
-    fn compound(&'a mut self, variant: Option<&'static str>) -> Compound<'a> {
+impl<'k> Walker<'k> {
+    fn compound<'a>(&'a mut self, variant: Option<&'static str>) -> Compound<'a, 'k> {
         let restore = variant.map(|name| {
             let len = self.path.len();
             if !self.path.is_empty() {
@@ -160,19 +177,21 @@ impl<'a> Walker {
     }
 }
 
-impl<'a> ser::Serializer for &'a mut Walker {
+impl<'a, 'k> ser::Serializer for &'a mut Walker<'k> {
     type Ok = ();
     type Error = WalkError;
-    type SerializeSeq = Compound<'a>;
-    type SerializeTuple = Compound<'a>;
-    type SerializeTupleStruct = Compound<'a>;
-    type SerializeTupleVariant = Compound<'a>;
-    type SerializeMap = Compound<'a>;
-    type SerializeStruct = Compound<'a>;
-    type SerializeStructVariant = Compound<'a>;
+    type SerializeSeq = Compound<'a, 'k>;
+    type SerializeTuple = Compound<'a, 'k>;
+    type SerializeTupleStruct = Compound<'a, 'k>;
+    type SerializeTupleVariant = Compound<'a, 'k>;
+    type SerializeMap = Compound<'a, 'k>;
+    type SerializeStruct = Compound<'a, 'k>;
+    type SerializeStructVariant = Compound<'a, 'k>;
 
     fn serialize_f64(self, v: f64) -> Done {
-        self.found.push((self.path.clone(), v));
+        if (self.keep)(&self.path, v) {
+            self.found.push((self.path.clone(), v));
+        }
         Ok(())
     }
     fn serialize_f32(self, v: f32) -> Done {
@@ -211,13 +230,17 @@ impl<'a> ser::Serializer for &'a mut Walker {
     ) -> Done {
         self.nested(variant, |w| value.serialize(w))
     }
-    fn serialize_seq(self, _: Option<usize>) -> Result<Compound<'a>, WalkError> {
+    fn serialize_seq(self, _: Option<usize>) -> Result<Compound<'a, 'k>, WalkError> {
         Ok(self.compound(None))
     }
-    fn serialize_tuple(self, _: usize) -> Result<Compound<'a>, WalkError> {
+    fn serialize_tuple(self, _: usize) -> Result<Compound<'a, 'k>, WalkError> {
         Ok(self.compound(None))
     }
-    fn serialize_tuple_struct(self, _: &'static str, _: usize) -> Result<Compound<'a>, WalkError> {
+    fn serialize_tuple_struct(
+        self,
+        _: &'static str,
+        _: usize,
+    ) -> Result<Compound<'a, 'k>, WalkError> {
         Ok(self.compound(None))
     }
     fn serialize_tuple_variant(
@@ -226,13 +249,13 @@ impl<'a> ser::Serializer for &'a mut Walker {
         _: u32,
         variant: &'static str,
         _: usize,
-    ) -> Result<Compound<'a>, WalkError> {
+    ) -> Result<Compound<'a, 'k>, WalkError> {
         Ok(self.compound(Some(variant)))
     }
-    fn serialize_map(self, _: Option<usize>) -> Result<Compound<'a>, WalkError> {
+    fn serialize_map(self, _: Option<usize>) -> Result<Compound<'a, 'k>, WalkError> {
         Ok(self.compound(None))
     }
-    fn serialize_struct(self, _: &'static str, _: usize) -> Result<Compound<'a>, WalkError> {
+    fn serialize_struct(self, _: &'static str, _: usize) -> Result<Compound<'a, 'k>, WalkError> {
         Ok(self.compound(None))
     }
     fn serialize_struct_variant(
@@ -241,7 +264,7 @@ impl<'a> ser::Serializer for &'a mut Walker {
         _: u32,
         variant: &'static str,
         _: usize,
-    ) -> Result<Compound<'a>, WalkError> {
+    ) -> Result<Compound<'a, 'k>, WalkError> {
         Ok(self.compound(Some(variant)))
     }
 }
@@ -255,7 +278,7 @@ compound_impl!(SerializeTupleVariant, serialize_field, element);
 compound_impl!(SerializeStruct, serialize_field, field);
 compound_impl!(SerializeStructVariant, serialize_field, field);
 
-impl ser::SerializeMap for Compound<'_> {
+impl ser::SerializeMap for Compound<'_, '_> {
     type Ok = ();
     type Error = WalkError;
     fn serialize_key<T: Serialize + ?Sized>(&mut self, _: &T) -> Done {
@@ -304,7 +327,7 @@ mod tests {
 
     #[test]
     fn every_float_is_found_with_its_path() {
-        let found = floats(&sample());
+        let found = walk(&sample(), &|_, _| true);
         let expected: Vec<(String, f64)> = [
             ("shapes[1].Circle.radius", 2.5),
             ("shapes[2].Points[0][0]", 1.0),

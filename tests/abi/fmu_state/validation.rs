@@ -367,9 +367,9 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
     // lead became a transmission), PathInterpolator2D 3 (a program's moves carry their
     // standstill; 2: the planned reference joined the constant-feed one), ContourCCC5X 5 (the feed-forward
     // remembers its inputs; 4: the feed-forward gains, the guard's averaged speeds and
-    // commands), PathInterpolator5X 5 (a plan's
-    // inputs carry a CL file's speeds; 4: the sample before the current one, for vref and
-    // aref).
+    // commands), PathInterpolator5X 6 (a plan saved with its inputs' fingerprint and its
+    // summary; 5: a plan's inputs carry a CL file's speeds; 4: the sample before the
+    // current one, for vref and aref).
     for (i, bytes, model, version) in [
         (&controller, &controller_bytes, "ContourCCC2D", 7u16),
         (&plant_instance, &plant_bytes, "XYServoPlant", 3),
@@ -379,7 +379,7 @@ fn states_from_an_older_layout_or_format_are_refused_with_a_clear_message() {
             &interpolator_5x,
             &interpolator_5x_bytes,
             "PathInterpolator5X",
-            5,
+            6,
         ),
     ] {
         let (_, envelope) = open_state(bytes);

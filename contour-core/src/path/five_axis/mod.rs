@@ -21,10 +21,11 @@ pub use jerk_filter::JerkFilter;
 pub use joint_path::{plan_joints, JointPath, NODE_BUDGET};
 pub use joint_reference::{JointReference, JointSample};
 pub use plan::{
-    FiveAxisCursor, FiveAxisPlan, FiveAxisPlanReport, PlannedSample, QUANTUM, SAMPLE_BUDGET,
+    FiveAxisCursor, FiveAxisPlan, FiveAxisPlanReport, PlanSummary, PlannedSample, QUANTUM,
+    SAMPLE_BUDGET,
 };
 pub use planned_reference::{PlannedFiveAxisReference, SavedPlannedReference};
-pub use planner::{FiveAxisInputs, Planner};
+pub use planner::{fingerprint, FiveAxisInputs, Planner};
 pub use programmed_feed::{check_feeds, feed_of_move, greatest_feed, program_feeds, FeedChange};
 pub use reference::{FiveAxisReference, ReferenceSample, SavedFiveAxisReference};
 pub use tool_path::{

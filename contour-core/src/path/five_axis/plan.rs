@@ -75,6 +75,18 @@ pub struct FiveAxisPlanReport {
     pub nodes: usize,
 }
 
+/// The plan a saved place was on, in numbers: a state is restored only onto a plan with
+/// the same (one made by another build from the same inputs may differ).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct PlanSummary {
+    /// Samples until the reference rests at the path's end.
+    pub samples: u64,
+    /// The jerk filter's two averages, samples.
+    pub filter: (u64, u64),
+    /// Planning nodes.
+    pub nodes: u64,
+}
+
 /// A plan: what every sample is computed from.
 #[derive(Debug)]
 pub struct FiveAxisPlan {
@@ -322,6 +334,15 @@ impl FiveAxisPlan {
         Err(PathError::invalid(format!(
             "no feed found within the limits after {ROUNDS} plans"
         )))
+    }
+
+    /// What a saved place on the plan checks the plan against.
+    pub fn summary(&self) -> PlanSummary {
+        PlanSummary {
+            samples: self.samples,
+            filter: (self.filter.0 as u64, self.filter.1 as u64),
+            nodes: self.nodes() as u64,
+        }
     }
 
     /// The plan's nodes along the path.

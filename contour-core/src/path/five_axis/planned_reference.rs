@@ -3,8 +3,8 @@
 
 use std::sync::Arc;
 
-use super::plan::{FiveAxisCursor, FiveAxisPlan, PlannedSample};
-use super::planner::{FiveAxisInputs, Planner};
+use super::plan::{FiveAxisCursor, FiveAxisPlan, PlanSummary, PlannedSample};
+use super::planner::{fingerprint, FiveAxisInputs, Planner};
 use super::ToolPath;
 use crate::geometry;
 use crate::kinematics::{Joints, TableTiltingAc};
@@ -36,28 +36,55 @@ impl PlannedFiveAxisReference {
         })
     }
 
-    /// On `plan` at a saved `cursor`, checked against the plan.
+    /// On the plan for `inputs` at a saved `cursor`. What needs no plan is checked first
+    /// (so a damaged state costs no planning): the inputs against the `saved`
+    /// fingerprint, the cursor's own consistency; then the plan the planner keeps or
+    /// makes against the saved summary, and the place against the plan.
     fn resume(
         inputs: FiveAxisInputs,
         cursor: FiveAxisCursor,
+        saved: (u64, PlanSummary),
         planner: &Planner,
     ) -> Result<Self, String> {
+        let (saved_fingerprint, saved_summary) = saved;
+        if fingerprint(&inputs) != saved_fingerprint {
+            return Err(
+                "the plan's saved inputs do not match their fingerprint: the state \
+                        is damaged"
+                    .into(),
+            );
+        }
+        cursor.filter.check()?;
+        let (m1, m2) = cursor.filter.lengths();
+        if (m1 as u64, m2 as u64) != saved_summary.filter {
+            return Err(format!(
+                "the saved jerk filter has {m1} + {m2} samples, the saved plan {} + {}",
+                saved_summary.filter.0, saved_summary.filter.1
+            ));
+        }
+        if cursor.sample > saved_summary.samples || !geometry::is_finite(&cursor.joints) {
+            return Err("the saved place lies outside the saved plan".into());
+        }
         let plan = planner
             .plan(&inputs, &|i| format!("pose {i}"))
             .map_err(|e| e.to_string())?;
-        cursor.filter.check()?;
-        let (m1, m2) = cursor.filter.lengths();
-        if (m1, m2) != plan.filter {
+        let summary = plan.summary();
+        if summary != saved_summary {
             return Err(format!(
-                "the saved jerk filter has {m1} + {m2} samples, the plan {} + {}",
-                plan.filter.0, plan.filter.1
+                "the state was saved on a plan of {} samples ({} nodes, a jerk filter of \
+                 {} + {}), this build plans {} ({} nodes, {} + {}) from the same inputs: it \
+                 was saved by another build",
+                saved_summary.samples,
+                saved_summary.nodes,
+                saved_summary.filter.0,
+                saved_summary.filter.1,
+                summary.samples,
+                summary.nodes,
+                summary.filter.0,
+                summary.filter.1
             ));
         }
-        if cursor.sample > plan.samples
-            || cursor.interval + 1 >= plan.path.s.len()
-            || cursor.foot + 1 >= plan.path.s.len()
-            || !geometry::is_finite(&cursor.joints)
-        {
+        if cursor.interval + 1 >= plan.path.s.len() || cursor.foot + 1 >= plan.path.s.len() {
             return Err("the saved place lies outside the plan".into());
         }
         Ok(PlannedFiveAxisReference {
@@ -127,6 +154,10 @@ impl PartialEq for PlannedFiveAxisReference {
 #[derive(serde::Serialize)]
 struct SavedReference<'a> {
     inputs: SavedInputs<'a>,
+    /// The inputs' [`fingerprint`], checked before they are planned again.
+    fingerprint: u64,
+    /// The plan the place is on, checked against the one restored.
+    plan: PlanSummary,
     cursor: &'a FiveAxisCursor,
 }
 
@@ -147,6 +178,8 @@ enum SavedInputs<'a> {
 #[derive(serde::Deserialize)]
 pub struct SavedPlannedReference {
     inputs: RestoredInputs,
+    fingerprint: u64,
+    plan: PlanSummary,
     cursor: FiveAxisCursor,
 }
 
@@ -172,7 +205,8 @@ impl SavedPlannedReference {
             },
             RestoredInputs::Data(inputs) => inputs,
         };
-        PlannedFiveAxisReference::resume(inputs, self.cursor, planner)
+        let saved = (self.fingerprint, self.plan);
+        PlannedFiveAxisReference::resume(inputs, self.cursor, saved, planner)
     }
 }
 
@@ -185,8 +219,112 @@ impl serde::Serialize for PlannedFiveAxisReference {
         };
         SavedReference {
             inputs,
+            fingerprint: fingerprint(i),
+            plan: self.plan.summary(),
             cursor: &self.cursor,
         }
         .serialize(serializer)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Vector;
+    use crate::kinematics::Pose;
+    use crate::math;
+
+    /// A planned quarter turn of 200 poses at 30 mm/s, 2 m/s², and 300 samples on it.
+    fn stepped(planner: &Planner) -> PlannedFiveAxisReference {
+        let poses: Vec<Pose> = (0..200)
+            .map(|i| {
+                let t = i as f64 * 0.008;
+                Pose {
+                    tip: Vector::<3>::new(20.0 * math::cos(t), 20.0 * math::sin(t), 1.0),
+                    axis: Vector::<3>::new(0.2 * math::cos(t), 0.2 * math::sin(t), 1.0),
+                }
+            })
+            .collect();
+        let inputs = FiveAxisInputs {
+            path: ToolPath::from_poses(&poses).unwrap(),
+            builtin: None,
+            feeds: Vec::new(),
+            machine: TableTiltingAc::ORIGIN,
+            joints: JointLimits::DEFAULT,
+            limits: PathLimits {
+                accel: 2000.0,
+                ..PathLimits::at_feed(30.0)
+            },
+            ts: 1e-3,
+        };
+        let mut r =
+            PlannedFiveAxisReference::new(inputs, planner, &|i| format!("pose {i}")).unwrap();
+        for _ in 0..300 {
+            r.step();
+        }
+        r
+    }
+
+    fn saved(r: &PlannedFiveAxisReference) -> SavedPlannedReference {
+        postcard::from_bytes(&postcard::to_stdvec(r).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn a_damaged_state_is_refused_before_planning_and_a_foreign_plan_after() {
+        let made_here = Planner::new();
+        let r = stepped(&made_here);
+        // Restored in a fresh process: planned once, then continues alike.
+        let fresh = Planner::new();
+        let mut restored = saved(&r).resume(&fresh).unwrap();
+        assert_eq!(
+            (restored.cursor.clone(), fresh.plans_made()),
+            (r.cursor.clone(), 1)
+        );
+        assert_eq!(restored.step(), r.clone().step());
+
+        // Inputs changed after saving (a flipped bit in a limit): refused, nothing planned.
+        let fresh = Planner::new();
+        let mut damaged = saved(&r);
+        let RestoredInputs::Data(inputs) = &mut damaged.inputs else {
+            panic!("saved with its data")
+        };
+        inputs.limits.feed = f64::from_bits(inputs.limits.feed.to_bits() ^ 1);
+        let e = damaged.resume(&fresh).err().unwrap();
+        assert!(e.contains("do not match their fingerprint"), "{e}");
+        // A place beyond the saved plan's end: refused, nothing planned.
+        let mut beyond = saved(&r);
+        beyond.cursor.sample = beyond.plan.samples + 1;
+        let e = beyond.resume(&fresh).err().unwrap();
+        assert!(e.contains("outside the saved plan"), "{e}");
+        assert_eq!(fresh.plans_made(), 0);
+
+        // Saved on a plan this build does not make from the same inputs (another
+        // build's planner): refused after planning, once.
+        let mut foreign = saved(&r);
+        foreign.plan.samples -= 1;
+        let e = foreign.resume(&fresh).err().unwrap();
+        assert!(e.contains("saved by another build"), "{e}");
+        let mut foreign = saved(&r);
+        foreign.plan.nodes += 1;
+        assert!(foreign.resume(&fresh).is_err());
+        assert_eq!(
+            fresh.plans_made(),
+            1,
+            "the plan is kept for the next restore"
+        );
+    }
+
+    /// Saved states carry the fingerprint, so it must not depend on the build or the
+    /// platform (FNV-1a of postcard's bytes): pinned for a small path and a built-in.
+    #[test]
+    fn the_fingerprint_is_the_same_everywhere() {
+        let r = stepped(&Planner::new());
+        assert_eq!(fingerprint(r.inputs()), 0x2069_992e_1f37_d16b);
+        let builtin = FiveAxisInputs {
+            path: ToolPath::builtin("tilted_helix").unwrap(),
+            builtin: Some("tilted_helix".into()),
+            ..r.inputs().clone()
+        };
+        assert_eq!(fingerprint(&builtin), 0xe0a2_754e_40f1_9bee);
     }
 }

@@ -42,11 +42,15 @@ pub struct FiveAxisInputs {
 pub struct Planner {
     /// The most samples a plan may have (at least 1).
     sample_budget: AtomicU64,
-    plans: Mutex<Vec<(u64, Weak<FiveAxisPlan>)>>,
+    /// Each plan alive with its inputs' fingerprint and the inputs (compared in full on
+    /// a fingerprint's match: a collision plans anew rather than share a plan).
+    plans: Mutex<Vec<(u64, FiveAxisInputs, Weak<FiveAxisPlan>)>>,
     /// The plans used last, kept alive after their instances let go of them: restoring a
     /// state checks it (a plan made and dropped) and then takes it (the same plan again),
     /// and an importer that rolls back between states of two plans would plan each time.
     recent: Mutex<[Option<Arc<FiveAxisPlan>>; RECENT_PLANS]>,
+    /// Plans made (not found kept).
+    made: AtomicU64,
 }
 
 const RECENT_PLANS: usize = 2;
@@ -66,6 +70,7 @@ impl Planner {
             sample_budget: AtomicU64::new(SAMPLE_BUDGET),
             plans: Mutex::new(Vec::new()),
             recent: Mutex::new([None, None]),
+            made: AtomicU64::new(0),
         }
     }
 
@@ -80,6 +85,11 @@ impl Planner {
         self.sample_budget.load(Ordering::Relaxed)
     }
 
+    /// How many plans were made, not found kept.
+    pub fn plans_made(&self) -> u64 {
+        self.made.load(Ordering::Relaxed)
+    }
+
     /// The plan for `inputs`, kept or made now; `name` names a programmed pose in
     /// messages.
     pub fn plan(
@@ -90,17 +100,18 @@ impl Planner {
         let key = fingerprint(inputs);
         {
             let mut plans = self.plans.lock().unwrap_or_else(|e| e.into_inner());
-            plans.retain(|(_, plan)| plan.strong_count() > 0);
+            plans.retain(|(_, _, plan)| plan.strong_count() > 0);
             if let Some(plan) = plans
                 .iter()
-                .find(|(k, _)| *k == key)
-                .and_then(|(_, p)| p.upgrade())
+                .find(|(k, made_from, _)| *k == key && made_from == inputs)
+                .and_then(|(_, _, p)| p.upgrade())
             {
                 drop(plans);
                 self.remember(&plan);
                 return Ok(plan);
             }
         }
+        self.made.fetch_add(1, Ordering::Relaxed);
         let poses = inputs.path.poses(PLAN_CHORD)?;
         let plan = Arc::new(FiveAxisPlan::within_budget(
             (&poses, &inputs.feeds),
@@ -111,10 +122,11 @@ impl Planner {
             name,
             self.sample_budget(),
         )?);
-        self.plans
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .push((key, Arc::downgrade(&plan)));
+        self.plans.lock().unwrap_or_else(|e| e.into_inner()).push((
+            key,
+            inputs.clone(),
+            Arc::downgrade(&plan),
+        ));
         self.remember(&plan);
         Ok(plan)
     }
@@ -134,14 +146,21 @@ impl Planner {
     }
 }
 
-fn fingerprint(inputs: &FiveAxisInputs) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut hasher = std::hash::DefaultHasher::new();
+/// A fingerprint of what a plan is made from, the same in every build and on every
+/// platform: FNV-1a over the inputs' postcard bytes, a built-in by its name. The plan
+/// cache's key, and what a saved state's inputs are checked against before they are
+/// planned (a damaged state is refused without planning).
+pub fn fingerprint(inputs: &FiveAxisInputs) -> u64 {
+    let mut hash = Fnv::default();
     match &inputs.builtin {
-        Some(name) => name.hash(&mut hasher),
-        None => postcard::to_stdvec(&inputs.path)
-            .unwrap_or_default()
-            .hash(&mut hasher),
+        Some(name) => {
+            hash.write(&[1]);
+            hash.write(name.as_bytes());
+        }
+        None => {
+            hash.write(&[0]);
+            hash.write(&postcard::to_stdvec(&inputs.path).unwrap_or_default());
+        }
     }
     let rest = (
         &inputs.machine,
@@ -150,10 +169,25 @@ fn fingerprint(inputs: &FiveAxisInputs) -> u64 {
         inputs.ts,
         &inputs.feeds,
     );
-    postcard::to_stdvec(&rest)
-        .unwrap_or_default()
-        .hash(&mut hasher);
-    hasher.finish()
+    hash.write(&postcard::to_stdvec(&rest).unwrap_or_default());
+    hash.0
+}
+
+/// FNV-1a, 64 bits.
+struct Fnv(u64);
+
+impl Default for Fnv {
+    fn default() -> Self {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
 }
 
 /// The chord a curve pair is sampled at for planning, mm: the planned tip leaves the
