@@ -283,6 +283,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
         let mut environment = Environment {
             resource_dir: None,
             planner: super::plans::planner(),
+            xy_plans: super::plans::xy_plans(),
         };
         if !fmuResourceLocation.is_null() {
             match c_str(fmuResourceLocation)

@@ -1,15 +1,23 @@
-//! The five-axis plans of this library's instances: one [`Planner`] for the process, which
-//! owns the instances, so instances on one path and limits share a plan and a restored
-//! state finds its plan instead of planning again (contour-core keeps no state of its own).
+//! The plans of this library's instances: one five-axis [`Planner`] and one [`XyPlans`]
+//! for the process, which owns the instances, so instances on one path and limits share a
+//! plan and a restored state finds its plan instead of planning again (contour-core keeps
+//! no state of its own).
 
 use std::sync::{Arc, OnceLock};
 
 use contour_core::path::five_axis::Planner;
+use contour_core::path::planar::XyPlans;
 
 /// The planner every instance of this library is given.
 pub fn planner() -> Arc<Planner> {
     static PLANNER: OnceLock<Arc<Planner>> = OnceLock::new();
     Arc::clone(PLANNER.get_or_init(|| Arc::new(Planner::new())))
+}
+
+/// The XY plan cache every instance of this library is given.
+pub fn xy_plans() -> Arc<XyPlans> {
+    static PLANS: OnceLock<Arc<XyPlans>> = OnceLock::new();
+    Arc::clone(PLANS.get_or_init(|| Arc::new(XyPlans::new())))
 }
 
 /// Sets the most samples a plan may have (a fuzzer's time limit; see

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use contour_core::path::five_axis::Planner;
+use contour_core::path::planar::XyPlans;
 use sha2::{Digest, Sha256};
 
 use super::units;
@@ -20,6 +21,8 @@ pub struct Environment {
     /// `fmi2::plans`), so instances on one path plan once and a restored state finds its
     /// plan.
     pub planner: Arc<Planner>,
+    /// The same for the XY table's planned references.
+    pub xy_plans: Arc<XyPlans>,
 }
 
 /// A model's answer when it cannot do what was asked; the text goes to the log.

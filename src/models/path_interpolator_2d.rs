@@ -15,10 +15,10 @@ use super::axis_variables::{
 use super::{line_arc_parameters, path_parameter};
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
-use crate::framework::saved_state::{self, SavedState, StateLayout};
+use crate::framework::saved_state::{self, RestoredState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, Real, XY};
 use crate::framework::variables::{Start, Values, Variable};
-use contour_core::path::planar::{Path, XyLimits, XyReference};
+use contour_core::path::planar::{Path, SavedXyReference, XyLimits, XyReference};
 use contour_core::path::{CircularArc, Curve, Interpolator, Line};
 
 variable_table! {
@@ -187,7 +187,7 @@ const READER: path_parameter::ReaderParameters = path_parameter::ReaderParameter
 };
 
 /// The reference the parameters choose.
-#[derive(Clone, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, serde::Serialize)]
 #[allow(clippy::large_enum_variant)] // one per instance
 enum Reference {
     /// `accel` = 0: the paper's constant-feed interpolator.
@@ -196,16 +196,58 @@ enum Reference {
     Planned(XyReference),
 }
 
-#[derive(Clone, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, serde::Serialize)]
 struct State {
     reference: Reference,
     clock: SampleClock,
 }
 
-impl SavedState for State {
+/// A saved [`Reference`] as read back (the same layout): a plan's inputs, before the
+/// instance's plan cache finds or makes the plan.
+#[derive(serde::Deserialize)]
+enum SavedReference {
+    ConstantFeed(Interpolator),
+    Planned(SavedXyReference),
+}
+
+/// A saved [`State`] as read back (the same layout).
+#[derive(serde::Deserialize)]
+struct SavedStateData {
+    reference: SavedReference,
+    clock: SampleClock,
+}
+
+impl RestoredState for State {
+    type Saved = SavedStateData;
+
+    /// The saved reference (a plan found in or made by the instance's cache), checked
+    /// like the parameters it was built from.
+    fn restore(
+        saved: SavedStateData,
+        time: f64,
+        environment: &Environment,
+    ) -> Result<Self, String> {
+        let reference = match saved.reference {
+            SavedReference::ConstantFeed(it) => Reference::ConstantFeed(it),
+            SavedReference::Planned(planned) => Reference::Planned(
+                planned
+                    .resume(&environment.xy_plans)
+                    .map_err(|e| format!("planned reference: {e}"))?,
+            ),
+        };
+        let state = State {
+            reference,
+            clock: saved.clock,
+        };
+        state.validate(time)?;
+        Ok(state)
+    }
+}
+
+impl State {
     /// Checks a restored state like the parameters it was built from; the error names
     /// the offending value. (A NURBS path is validated by its own decoder.)
-    fn validate(&self, time: f64, _environment: &Environment) -> Result<(), String> {
+    fn validate(&self, time: f64) -> Result<(), String> {
         self.clock.validate_at(time)?;
         let it = match &self.reference {
             Reference::ConstantFeed(it) => it,
@@ -338,7 +380,8 @@ impl Model for PathInterpolator2D {
             };
             limits.validate().map_err(|e| format!("parameter {e}"))?;
             Reference::Planned(
-                XyReference::new(path, limits).map_err(|e| format!("parameter 'path': {e}"))?,
+                XyReference::planned_by(path, limits, &self.environment.xy_plans)
+                    .map_err(|e| format!("parameter 'path': {e}"))?,
             )
         } else {
             if let Path::Program(_) = path {
@@ -410,6 +453,40 @@ mod tests {
                 path(&values, &env).unwrap(),
                 builtin::by_name(name).unwrap()
             );
+        }
+    }
+
+    /// A planned NURBS reference restored into a fresh instance of the same process
+    /// finds the plan (none made again) and goes on bit for bit; the same state into an
+    /// instance with a cache of its own plans once, alike.
+    #[test]
+    fn a_restored_plan_is_found_not_made_again() {
+        use crate::framework::variables::Value;
+        let env = Environment::default();
+        let mut values = Values::from_table(&VARIABLES);
+        values.set(PATH.vr(), Value::String("infinity".into()));
+        values.set(ACCEL.vr(), Value::Real(2000.0));
+        let mut a = (INFO.create)(&env);
+        a.initialize(&mut values, 0.0).unwrap();
+        for k in 0..100 {
+            a.do_step(&mut values, k as f64 * 1e-3, 1e-3).unwrap();
+        }
+        assert_eq!(env.xy_plans.plans_made(), 1);
+        let saved = a.save_state().unwrap();
+        let mut b = (INFO.create)(&env);
+        b.restore_state(&saved, 0.1).unwrap();
+        assert_eq!(env.xy_plans.plans_made(), 1, "planned again");
+        let elsewhere = Environment::default();
+        let mut c = (INFO.create)(&elsewhere);
+        c.restore_state(&saved, 0.1).unwrap();
+        assert_eq!(elsewhere.xy_plans.plans_made(), 1);
+        let (mut vb, mut vc) = (values.clone(), values.clone());
+        for k in 100..200 {
+            let t = k as f64 * 1e-3;
+            a.do_step(&mut values, t, 1e-3).unwrap();
+            b.do_step(&mut vb, t, 1e-3).unwrap();
+            c.do_step(&mut vc, t, 1e-3).unwrap();
+            assert!(values == vb && values == vc, "sample {k}");
         }
     }
 }

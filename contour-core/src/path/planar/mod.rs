@@ -9,14 +9,16 @@ pub mod builtin;
 mod corner_blend;
 mod nurbs_pieces;
 mod plan;
+mod plan_cache;
 mod program;
 mod reference;
 
 pub use blending::{blended, MIN_BLEND_TURN};
 pub use corner_blend::CornerBlend;
 pub use plan::{planned_geometry, XyCursor, XyLimits, XyPlan, XyPoint};
+pub use plan_cache::XyPlans;
 pub use program::{Move, Program, Shape, Standstill};
-pub use reference::XyReference;
+pub use reference::{SavedXyReference, XyReference};
 
 use serde::{Deserialize, Serialize};
 

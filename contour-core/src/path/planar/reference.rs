@@ -1,11 +1,15 @@
 //! The planned XY reference sampled every Ts (docs/design/two-axis.md §4.9): the plan of
 //! [`XyPlan`] made once, then one sample a step in O(1). It saves its inputs and its
-//! sample count; a restored one plans again (the plan is a function of them), so a state
-//! from elsewhere cannot carry a plan that breaks the limits.
+//! sample count; a restored one is planned from them (the plan is a function of them), so
+//! a state from elsewhere cannot carry a plan that breaks the limits: through an
+//! [`XyPlans`] cache, which finds the plan an instance of this process made.
+
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
 use super::plan::{XyCursor, XyLimits, XyPlan, XyPoint};
+use super::plan_cache::XyPlans;
 use crate::path::planar::Path;
 use crate::path::PathError;
 
@@ -14,38 +18,69 @@ use crate::path::PathError;
 pub struct XyReference {
     path: Path,
     limits: XyLimits,
-    plan: XyPlan,
+    plan: Arc<XyPlan>,
     /// Samples taken: the current one is at k·Ts.
     k: u64,
     cursor: XyCursor,
     current: XyPoint,
 }
 
+/// A saved [`XyReference`] as read back, before [`SavedXyReference::resume`] finds or
+/// makes its plan.
 #[derive(Serialize, Deserialize)]
-struct XyReferenceData {
+pub struct SavedXyReference {
     path: Path,
     limits: XyLimits,
     k: u64,
 }
 
+impl SavedXyReference {
+    /// The reference at its saved sample, on the plan `plans` keeps or makes for its path
+    /// and limits.
+    pub fn resume(self, plans: &XyPlans) -> Result<XyReference, String> {
+        check_sample_time(&self)?;
+        let plan = plans
+            .plan(&self.path, &self.limits)
+            .map_err(|e| e.to_string())?;
+        Ok(XyReference::on(plan, self.path, self.limits, self.k))
+    }
+}
+
+/// A saved sample count whose time is not a number is refused before any planning.
+fn check_sample_time(saved: &SavedXyReference) -> Result<(), String> {
+    if (saved.limits.ts * saved.k as f64).is_finite() {
+        Ok(())
+    } else {
+        Err("planned reference: sample time not finite".into())
+    }
+}
+
 impl XyReference {
     /// Plans `path` within `limits`; the first sample is the path's start, at rest.
     pub fn new(path: Path, limits: XyLimits) -> Result<Self, PathError> {
-        Self::at_sample(path, limits, 0)
+        let plan = Arc::new(XyPlan::new(&path, &limits)?);
+        Ok(Self::on(plan, path, limits, 0))
     }
 
-    fn at_sample(path: Path, limits: XyLimits, k: u64) -> Result<Self, PathError> {
-        let plan = XyPlan::new(&path, &limits)?;
+    /// [`XyReference::new`] on the plan `plans` keeps or makes: instances on one path
+    /// and limits share it.
+    pub fn planned_by(path: Path, limits: XyLimits, plans: &XyPlans) -> Result<Self, PathError> {
+        let plan = plans.plan(&path, &limits)?;
+        Ok(Self::on(plan, path, limits, 0))
+    }
+
+    /// On `plan` (of `path` within `limits`) at sample `k`.
+    fn on(plan: Arc<XyPlan>, path: Path, limits: XyLimits, k: u64) -> Self {
         let mut cursor = XyCursor::default();
         let current = plan.at(k as f64 * limits.ts, &mut cursor);
-        Ok(XyReference {
+        XyReference {
             path,
             limits,
             plan,
             k,
             cursor,
             current,
-        })
+        }
     }
 
     /// The next sample.
@@ -109,16 +144,18 @@ impl Serialize for XyReference {
     }
 }
 
+/// Planned anew: a reference read without a cache (see [`SavedXyReference`]).
 impl<'de> Deserialize<'de> for XyReference {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let data = XyReferenceData::deserialize(d)?;
-        let samples = data.limits.ts * data.k as f64;
-        if !samples.is_finite() {
-            return Err(serde::de::Error::custom(
-                "planned reference: sample time not finite",
-            ));
-        }
-        XyReference::at_sample(data.path, data.limits, data.k).map_err(serde::de::Error::custom)
+        let saved = SavedXyReference::deserialize(d)?;
+        check_sample_time(&saved).map_err(serde::de::Error::custom)?;
+        let plan = XyPlan::new(&saved.path, &saved.limits).map_err(serde::de::Error::custom)?;
+        Ok(XyReference::on(
+            Arc::new(plan),
+            saved.path,
+            saved.limits,
+            saved.k,
+        ))
     }
 }
 
