@@ -19,7 +19,7 @@ use crate::framework::saved_state::{self, RestoredState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, Real, XY};
 use crate::framework::variables::{Start, Values, Variable};
 use contour_core::path::planar::{Path, SavedXyReference, XyLimits, XyReference};
-use contour_core::path::{CircularArc, Curve, Interpolator, Line};
+use contour_core::path::{Curve, Interpolator};
 
 variable_table! {
     static VARIABLES;
@@ -276,16 +276,9 @@ impl State {
                 self.clock.period()
             ));
         }
-        match it.path() {
-            Path::Line(l) => Line::new(l.start(), l.end())
-                .map(drop)
-                .map_err(|e| format!("interpolator path: {e}"))?,
-            Path::Arc(a) => CircularArc::new(a.center(), a.radius(), a.start_angle(), a.sweep())
-                .map(drop)
-                .map_err(|e| format!("interpolator path: {e}"))?,
-            // Both decoders check their paths as their constructors do.
-            Path::Nurbs(_) | Path::Program(_) => {}
-        }
+        it.path()
+            .check()
+            .map_err(|e| format!("interpolator path: {e}"))?;
         saved_state::all_finite(self)?;
         let (u0, u1) = it.path().param_range();
         if !(u0..=u1).contains(&it.parameter()) {

@@ -42,9 +42,11 @@ pub fn blended(program: &Program, tolerance: f64) -> Program {
                 return None;
             }
             let reach = REACH * a.length().min(b.length());
-            // Lines of a few rounding units: not rounded (what a blend would leave of
-            // them could round to nothing).
-            if reach <= 1e-9 * (1.0 + a.end().amax()) {
+            // Lines of a few rounding units, or a blend narrower than the corner's
+            // coordinates resolve: not rounded (what a blend would leave of the lines could
+            // round to nothing, and its ends would not meet them).
+            let resolution = 1e-9 * (1.0 + a.end().amax());
+            if reach <= resolution || within <= resolution {
                 return None;
             }
             CornerBlend::at_corner(a.end(), t1, t2, within, reach)
@@ -71,5 +73,34 @@ pub fn blended(program: &Program, tolerance: f64) -> Program {
             });
         }
     }
-    Program::new(out).expect("blends join the lines they round")
+    // Blends join the lines they round; should rounding still part them somewhere (at
+    // coordinates far beyond any machine's), the program stays as programmed.
+    Program::new(out).unwrap_or_else(|_| program.clone())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A program the fuzzer wrote (fuzz target gcode_program): a move to Y = 6.7e22 mm and
+    /// back home (G28 in the YZ plane), blended within 0.01 mm, far below what coordinates
+    /// that large resolve. Planned, it stays sharp there instead of panicking.
+    #[test]
+    fn a_corner_beyond_the_coordinates_resolution_stays_sharp() {
+        use crate::part_program::gcode::{parse_gcode, GcodeOptions};
+        use crate::path::planar::{Path, XyLimits, XyReference};
+        let text = "%\nO1001 (BRACKET)\nN15. H2\nG1 Z-1. F30\rG0 Z5.00 \rY66666666666666666666660.166666666666660\nG28 G19 X0. Y0.\nG90\nG53 G0 Z0.\nM30\n%\n";
+        let options = GcodeOptions {
+            dialect: crate::part_program::gcode::Dialect::Fanuc,
+            home: crate::geometry::Vector::<3>::new(-12.0, 10.0, 50.0),
+            ..GcodeOptions::default()
+        };
+        let part = parse_gcode(text, "far.ngc", &options).unwrap();
+        let program = Program::from_part_program(&part).unwrap();
+        let limits = XyLimits::example();
+        let planned = blended(&program, limits.tolerance);
+        assert!(Program::new(planned.moves().to_vec()).is_ok());
+        // Planning it may refuse it (its length), never panic.
+        let _ = XyReference::new(Path::Program(program), limits);
+    }
 }

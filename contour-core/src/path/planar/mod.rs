@@ -42,6 +42,19 @@ pub enum Path {
 }
 
 impl Path {
+    /// Checks a path that did not come through a constructor (one read back from a saved
+    /// state) as its constructor would: a line's or an arc's numbers (a radius > 0, …);
+    /// a NURBS and a program check themselves when they are read.
+    pub fn check(&self) -> Result<(), PathError> {
+        match self {
+            Path::Line(l) => Line::new(l.start(), l.end()).map(drop),
+            Path::Arc(a) => {
+                CircularArc::new(a.center(), a.radius(), a.start_angle(), a.sweep()).map(drop)
+            }
+            Path::Nurbs(_) | Path::Program(_) => Ok(()),
+        }
+    }
+
     /// Builds a path from a built-in name (`circle`, `line`, `arc`, `infinity`, `trident`)
     /// or, failing that, from a G-code program (by its name's ending) or a NURBS JSON file
     /// (relative names resolved against `base_dir`).

@@ -141,6 +141,19 @@ pub fn planned_geometry(path: &Path, tolerance: f64) -> Result<Path, PathError> 
 }
 
 impl XyLimits {
+    /// Limits for the tests: 50 mm/s, rapids at 100, 2 m/s², 10⁵ mm/s³, 5 µm, 1 ms.
+    #[cfg(test)]
+    pub(crate) fn example() -> Self {
+        XyLimits {
+            feed: 50.0,
+            rapid: 100.0,
+            accel: 2000.0,
+            jerk: 1e5,
+            tolerance: 0.005,
+            ts: 1e-3,
+        }
+    }
+
     /// Checks every value; the message names it.
     pub fn validate(&self) -> Result<(), String> {
         let positive = [

@@ -71,14 +71,7 @@ mod tests {
     fn a_plan_is_made_once_for_a_path_and_its_limits_and_kept_while_used() {
         let plans = XyPlans::new();
         let path = builtin::by_name("infinity").unwrap();
-        let limits = XyLimits {
-            feed: 50.0,
-            rapid: 100.0,
-            accel: 2000.0,
-            jerk: 1e5,
-            tolerance: 0.005,
-            ts: 1e-3,
-        };
+        let limits = XyLimits::example();
         let a = plans.plan(&path, &limits).unwrap();
         let b = plans.plan(&path, &limits).unwrap();
         assert!(Arc::ptr_eq(&a, &b));

@@ -27,7 +27,7 @@ pub struct XyReference {
 
 /// A saved [`XyReference`] as read back, before [`SavedXyReference::resume`] finds or
 /// makes its plan.
-#[derive(Serialize, Deserialize)]
+#[derive(Debug, Serialize, Deserialize)]
 pub struct SavedXyReference {
     path: Path,
     limits: XyLimits,
@@ -38,7 +38,7 @@ impl SavedXyReference {
     /// The reference at its saved sample, on the plan `plans` keeps or makes for its path
     /// and limits.
     pub fn resume(self, plans: &XyPlans) -> Result<XyReference, String> {
-        check_sample_time(&self)?;
+        check_before_planning(&self)?;
         let plan = plans
             .plan(&self.path, &self.limits)
             .map_err(|e| e.to_string())?;
@@ -46,8 +46,12 @@ impl SavedXyReference {
     }
 }
 
-/// A saved sample count whose time is not a number is refused before any planning.
-fn check_sample_time(saved: &SavedXyReference) -> Result<(), String> {
+/// What a saved reference is refused for before any planning: limits the parameters
+/// would not pass, a line or an arc its constructor would not make, a sample time that is
+/// not a number.
+fn check_before_planning(saved: &SavedXyReference) -> Result<(), String> {
+    saved.limits.validate()?;
+    saved.path.check().map_err(|e| e.to_string())?;
     if (saved.limits.ts * saved.k as f64).is_finite() {
         Ok(())
     } else {
@@ -148,7 +152,7 @@ impl Serialize for XyReference {
 impl<'de> Deserialize<'de> for XyReference {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let saved = SavedXyReference::deserialize(d)?;
-        check_sample_time(&saved).map_err(serde::de::Error::custom)?;
+        check_before_planning(&saved).map_err(serde::de::Error::custom)?;
         let plan = XyPlan::new(&saved.path, &saved.limits).map_err(serde::de::Error::custom)?;
         Ok(XyReference::on(
             Arc::new(plan),
@@ -163,6 +167,77 @@ impl<'de> Deserialize<'de> for XyReference {
 mod tests {
     use super::*;
     use crate::path::planar::Program;
+
+    /// A saved arc its constructor would refuse (a negative radius) and limits the
+    /// parameters would refuse are refused before planning: the fuzzer's state with such
+    /// an arc planned an arc of negative length and panicked sampling it.
+    #[test]
+    fn a_saved_reference_is_checked_before_it_is_planned() {
+        use crate::geometry::Vector2;
+        #[derive(Serialize)]
+        struct Arc {
+            center: Vector2,
+            radius: f64,
+            start_angle: f64,
+            sweep: f64,
+        }
+        #[derive(Serialize)]
+        #[allow(dead_code)]
+        enum Path {
+            Line(()),
+            Arc(Arc),
+        }
+        #[derive(Serialize)]
+        struct Saved {
+            path: Path,
+            limits: XyLimits,
+            k: u64,
+        }
+        let limits = XyLimits::example();
+        let arc = |radius| {
+            Path::Arc(Arc {
+                center: Vector2::new(0.0, 0.0),
+                radius,
+                start_angle: 0.0,
+                sweep: 1.0,
+            })
+        };
+        let cases = [
+            (arc(-5.0), limits, "radius"),
+            (
+                arc(5.0),
+                XyLimits {
+                    jerk: -1.0,
+                    ..limits
+                },
+                "jerk",
+            ),
+            (
+                arc(5.0),
+                XyLimits {
+                    accel: f64::NAN,
+                    ..limits
+                },
+                "accel",
+            ),
+        ];
+        for (path, limits, expected) in cases {
+            let bytes = postcard::to_stdvec(&Saved { path, limits, k: 0 }).unwrap();
+            let saved: SavedXyReference = postcard::from_bytes(&bytes).unwrap();
+            let e = saved.resume(&XyPlans::new()).err().unwrap();
+            assert!(e.contains(expected), "{e}");
+            assert!(postcard::from_bytes::<XyReference>(&bytes).is_err());
+        }
+        // The same arc with a positive radius plans.
+        let bytes = postcard::to_stdvec(&Saved {
+            path: arc(5.0),
+            limits,
+            k: 0,
+        })
+        .unwrap();
+        let saved: SavedXyReference = postcard::from_bytes(&bytes).unwrap();
+        assert!(saved.resume(&XyPlans::new()).is_ok());
+    }
 
     /// The look-ahead is the next step, bit for bit, on a program with an exact stop, a
     /// tight arc and its end, and peeking moves nothing.
