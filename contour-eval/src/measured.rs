@@ -83,13 +83,14 @@ struct Rows {
 }
 
 impl Rows {
+    /// Room for `rows` rows in all, in the columns of the kind read so far.
     fn reserve(&mut self, rows: usize) {
         let more = rows.saturating_sub(self.times.len());
         self.times.reserve(more);
-        match () {
-            _ if !self.planar.is_empty() => self.planar.reserve(more),
-            _ if !self.joints.is_empty() => self.joints.reserve(more),
-            _ => {}
+        if self.joints.is_empty() {
+            self.planar.reserve(more);
+        } else {
+            self.joints.reserve(more);
         }
     }
 

@@ -101,11 +101,6 @@ impl WindowedViterbi {
         Arc::clone(&self.segments)
     }
 
-    /// The mapping's model.
-    pub fn params(&self) -> &HmmParams {
-        &self.params
-    }
-
     /// Samples whose mapping is still open (their back-pointer rows are held).
     pub fn pending(&self) -> usize {
         self.samples - self.back.first()

@@ -193,3 +193,23 @@ impl Fnv {
 /// The chord a curve pair is sampled at for planning, mm: the planned tip leaves the
 /// curve by at most chord²·κ/8 (2.5 nm at a 5 mm radius).
 const PLAN_CHORD: f64 = 0.01;
+
+#[cfg(test)]
+mod tests {
+    use super::Fnv;
+
+    /// FNV-1a 64 as its authors publish it (the reference test vectors of
+    /// draft-eastlake-fnv): the fingerprint saved states carry is that function.
+    #[test]
+    fn the_hash_is_fnv_1a_64() {
+        for (text, expected) in [
+            ("", 0xcbf2_9ce4_8422_2325_u64),
+            ("a", 0xaf63_dc4c_8601_ec8c),
+            ("foobar", 0x8594_4171_f739_67e8),
+        ] {
+            let mut hash = Fnv::default();
+            hash.write(text.as_bytes());
+            assert_eq!(hash.0, expected, "{text:?}");
+        }
+    }
+}
