@@ -4,11 +4,12 @@
 //! (Python, on fmpy) bit for bit, at the cost of the FMUs themselves.
 //!
 //! [`ssp`] reads the loop, [`system`] loads and checks its FMUs, [`simulation`] runs it;
-//! [`fmi2`] is the only place that calls into an FMU (the only `unsafe`), and [`watchdog`]
+//! [`metrics`] measures a run where it ran (a campaign's batch); [`fmi2`] is the only place that calls into an FMU (the only `unsafe`), and [`watchdog`]
 //! notices a call that does not return.
 
 pub mod archive;
 pub mod fmi2;
+pub mod metrics;
 pub mod model_description;
 pub mod simulation;
 pub mod ssp;

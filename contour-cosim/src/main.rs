@@ -8,6 +8,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use contour_cosim::fmi2::{self, Activity};
+use contour_cosim::metrics::Metrics;
 use contour_cosim::ssp::StartValues;
 use contour_cosim::watchdog::Watchdog;
 use contour_cosim::{
@@ -26,7 +27,10 @@ batch: many runs through one set of instances (reset between runs), one per line
 VARIABLE, TEXT], ...]} (TEXT as --start takes it; the options' start values come first).
 For each run it writes a JSON line {"run", "status" ("ok" or "error"), "message",
 "steps"} and, when ok, the trajectory: (steps + 1) rows of the recorded columns as
-little-endian f64. Its first line lists the columns: {"columns": [...]}.
+little-endian f64. Its first line lists the columns: {"columns": [...]}. With --metrics
+each ok run's line carries its "metrics" ({NAME: value}; NaN and infinities as the
+strings "NaN", "inf", "-inf") and no trajectory unless --trajectory asks for it; the first
+line then also says {"metrics": [...], "trajectory": true|false}.
 
 options:
   --parameter-set NAME     the start values of the SSP file's parameter set NAME
@@ -41,6 +45,12 @@ options:
   --record UNIT.VAR,...    the variables to record (default: every output of every unit)
   --output FILE            where the results go (default: standard output)
   --runs FILE              batch: the run lines (default: standard input)
+  --metrics NAME,...       batch: measure each run where it ran (the campaigns' metrics:
+                           contour_error, estimated_contour_error of the two-axis loop;
+                           tip_error, orientation_error, estimated_tip_error,
+                           estimated_orientation_error of the five-axis loop; each .max
+                           or .mean) and answer them instead of the trajectory
+  --trajectory             batch with --metrics: the trajectory too
   --timeout SECONDS        a single FMU call that takes longer ends the run as a timeout
                            (default 60)
   --log                    print the FMUs' log messages on standard error
@@ -68,6 +78,8 @@ struct Options {
     record: Option<Vec<String>>,
     output: Option<PathBuf>,
     runs: Option<PathBuf>,
+    metrics: Option<Vec<String>>,
+    trajectory: bool,
     timeout: f64,
     log: bool,
 }
@@ -108,13 +120,19 @@ fn parse(args: &[String]) -> Result<Options, Error> {
         record: None,
         output: None,
         runs: None,
+        metrics: None,
+        trajectory: false,
         timeout: 60.0,
         log: false,
     };
     let mut rest = args[2..].iter();
     while let Some(option) = rest.next() {
-        if option == "--log" {
-            options.log = true;
+        if option == "--log" || option == "--trajectory" {
+            *(if option == "--log" {
+                &mut options.log
+            } else {
+                &mut options.trajectory
+            }) = true;
             continue;
         }
         let value = rest
@@ -132,12 +150,23 @@ fn parse(args: &[String]) -> Result<Options, Error> {
             "--record" => options.record = Some(value.split(',').map(str::to_string).collect()),
             "--output" => options.output = Some(PathBuf::from(value)),
             "--runs" => options.runs = Some(PathBuf::from(value)),
+            "--metrics" => {
+                options.metrics = Some(value.split(',').map(|m| m.trim().to_string()).collect())
+            }
             "--timeout" => options.timeout = seconds(option, value)?,
             other => return Err(usage(&format!("unknown option {other:?}"))),
         }
     }
     if options.until.is_some() && options.stop.is_some() {
         return Err(usage("--stop and --until exclude each other"));
+    }
+    if options.command != "batch" && options.metrics.is_some() {
+        return Err(usage("--metrics is an option of batch"));
+    }
+    if options.trajectory && options.metrics.is_none() {
+        return Err(usage(
+            "--trajectory goes with --metrics (a batch without metrics answers trajectories)",
+        ));
     }
     Ok(options)
 }
@@ -155,6 +184,7 @@ struct Setup {
     starts: StartValues,
     experiment: Experiment,
     recording: Recording,
+    metrics: Option<Metrics>,
 }
 
 fn setup(options: &Options, system: &System) -> Result<Setup, Error> {
@@ -190,18 +220,30 @@ fn setup(options: &Options, system: &System) -> Result<Setup, Error> {
         })?),
     };
     let experiment = Experiment { step, end }.checked()?;
-    let columns = match &options.record {
-        Some(names) => names
+    let metrics = match &options.metrics {
+        Some(names) => Some(Metrics::new(system, names)?),
+        None => None,
+    };
+    let mut columns = match (&options.record, &metrics) {
+        (Some(names), _) => names
             .iter()
             .map(|n| port(n))
             .collect::<Result<Vec<_>, _>>()?,
-        None => system.outputs(),
+        // Metrics alone record what they read.
+        (None, Some(_)) => Vec::new(),
+        (None, None) => system.outputs(),
     };
+    for column in metrics.iter().flat_map(Metrics::columns) {
+        if !columns.contains(column) {
+            columns.push(column.clone());
+        }
+    }
     let recording = Recording::new(system, &columns)?;
     Ok(Setup {
         starts,
         experiment,
         recording,
+        metrics,
     })
 }
 
@@ -239,10 +281,10 @@ fn run(options: &Options) -> Result<Outcome, Error> {
         );
         return write_out(&mut output, text.as_bytes()).map(|()| Outcome::Done);
     }
-    let setup = setup(options, &system)?;
+    let mut setup = setup(options, &system)?;
     let mut simulation = Simulation::watched(&system, options.scheme, options.log, activity)?;
     if options.command == "batch" {
-        return batch(options, &system, &setup, &mut simulation, &mut output);
+        return batch(options, &system, &mut setup, &mut simulation, &mut output);
     }
     let start_values = system.start_values(&setup.starts)?;
     let trace = simulation.run(&setup.experiment, &start_values, &setup.recording)?;
@@ -323,10 +365,23 @@ fn run_line(line: &str, system: &System) -> Result<StartValues, Error> {
     Ok(starts)
 }
 
+/// A metric's value in a result line: a number, or the name of a non-finite one.
+fn metric_value(value: f64) -> serde_json::Value {
+    if value.is_finite() {
+        serde_json::json!(value)
+    } else if value.is_nan() {
+        serde_json::json!("NaN")
+    } else if value > 0.0 {
+        serde_json::json!("inf")
+    } else {
+        serde_json::json!("-inf")
+    }
+}
+
 fn batch(
     options: &Options,
     system: &System,
-    setup: &Setup,
+    setup: &mut Setup,
     simulation: &mut Simulation,
     output: &mut dyn Write,
 ) -> Result<Outcome, Error> {
@@ -337,8 +392,13 @@ fn batch(
         )),
         None => Box::new(std::io::stdin().lock()),
     };
-    let columns = serde_json::json!({ "columns": setup.recording.columns() });
-    write_out(output, format!("{columns}\n").as_bytes())?;
+    let mut header = serde_json::json!({ "columns": setup.recording.columns() });
+    let trajectory = setup.metrics.is_none() || options.trajectory;
+    if let Some(metrics) = &setup.metrics {
+        header["metrics"] = serde_json::json!(metrics.names());
+        header["trajectory"] = serde_json::json!(trajectory);
+    }
+    write_out(output, format!("{header}\n").as_bytes())?;
     let mut bytes = Vec::new();
     for line in input.lines() {
         let line = line.map_err(|e| Error::Failed(format!("cannot read the run lines: {e}")))?;
@@ -350,17 +410,31 @@ fn batch(
         let result = run_line(&line, system).and_then(|mut starts| {
             starts.splice(0..0, setup.starts.iter().cloned());
             let values = system.start_values(&starts)?;
-            simulation.run(&setup.experiment, &values, &setup.recording)
+            let trace = simulation.run(&setup.experiment, &values, &setup.recording)?;
+            let measured = match &mut setup.metrics {
+                Some(metrics) => Some(metrics.compute(&trace, simulation)?),
+                None => None,
+            };
+            Ok((trace, measured))
         });
         let (status, message, steps) = match &result {
-            Ok(trace) => ("ok", String::new(), trace.steps),
+            Ok((trace, _)) => ("ok", String::new(), trace.steps),
             Err(e) => ("error", e.to_string(), 0),
         };
         bytes.clear();
-        let head =
+        let mut head =
             serde_json::json!({ "run": id, "status": status, "message": message, "steps": steps });
+        if let (Ok((_, Some(values))), Some(metrics)) = (&result, &setup.metrics) {
+            head["metrics"] = metrics
+                .names()
+                .iter()
+                .zip(values)
+                .map(|(name, &v)| (name.clone(), metric_value(v)))
+                .collect::<serde_json::Map<_, _>>()
+                .into();
+        }
         bytes.extend_from_slice(format!("{head}\n").as_bytes());
-        if let Ok(trace) = &result {
+        if let (Ok((trace, _)), true) = (&result, trajectory) {
             bytes.extend(trace.values.iter().flat_map(|v| v.to_le_bytes()));
         }
         // The caller reads as runs finish, and knows which run a crash took.

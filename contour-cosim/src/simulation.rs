@@ -481,6 +481,17 @@ impl<'a> Simulation<'a> {
         self.step(experiment, recording)
     }
 
+    /// The value of `variable` now: after a run, the value the run ended with.
+    pub fn value(&mut self, variable: Resolved) -> Result<Value, Error> {
+        if self.instances.is_empty() {
+            return Err(Error::Failed(
+                "no instances: the last run failed, so its values are gone".into(),
+            ));
+        }
+        self.get(variable)
+            .map_err(|f| self.failed(variable.unit, f, None))
+    }
+
     fn get(&mut self, variable: Resolved) -> Result<Value, CallFailed> {
         let instance = &mut self.instances[variable.unit];
         let vr = [variable.value_reference];

@@ -16,7 +16,7 @@ import pytest
 
 from contour_fmu.campaign import CampaignError, load
 from contour_fmu.campaign.execute import execute
-from contour_fmu.campaign.metrics import compute
+from contour_fmu.campaign.metrics import agreement, compute
 from contour_fmu.campaign.store import OutputInUse
 from contour_fmu.engines.master import closed_loop
 from contour_fmu.loops.wiring import LOOPS
@@ -110,8 +110,9 @@ def test_the_campaign_expands_to_sixteen_runs_in_order(sixteen):
 
 def test_serial_rows_are_the_fmpy_masters_with_fresh_instances(sixteen, serial_table, fmus):
     """The campaign resets one set of instances between runs; the master instantiates
-    anew for each. Same metrics to the bit; on the circle the true error also agrees with
-    the closed-form distance to the circle."""
+    anew for each. Same metrics (the estimates to the bit, the true errors, measured by
+    contour-cosim, within the engines' agreement); on the circle the true error also agrees
+    with the closed-form distance to the circle."""
     table = serial_table.to_pydict()
     assert table["status"] == ["ok"] * 16
     # run 8 (CCC on) follows run 7 (CCC off) in one batch, on the same instances
@@ -124,7 +125,8 @@ def test_serial_rows_are_the_fmpy_masters_with_fresh_instances(sixteen, serial_t
         expected = compute("two_axis", sixteen.metrics, trace, values["interpolator"],
                            sixteen.units["interpolator"].variables)
         for metric, value in expected.items():
-            assert table[metric][run.id] == value, (run.id, metric)
+            # The native engine's own metrics: the true ones within the engines' agreement.
+            assert abs(table[metric][run.id] - value) <= agreement(metric), (run.id, metric)
         if run.path == "circle":
             exact = paper_circle_distance(before["plant.pos.x"], before["plant.pos.y"])
             # reference_paths measures to a 200 001-point polygon: off by its sagitta at most
@@ -215,7 +217,9 @@ def test_replay_reproduces_a_row(sixteen, serial_table, tmp_path):
         assert f"{metric} = {row[metric][13]!r}" in done.stdout
     series = np.genfromtxt(tmp_path / "run13.csv", delimiter=",", names=True)
     assert len(series) == 400
-    assert series["contour_error"].max() == pytest.approx(row["contour_error.max"][13], abs=1e-15)
+    # The series' errors are Python's (metrics.errors), the row's contour-cosim's.
+    assert series["contour_error"].max() == pytest.approx(row["contour_error.max"][13],
+                                                          abs=agreement("contour_error.max"))
 
 
 def test_the_summary_lists_the_worst_runs_with_their_replay_command(sixteen, serial_table, tmp_path):
@@ -291,7 +295,8 @@ def test_five_axis_rows_are_the_fmpy_masters_and_a_boolean_sweep_is_reported(tmp
         trace.update({name: after[name] for name in after.dtype.names if name.startswith("controller.")})
         expected = compute("five_axis", campaign.metrics, trace, values["interpolator"],
                            campaign.units["interpolator"].variables)
-        assert {m: t[m][run.id] for m in campaign.metrics} == expected
+        for metric, value in expected.items():
+            assert abs(t[metric][run.id] - value) <= agreement(metric), (run.id, metric)
     assert t["tip_error.max"][1] < t["tip_error.max"][0]
     text = report.write(campaign, table, tmp_path / "out")
     assert "controller.ccc.enable = False" in text  # the worst run: without CCC

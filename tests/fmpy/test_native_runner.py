@@ -14,6 +14,7 @@ import zipfile
 import numpy as np
 import pytest
 
+from contour_fmu import repo
 from contour_fmu.engines import native
 from contour_fmu.engines.master import CLOSED_LOOP_RECORD, FIVE_AXIS_RECORD, closed_loop, five_axis_closed_loop
 from contour_fmu.loops.wiring import LOOPS
@@ -251,3 +252,117 @@ def test_what_an_fmu_prints_on_stdout_does_not_reach_the_results(cosim, tmp_path
     assert "chatty" not in done.stdout and done.stderr.count("chatty FMU at t =") == 20
     loud = native.run(ssd, step=0.01, stop=0.2, start=chatty, record=[("a", "pos.x")])
     assert np.array_equal(loud["a.pos.x"], quiet["a.pos.x"])
+
+
+def batch_answers(cosim, ssd, runs, *options):
+    """(first line, [(result line, rows or None)]) of `contour-cosim batch` on the run lines
+    `runs` ([(id, [[unit, variable, text], ...])])."""
+    lines = "".join(json.dumps({"run": i, "start": s}) + "\n" for i, s in runs)
+    done = subprocess.run([str(cosim), "batch", str(ssd), *map(str, options)], input=lines.encode(),
+                          capture_output=True)
+    assert done.returncode == 0, done.stderr
+    out = done.stdout
+    first, out = out.split(b"\n", 1)
+    header = json.loads(first)
+    width, trajectory = len(header["columns"]), header.get("trajectory", True)
+    answers = []
+    while out:
+        line, out = out.split(b"\n", 1)
+        head = json.loads(line)
+        table = None
+        if head["status"] == "ok" and trajectory:
+            size = (head["steps"] + 1) * width * 8
+            table, out = np.frombuffer(out[:size], dtype="<f8").reshape(-1, width), out[size:]
+        answers.append((head, table))
+    return header, answers
+
+
+TWO_AXIS_METRICS = ["contour_error.max", "contour_error.mean", "estimated_contour_error.max",
+                    "estimated_contour_error.mean"]
+
+
+def test_a_batch_measures_its_runs_as_the_campaigns_python_does(loops, cosim):
+    """`batch --metrics` (issue 43, item 1): on the five built-in paths, with and without the
+    CCC, the metrics of each run against the campaigns' Python metrics of the same run's
+    trajectory: the true contour error within metrics.ENGINE_AGREEMENT (the Python one
+    measures to a polygon), the controller's estimate to the bit; the run itself is the one
+    a batch without metrics makes, bit for bit; without --trajectory only the result lines
+    come back."""
+    from contour_fmu.campaign.metrics import agreement, compute
+
+    ssd = loops / "two_axis.ssd"
+    runs = [(f"{path}-{ccc}", [["interpolator", "path", path], ["interpolator", "feed", "60"],
+                               ["controller", "ccc.enable", ccc]])
+            for path in ("circle", "line", "arc", "infinity", "trident") for ccc in ("false", "true")]
+    record = ",".join(f"{u}.{n}" for u, n in LOOPS["two_axis"].recorded)
+    common = ("--stop", "1.2", "--record", record)
+    plain_header, plain = batch_answers(cosim, ssd, runs, *common)
+    header, measured = batch_answers(cosim, ssd, runs, *common, "--metrics", ",".join(TWO_AXIS_METRICS),
+                                     "--trajectory")
+    assert header["columns"] == plain_header["columns"] and header["trajectory"] is True
+    assert header["metrics"] == TWO_AXIS_METRICS
+    variables = {"path": type("Start", (), {"start": "circle"})()}
+    for (run, start), (head, table), (_, plain_table) in zip(runs, measured, plain):
+        assert head["status"] == "ok", head
+        assert np.array_equal(table, plain_table), run
+        trace = {c: table[1:, i] if c.startswith("controller.") else table[:-1, i]
+                 for i, c in enumerate(header["columns"])}
+        expected = compute("two_axis", TWO_AXIS_METRICS, trace, {"path": start[0][2]}, variables)
+        for metric, value in expected.items():
+            got = head["metrics"][metric]
+            assert abs(got - value) <= agreement(metric), (run, metric, got, value)
+        if "circle" in run:  # the closed form: the exact distance, to rounding
+            exact = np.abs(np.hypot(trace["plant.pos.x"] + 10.0, trace["plant.pos.y"]) - 10.0)
+            assert head["metrics"]["contour_error.max"] == pytest.approx(exact.max(), abs=1e-13)
+    assert measured[6][0]["metrics"]["contour_error.max"] > 0.01  # infinity without CCC: real errors
+    header, rows_only = batch_answers(cosim, ssd, runs[:2], "--stop", "1.2", "--metrics", "contour_error.max")
+    assert header["trajectory"] is False and header["columns"] == ["plant.pos.x", "plant.pos.y"]
+    assert [table for _, table in rows_only] == [None, None]
+    assert [head["metrics"]["contour_error.max"] for head, _ in rows_only] == [
+        head["metrics"]["contour_error.max"] for head, _ in measured[:2]]
+
+
+def test_a_five_axis_batch_measures_tip_and_orientation_errors(loops, cosim):
+    """The five-axis metrics against the campaigns' Python ones (five_axis_truth) on the
+    helix and the figure-eight, with the machine's pivots moved."""
+    from contour_fmu.campaign.metrics import agreement, compute
+
+    names = ["tip_error.max", "tip_error.mean", "orientation_error.max", "orientation_error.mean",
+             "estimated_tip_error.max", "estimated_orientation_error.mean"]
+    pivots = {"pivot.A.y": 2.0, "pivot.A.z": -40.0, "pivot.C.x": 1.5, "pivot.C.y": -0.5}
+    starts = [["interpolator", k, repr(v)] for k, v in pivots.items()]
+    runs = [(path, [["interpolator", "path", path], *starts]) for path in ("tilted_helix", "figure_eight")]
+    header, measured = batch_answers(cosim, loops / "five_axis.ssd", runs, "--stop", "0.8", "--metrics",
+                                     ",".join(names), "--trajectory")
+    variables = {name: type("Start", (), {"start": 0.0})() for name in pivots}
+    for (run, _), (head, table) in zip(runs, measured):
+        assert head["status"] == "ok", head
+        trace = {c: table[1:, i] if c.startswith("controller.") else table[:-1, i]
+                 for i, c in enumerate(header["columns"])}
+        expected = compute("five_axis", names, trace, pivots, variables)
+        for metric, value in expected.items():
+            assert abs(head["metrics"][metric] - value) <= agreement(metric), (run, metric)
+        assert head["metrics"]["tip_error.max"] > 1e-3  # mm: a real lag
+
+
+def test_batch_metrics_refused_or_unmeasurable_say_why(loops, cosim):
+    ssd = loops / "two_axis.ssd"
+    for args, words in [
+        (["batch", "--metrics", "contour_error.median"], "unknown metric \"contour_error.median\""),
+        (["batch", "--metrics", "contour_error.max,contour_error.max"], "named twice"),
+        (["batch", "--metrics", "tip_error.max"],
+         "--metrics tip_error.max, a metric of the five-axis loop: interpolator (PathInterpolator2D.fmu) "
+         "has no variable \"ref.X\""),
+        (["run", "--metrics", "contour_error.max"], "--metrics is an option of batch"),
+        (["batch", "--trajectory"], "--trajectory goes with --metrics"),
+    ]:
+        assert words in refused(cosim, args[0], ssd, "--stop", "0.1", *args[1:]), args
+    # A path the runner has no exact geometry for: an error row, which names the way out.
+    program = repo.root() / "tests" / "data" / "cam" / "cambam" / "enclosure-labels.nc"
+    _, answers = batch_answers(cosim, ssd, [(0, [["interpolator", "path", str(program)]]),
+                                            (1, [["interpolator", "path", "circle"]])],
+                               "--stop", "0.2", "--metrics", "contour_error.max,estimated_contour_error.max")
+    (bad, _), (good, _) = answers
+    assert bad["status"] == "error" and "use estimated_contour_error.* there" in bad["message"], bad
+    assert "needs a built-in path" in bad["message"] and "metrics" not in bad
+    assert good["status"] == "ok" and good["metrics"]["contour_error.max"] > 0

@@ -68,22 +68,18 @@ def command_replay(args):
     from ..output_files import write_csv
     from .execute import archives_of, job_of
     from .metrics import errors
-    from .runner import LoopInstances, run_one, unpacked
     from .spec import load
 
     campaign = load(args.file, args.fmu_dir)
     run = campaign.run(args.run)
     job = job_of(campaign)
-    instances = LoopInstances(job.loop, unpacked(job, archives_of(campaign)))
+    # On the campaign's engine, so the printed metrics are the row's.
+    replay = _replay_native if job.engine == "native" else _replay_fmpy
     try:
-        values, trace = run_one(job, instances, run.start_values)
+        values, trace = replay(job, archives_of(campaign), run)
     except Exception as e:  # noqa: BLE001  a failed run's reason, as its row gives it
-        for line in instances.log.failures():
-            print(line, file=sys.stderr)
         print(f"run {run.id} failed: {type(e).__name__}: {e}", file=sys.stderr)
         return 1
-    finally:
-        instances.free()
     interpolator = run.start_values.get("interpolator", {})
     columns = dict(trace)
     for quantity, per_sample in errors(job.loop, trace, interpolator, job.interpolator_variables).items():
@@ -97,6 +93,26 @@ def command_replay(args):
         print(f"  {metric} = {value!r}")
     print(f"time series in {target}")
     return 0
+
+
+def _replay_fmpy(job, archives, run):
+    from .runner import LoopInstances, run_one, unpacked
+
+    instances = LoopInstances(job.loop, unpacked(job, archives))
+    try:
+        return run_one(job, instances, run.start_values)
+    except Exception:
+        for line in instances.log.failures():
+            print(line, file=sys.stderr)
+        raise
+    finally:
+        instances.free()
+
+
+def _replay_native(job, archives, run):
+    from . import native_batch
+
+    return native_batch.replay(job, archives, run.id, run.start_values)
 
 
 def main(argv=None, prog=PROG):

@@ -2,14 +2,18 @@
 master (engine = "native", the default), in a child process (contour_fmu.engines.native's
 Batch).
 
-The child steps the loop's FMUs at their own cost and answers each run line with the
-run's trajectory (`contour-cosim batch`: a JSON line per run, then its rows as f64); it
-stays up for the worker's next batches, so the FMUs are unpacked and loaded once per
-worker. The metrics are computed here by the same code as for the fmpy engine, on the
-same trajectory, so both engines give the same rows. The child isolates the worker from
-the FMUs: an FMU that crashes its process (a segfault in a foreign FMU) or a call that
-hangs past the campaign's `timeout` costs the run under way, recorded as "crashed" (with
-the signal) or "timeout"; the next run starts a new child.
+The child steps the loop's FMUs at their own cost, measures each run where it ran and
+answers its row of metrics (`contour-cosim batch --metrics`: a JSON line per run, no
+trajectory); it stays up for the worker's next batches, so the FMUs are unpacked and
+loaded once per worker. The metrics are contour-cosim's own, written in Rust (exact
+distances to the path); the fmpy engine computes them in Python (contour_fmu.campaign.
+metrics), the independent check: the two engines' rows agree within the tolerances of
+docs/campaigns.md ("Metrics"), tested in tests/fmpy/test_campaign_native.py.
+
+The child isolates the worker from the FMUs: an FMU that crashes its process (a segfault
+in a foreign FMU) or a call that hangs past the campaign's `timeout` costs the run under
+way, recorded as "crashed" (with the signal) or "timeout"; the next run starts a new
+child.
 
 A worker gets the FMU archives and the contour-cosim program as bytes from the campaign's
 worker plugin (execute.CampaignFiles), as it gets the FMUs for fmpy; nothing needs to be
@@ -28,7 +32,6 @@ from ..engines import native
 from ..engines.native import Batch, Ended, RunFailed
 from ..loops import ssp
 from ..loops.wiring import LOOPS
-from . import metrics as campaign_metrics
 from .runner import ORDER, _scratch, worker_name
 
 PROGRAM = "contour-cosim"
@@ -72,28 +75,44 @@ def check_program(folder):
                         f"{done.returncode}): {done.stderr.decode(errors='replace').strip()[-500:]}")
 
 
-def command(job, folder):
-    """contour-cosim's command line for the job's runs, read from its standard input."""
+def command(job, folder, trajectory=False):
+    """contour-cosim's command line for the job's runs, read from its standard input;
+    with `trajectory` the runs' recorded columns come back too (a replay's)."""
     until = {} if job.stop is not None else {
         "until": "interpolator.done", "settle": job.settle, "max_stop": job.max_stop}
-    return native.arguments(folder / "loop.ssd", step=job.step, stop=job.stop,
-                            record=_columns(job.loop), timeout=job.timeout, scheme=None,
-                            command="batch", executable=folder / PROGRAM, **until)
+    args = native.arguments(folder / "loop.ssd", step=job.step, stop=job.stop,
+                            metrics=list(job.metrics), timeout=job.timeout, scheme=None,
+                            command="batch", executable=folder / PROGRAM,
+                            record=LOOPS[job.loop].recorded if trajectory else None, **until)
+    return args + ["--trajectory"] if trajectory else args
 
 
-def _columns(loop):
-    """The recorded columns, unit by unit in stepping order (as the fmpy runner reads them)."""
-    return [(unit, n) for unit in ORDER for u, n in LOOPS[loop].recorded if u == unit]
+def _metrics(job, run_id, head):
+    """The row's metric values from a run's result line (numbers, or "NaN", "inf")."""
+    try:
+        return {m: float(head["metrics"][m]) for m in job.metrics}
+    except (KeyError, TypeError, ValueError) as e:
+        raise RunFailed(f"contour-cosim answered run {run_id} without its metrics: {e!r}") from None
 
 
-def _trace(job, table, steps):
-    """The fmpy runner's trace from the rows t_0..t_k: the controller's outputs once the
-    units stepped (row k+1), the rest before the step (row k)."""
+def replay(job, archives, run_id, start_values, within=None):
+    """(metrics, trace) of one run alone, through contour-cosim as a batch runs it: the
+    row's metrics and the fmpy runner's trace of the recorded columns (the controller's
+    outputs once the units stepped, row k + 1; the rest before the step, row k). Raises
+    RunFailed with the run's message when it fails."""
+    folder = prepare(job, archives, local_program(), within)
+    batch = Batch(command(job, folder, trajectory=True), folder)
+    try:
+        head, table = batch.run(run_id, start_values, ORDER)
+    finally:
+        batch.close()
+    if head["status"] != "ok":
+        raise RunFailed(head["message"])
+    steps = head["steps"]
     trace = {"time": np.arange(steps) * job.step}
-    for i, (unit, name) in enumerate(_columns(job.loop)):
-        column = table[:, i]
-        trace[f"{unit}.{name}"] = column[1:] if unit == "controller" else column[:-1]
-    return trace
+    for i, column in enumerate(batch.columns):
+        trace[column] = table[1:, i] if column.startswith("controller.") else table[:-1, i]
+    return _metrics(job, run_id, head), trace
 
 
 def _row(run_id, status, message, began, metrics, values=None):
@@ -152,18 +171,12 @@ def run_one(job, folder, run_id, start_values):
     began = time.perf_counter()
     try:
         with _lock:
-            head, table = _answer(job, folder, run_id, start_values)
+            head, _ = _answer(job, folder, run_id, start_values)
     except Ended as ended:
         return _ended_row(run_id, ended, began, job.metrics)
-    if table is None:
+    if head["status"] != "ok":
         return _row(run_id, "error", head["message"], began, job.metrics)
-    try:
-        values = campaign_metrics.compute(job.loop, job.metrics, _trace(job, table, head["steps"]),
-                                          start_values.get("interpolator", {}),
-                                          job.interpolator_variables)
-    except Exception as e:  # noqa: BLE001  every failure of a run is its row's message
-        return _row(run_id, "error", f"{type(e).__name__}: {e}", began, job.metrics)
-    return _row(run_id, "ok", "", began, job.metrics, values)
+    return _row(run_id, "ok", "", began, job.metrics, _metrics(job, run_id, head))
 
 
 def run_batch(job, runs, archives=None):

@@ -75,10 +75,11 @@ def text(value):
 
 def arguments(ssd, parameter_set=None, start=None, step=None, stop=None, scheme="gauss-seidel",
               record=None, timeout=None, until=None, settle=None, max_stop=None, command="run",
-              executable=None):
+              executable=None, metrics=None):
     """The command line of one run (see `run`), or with `command` = "batch" of a batch
-    process (see `Batch`); `executable` is contour-cosim (default: `program()`), `scheme`
-    None leaves the program's default."""
+    process (see `Batch`; `metrics`, a list of the campaigns' metric names, are then
+    measured by the process and answered instead of the trajectory); `executable` is
+    contour-cosim (default: `program()`), `scheme` None leaves the program's default."""
     args = [str(executable or program()), command, str(ssd)]
     if scheme is not None:
         args += ["--scheme", scheme]
@@ -93,6 +94,8 @@ def arguments(ssd, parameter_set=None, start=None, step=None, stop=None, scheme=
             args += [option, value if isinstance(value, str) else repr(float(value))]
     if record is not None:
         args += ["--record", ",".join(f"{unit}.{name}" for unit, name in record)]
+    if metrics is not None:
+        args += ["--metrics", ",".join(metrics)]
     return args
 
 
@@ -162,7 +165,8 @@ class Batch:
     """A `contour-cosim batch` process, kept for many runs (its FMUs unpacked and loaded
     once): a run line in, the run's result out. `args` is its command line
     (`arguments(..., command="batch")`), `scratch` a folder for its standard error. A
-    process that answers out of turn or garbled is killed: it is never read again."""
+    process that answers out of turn or garbled is killed: it is never read again. With
+    metrics the process answers no trajectory (`trajectory` False)."""
 
     def __init__(self, args, scratch):
         self.errors = tempfile.TemporaryFile(dir=scratch)
@@ -172,7 +176,10 @@ class Batch:
         if not header:
             self.ended()
         try:
-            self.width = len(json.loads(header)["columns"])
+            said = json.loads(header)
+            self.columns = list(said["columns"])
+            self.width = len(self.columns)
+            self.trajectory = bool(said.get("trajectory", True))
         except (ValueError, KeyError, TypeError):
             self.garbled(f"a first line that is not its columns: {header[:200]!r}")
 
@@ -205,8 +212,8 @@ class Batch:
 
     def run(self, run_id, start_values, order=None):
         """(head, table): the result line of the run with `start_values` ({unit: {variable:
-        value}}, set unit by unit in `order`, default the dict's) and, when ok, its rows
-        t_0..t_k."""
+        value}}, set unit by unit in `order`, default the dict's) and, when ok and the
+        process answers trajectories, its rows t_0..t_k (else None)."""
         starts = [[unit, name, text(value)] for unit in (order or start_values)
                   for name, value in start_values.get(unit, {}).items()]
         try:
@@ -224,7 +231,7 @@ class Batch:
             self.garbled(f"a line that is not a run's result: {line[:200]!r}")
         if answered != run_id:
             self.garbled(f"run {answered} for run {run_id}")
-        if not ok:
+        if not ok or not self.trajectory:
             return head, None
         size = (steps + 1) * self.width * 8
         data = self.process.stdout.read(size)
