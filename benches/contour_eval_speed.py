@@ -28,6 +28,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "python"))
 
+from baseline import checkout  # noqa: E402
 from contour_fmu import repo  # noqa: E402
 
 TARGET = Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target")
@@ -85,9 +86,7 @@ def baseline_binary(rev):
     if stamp.exists() and binary.exists():
         return binary
     try:
-        if not tree.exists():
-            subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(tree), rev],
-                           check=True, capture_output=True)
+        checkout(rev, DATA)
         subprocess.run(["cargo", "build", "--release", "-q", "-p", "contour-eval"], cwd=tree, check=True,
                        env={**os.environ, "CARGO_TARGET_DIR": str(target)})
     except (OSError, subprocess.CalledProcessError) as e:

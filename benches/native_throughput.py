@@ -57,8 +57,9 @@ method = "grid"
 "plant.x.J" = {{ factors = {factors} }}
 """
 
-# Runs per round: each way takes about a second.
-RUNS = {"in_process": 400, "native": 200, "native_campaign": 100, "fmpy_campaign": 8}
+# Runs per round: each way takes about a second (the two native ways, compared with each
+# other, as many runs each).
+RUNS = {"in_process": 400, "native": 500, "native_campaign": 500, "fmpy_campaign": 8}
 
 
 def in_process(runs):

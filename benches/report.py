@@ -3,8 +3,8 @@
 Reads what the bench parts leave in <target>/bench-report/ (<target> is $CARGO_TARGET_DIR,
 else target/): fmu_abi.json (benches/fmu_abi.rs), c_harness.json and
 c_harness_callgrind.json (benches/c_harness/run.sh), fuzzy_vs_skfuzzy.json,
-tuning_vs_pyswarms_fmu.json, pso_tables.json, native_throughput.json, campaign_scaling.json and
-contour_eval_speed.json (the Python
+tuning_vs_pyswarms_fmu.json, pso_tables.json, native_throughput.json, campaign_scaling.json,
+contour_eval_speed.json and restore_fuzz_speed.json (the Python
 benches' --json), plus
 criterion's own estimates in <target>/criterion/. Prints the page and writes it to
 <target>/bench-report/report.md. A figure that is missing, or older than the run's start
@@ -232,6 +232,16 @@ def page():
                        + f"; outputs identical: {'yes' if same else 'NO'}") if over else "", "{:.3f}x"))
     lines.append(line(f"this build on one thread (--threads 1) / {base}", dig(evaluation, "one_thread_over_baseline"),
                       "", "{:.3f}x"))
+
+    restoring = load("restore_fuzz_speed.json")
+    base = restoring.get("baseline_rev", "the baseline")
+    lines.append(f"\nFuzzing restored states (deserialize_state, {restoring.get('seconds', '?')} s from each "
+                 "build's seeds, medians)")
+    over = dig(restoring, "ratio")
+    lines.append(line(f"executions a second, this build / {base}", over,
+                      (f"{dig(restoring, 'exec_per_s', 'this build'):.0f} vs "
+                       f"{dig(restoring, 'exec_per_s', base):.0f} exec/s; target >= 10x: "
+                       + ("met" if over >= 10 else "MISSED")) if over else "", "{:.1f}x"))
 
     small = [("fuzzy eval", criterion("fuzzy_evaluate_three_outputs")),
              ("2-axis sample", criterion("controller_sample_fuzzy")),

@@ -198,6 +198,24 @@ def test_a_plant_that_segfaults_or_hangs_costs_its_run_only(fmus, cosim, tmp_pat
     assert again.column("status").to_pylist() == rows["status"]
 
 
+def test_runs_sent_ahead_of_a_crash_run_on_the_next_child(fmus, cosim, tmp_path):
+    """The native engine sends a run line ahead of the answer it waits for: in one batch,
+    the run after a segfault, an fmi2Fatal or a hang, which the ended child had taken but
+    not run, runs on the next child and gives the same row as the first run."""
+    faulty_fmu.build(tmp_path)
+    fine = 'parameters = {{ "plant.fault_time" = 0.1 }}'
+    variants = [("fine", ""), ("segfault", 'parameters = {{ "plant.fault" = 1, "plant.fault_time" = 0.1 }}'),
+                ("fine 2", fine), ("fatal", 'parameters = {{ "plant.fault" = 4, "plant.fault_time" = 0.1 }}'),
+                ("fine 3", fine), ("hang", 'parameters = {{ "plant.fault" = 2, "plant.fault_time" = 0.2 }}'),
+                ("fine 4", fine)]
+    text = FAULTY[:FAULTY.index("[[variants]]")].replace("batch_size = 2", "batch_size = 7")
+    text += "".join(f'[[variants]]\nname = "{name}"\n{extra}\n\n' for name, extra in variants)
+    c = campaign(tmp_path, text, fmus=fmus, plant=tmp_path / "Faulty.fmu")
+    rows = execute(c, tmp_path / "out", serial=True, show_progress=False).consolidate().to_pydict()
+    assert rows["status"] == ["ok", "crashed", "ok", "error", "ok", "timeout", "ok"], rows["message"]
+    assert len(set(rows["contour_error.max"][k] for k in (0, 2, 4, 6))) == 1
+
+
 def test_workers_that_cannot_run_contour_cosim_stop_the_campaign_before_any_run(
         fmus, tmp_path, monkeypatch):
     broken = tmp_path / "contour-cosim"

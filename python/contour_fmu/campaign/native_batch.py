@@ -22,6 +22,7 @@ installed on it but this package.
 
 import subprocess
 import tempfile
+from collections import deque
 import threading
 import time
 from pathlib import Path
@@ -123,13 +124,13 @@ def _row(run_id, status, message, began, metrics, values=None):
 
 
 _children = {}  # command line -> Batch, for this process's lifetime
-# A worker with several threads runs batches at once: one of them talks to the child at a
-# time (a pipe carries one conversation).
+# A worker with several threads runs batches at once: one batch at a time talks to the
+# child (a pipe carries one conversation).
 _lock = threading.Lock()
 
 
-def _child(job, folder):
-    key = tuple(command(job, folder))
+def _child(key, folder):
+    """The child running the command line `key` (a tuple), started when there is none."""
     if key not in _children:
         # One child at a time: another campaign's is not needed any more.
         for other in _children.values():
@@ -151,32 +152,51 @@ def _ended_row(run_id, ended, began, metrics):
     raise RunFailed(f"contour-cosim stopped (exit status {status}): {said[-2000:]}")
 
 
-def _answer(job, folder, run_id, start_values):
-    """The child's (head, table) for a run; a child that had stopped after an FMU's
-    fmi2Fatal in the run before is replaced and asked again."""
-    for attempt in (1, 2):
-        try:
-            return _child(job, folder).run(run_id, start_values, ORDER)
-        except Ended as ended:
-            _children.pop(tuple(command(job, folder)), None)
-            if ended.args[0] != native.FATAL_STATUS or attempt == 2:
-                raise
-        except RunFailed:
-            _children.pop(tuple(command(job, folder)), None)
-            raise
+# Run lines sent ahead of the answer read: the child starts the next run while Python
+# makes the row of the last.
+AHEAD = 2
 
 
-def run_one(job, folder, run_id, start_values):
-    """The row of one run through this process's child (made anew after a crash)."""
+def _rows(job, folder, runs):
+    """The rows of `runs`, in order, through this process's child (made anew after a
+    crash, a timeout or an fmi2Fatal). The runs a child took but did not answer before it
+    ended, after the one under way, go to the next child."""
+    key = tuple(command(job, folder))
+    waiting, sent = deque(runs), deque()
     began = time.perf_counter()
-    try:
-        with _lock:
-            head, _ = _answer(job, folder, run_id, start_values)
-    except Ended as ended:
-        return _ended_row(run_id, ended, began, job.metrics)
-    if head["status"] != "ok":
-        return _row(run_id, "error", head["message"], began, job.metrics)
-    return _row(run_id, "ok", "", began, job.metrics, _metrics(job, run_id, head))
+    replaced_after_fatal = False
+    while waiting or sent:
+        try:
+            child = _child(key, folder)
+            while waiting and len(sent) < AHEAD:
+                run = waiting.popleft()
+                sent.append(run)
+                if not child.send(*run, ORDER):
+                    break  # it has ended: receiving says how
+            run_id, _ = sent[0]
+            head, _ = child.receive(run_id)
+        except Ended as ended:
+            _children.pop(key, None)
+            waiting.extendleft(reversed(sent))
+            sent.clear()
+            # After an fmi2Fatal the child answered that run, then ended: the next run
+            # goes to a new child, once.
+            if ended.args[0] == native.FATAL_STATUS and not replaced_after_fatal:
+                replaced_after_fatal = True
+                continue
+            run_id, _ = waiting.popleft()
+            yield _ended_row(run_id, ended, began, job.metrics)
+        except RunFailed:
+            _children.pop(key, None)
+            raise
+        else:
+            sent.popleft()
+            if head["status"] != "ok":
+                yield _row(run_id, "error", head["message"], began, job.metrics)
+            else:
+                yield _row(run_id, "ok", "", began, job.metrics, _metrics(job, run_id, head))
+        replaced_after_fatal = False
+        began = time.perf_counter()
 
 
 def run_batch(job, runs, archives=None):
@@ -192,7 +212,8 @@ def run_batch(job, runs, archives=None):
     else:
         raise RunFailed(f"{worker_name()} has no copy of the campaign's FMUs and contour-cosim "
                         "(the campaign's worker plugin did not run here)")
-    return [run_one(job, folder, run_id, start_values) for run_id, start_values in runs]
+    with _lock:
+        return list(_rows(job, folder, runs))
 
 
 def local_program():

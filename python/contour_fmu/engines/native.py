@@ -214,13 +214,25 @@ class Batch:
         """(head, table): the result line of the run with `start_values` ({unit: {variable:
         value}}, set unit by unit in `order`, default the dict's) and, when ok and the
         process answers trajectories, its rows t_0..t_k (else None)."""
+        if not self.send(run_id, start_values, order):
+            self.ended()
+        return self.receive(run_id)
+
+    def send(self, run_id, start_values, order=None):
+        """Writes the run's line (see `run`); False when the process no longer reads (it
+        has ended: `receive` says how). A caller may send runs ahead of their answers."""
         starts = [[unit, name, text(value)] for unit in (order or start_values)
                   for name, value in start_values.get(unit, {}).items()]
         try:
             self.process.stdin.write((json.dumps({"run": run_id, "start": starts}) + "\n").encode())
             self.process.stdin.flush()
         except OSError:
-            self.ended()
+            return False
+        return True
+
+    def receive(self, run_id):
+        """(head, table) of the oldest run sent and not yet received, `run_id` (see `run`);
+        Ended when the process ended first, RunFailed when it answers another run."""
         line = self.process.stdout.readline()
         if not line:
             self.ended()
