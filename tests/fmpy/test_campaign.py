@@ -23,7 +23,7 @@ from contour_fmu.loops.wiring import LOOPS
 from contour_fmu.checks.reference_paths import paper_circle_distance
 from contour_fmu.tuned import start_values
 from helpers import campaign_faults
-from helpers.checkout import REPO
+from helpers.checkout import REPO, target_dir
 
 # The workers import contour_fmu (installed) but not the tests: send the faults by value.
 cloudpickle.register_pickle_by_value(campaign_faults)
@@ -357,6 +357,9 @@ def test_the_example_campaigns_expand_as_documented():
 
 # --- bad input: refused before any run ----------------------------------------------------
 
+# The SI build beside the mm one (make fmus writes both).
+SI_PLANT = target_dir() / "fmu-si" / "XYServoPlant.fmu"
+
 BAD = [
     ("unknown FMU", lambda t: t.replace('directory = "{fmus}"', 'directory = "{fmus}"\ncontroller = "Nope.fmu"'),
      r"no FMU .*Nope\.fmu for the controller"),
@@ -377,6 +380,9 @@ BAD = [
      r"feed = -50\.0: expected a feed > 0"),
     ("unknown metric", lambda t: t.replace('"estimated_contour_error.max"', '"tip_error.max"'),
      r"metrics: unknown 'tip_error\.max' for the two_axis loop"),
+    ("the SI build's plant", lambda t: t.replace('directory = "{fmus}"', 'directory = "{fmus}"\nplant = "'
+                                                 + str(SI_PLANT) + '"'),
+     r"XYServoPlant\.fmu speaks SI \(plant\..* is in m\): a campaign's metrics are in mm"),
     ("a true error on a user's path", lambda t: t.replace('path = "trident"', 'path = "part.json"'),
      r"contour_error\.\* needs a built-in path"),
     ("a typo in a key", lambda t: t.replace("batch_size = 3", "batchsize = 3"),

@@ -357,6 +357,10 @@ def test_batch_metrics_refused_or_unmeasurable_say_why(loops, cosim):
         (["batch", "--trajectory"], "--trajectory goes with --metrics"),
     ]:
         assert words in refused(cosim, args[0], ssd, "--stop", "0.1", *args[1:]), args
+    # The SI build measures in m; the metrics are in mm.
+    si = repo.fmu_dir().parent / "fmu-si" / "two_axis.ssd"
+    assert "plant.pos.x is in m; the metrics are in mm and rad" in refused(
+        cosim, "batch", si, "--stop", "0.1", "--metrics", "contour_error.max")
     # A path the runner has no exact geometry for: an error row, which names the way out.
     program = repo.root() / "tests" / "data" / "cam" / "cambam" / "enclosure-labels.nc"
     _, answers = batch_answers(cosim, ssd, [(0, [["interpolator", "path", str(program)]]),

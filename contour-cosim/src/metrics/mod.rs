@@ -84,9 +84,7 @@ impl Quantity {
             }
         }
     }
-}
 
-impl Quantity {
     /// The loop it is measured on.
     fn machine(self) -> &'static str {
         match self {
@@ -174,12 +172,27 @@ impl Metrics {
             for (unit, variable) in
                 reads.chain(geometry.iter().map(|v| ("interpolator", v.to_string())))
             {
-                system.resolve(unit, &variable).map_err(|e| {
+                let refused = |why: String| {
                     Error::Refused(format!(
-                        "--metrics {name}, a metric of the {} loop: {e}",
+                        "--metrics {name}, a metric of the {} loop: {why}",
                         quantity.machine()
                     ))
-                })?;
+                };
+                let resolved = system
+                    .resolve(unit, &variable)
+                    .map_err(|e| refused(e.to_string()))?;
+                // Lengths are measured in mm: the SI build's FMUs speak m.
+                let declared = system.units[resolved.unit]
+                    .fmu
+                    .description
+                    .variable(&variable)
+                    .and_then(|v| v.unit.as_deref());
+                if declared == Some("m") {
+                    return Err(refused(format!(
+                        "{unit}.{variable} is in m; the metrics are in mm and rad: run the \
+                         loop of the mm build (target/fmu, not the SI build's target/fmu-si)"
+                    )));
+                }
             }
             for (unit, name) in quantity.columns() {
                 let column = (unit.to_string(), name);

@@ -302,6 +302,11 @@ class _Reader:
             if md.modelName != expected:
                 self.fail(f"{path} is {md.modelName!r}, not the {unit} of the {self.loop} "
                           f"loop ({expected}, FMI 2.0 Co-Simulation)")
+            in_metres = [v.name for v in md.modelVariables if v.unit == "m"]
+            if in_metres:
+                self.fail(f"{path} speaks SI ({unit}.{in_metres[0]} is in m): a campaign's "
+                          "metrics are in mm and rad; run it on the mm build's FMUs (target/fmu, "
+                          "not target/fmu-si)")
             variables = {v.name: Variable(v.type, v.causality, _start(v), _bound(v.min), _bound(v.max),
                                           _items(v)) for v in md.modelVariables}
             units[unit] = Unit(unit, path.resolve(), _sha256(path), variables)
