@@ -8,7 +8,8 @@
 //! paths (`path::planar`, `path::five_axis`); [`contour`] (contour errors, split by
 //! paper into `planar` and `five_axis`); [`control`] (PID, fuzzy gain scheduling, the
 //! cross-coupled controllers); [`plant`] (the test plants); [`sim`] (the closed loops in
-//! process). Units: mm, rad, s.
+//! process); [`shared`] keeps what instances share (plans, indexes) for their owner. Units:
+//! mm, rad, s.
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -22,4 +23,5 @@ pub mod math;
 pub mod part_program;
 pub mod path;
 pub mod plant;
+pub mod shared;
 pub mod sim;

@@ -25,6 +25,7 @@ use std::ffi::c_char;
 use std::ptr;
 
 use contour_core::path::five_axis::Planner;
+use contour_core::contour::planar::TrueErrorIndexes;
 use contour_core::path::planar::XyPlans;
 use contour_fmu::framework::model::{Environment, ModelInfo};
 use contour_fmu::framework::variables::{Values, VarType};
@@ -167,6 +168,8 @@ unsafe fn through_fmi(index: usize, model: &'static ModelInfo, bytes: &[u8]) {
 fn fuzz_environment() -> Environment {
     static PLANNER: std::sync::OnceLock<std::sync::Arc<Planner>> = std::sync::OnceLock::new();
     static XY_PLANS: std::sync::OnceLock<std::sync::Arc<XyPlans>> = std::sync::OnceLock::new();
+    static INDEXES: std::sync::OnceLock<std::sync::Arc<TrueErrorIndexes>> =
+        std::sync::OnceLock::new();
     let planner = PLANNER.get_or_init(|| {
         let planner = Planner::new();
         planner.set_sample_budget(FUZZ_SAMPLE_BUDGET);
@@ -176,6 +179,7 @@ fn fuzz_environment() -> Environment {
         resource_dir: None,
         planner: std::sync::Arc::clone(planner),
         xy_plans: std::sync::Arc::clone(XY_PLANS.get_or_init(Default::default)),
+        indexes: std::sync::Arc::clone(INDEXES.get_or_init(Default::default)),
     }
 }
 

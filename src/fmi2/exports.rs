@@ -284,6 +284,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
             resource_dir: None,
             planner: super::plans::planner(),
             xy_plans: super::plans::xy_plans(),
+            indexes: super::plans::true_error_indexes(),
         };
         if !fmuResourceLocation.is_null() {
             match c_str(fmuResourceLocation)

@@ -1,10 +1,11 @@
-//! The plans of this library's instances: one five-axis [`Planner`] and one [`XyPlans`]
-//! for the process, which owns the instances, so instances on one path and limits share a
-//! plan and a restored state finds its plan instead of planning again (contour-core keeps
-//! no state of its own).
+//! The plans of this library's instances: one five-axis [`Planner`], one [`XyPlans`] and
+//! one [`TrueErrorIndexes`] for the process, which owns the instances, so instances on one
+//! path and limits share a plan or an index and a restored state finds its own instead of
+//! making it again (contour-core keeps no state of its own).
 
 use std::sync::{Arc, OnceLock};
 
+use contour_core::contour::planar::TrueErrorIndexes;
 use contour_core::path::five_axis::Planner;
 use contour_core::path::planar::XyPlans;
 
@@ -18,6 +19,12 @@ pub fn planner() -> Arc<Planner> {
 pub fn xy_plans() -> Arc<XyPlans> {
     static PLANS: OnceLock<Arc<XyPlans>> = OnceLock::new();
     Arc::clone(PLANS.get_or_init(|| Arc::new(XyPlans::new())))
+}
+
+/// The exact-distance index cache every instance of this library is given.
+pub fn true_error_indexes() -> Arc<TrueErrorIndexes> {
+    static INDEXES: OnceLock<Arc<TrueErrorIndexes>> = OnceLock::new();
+    Arc::clone(INDEXES.get_or_init(|| Arc::new(TrueErrorIndexes::new())))
 }
 
 /// Sets the most samples a plan may have (a fuzzer's time limit; see

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use contour_core::contour::planar::TrueErrorIndexes;
 use contour_core::path::five_axis::Planner;
 use contour_core::path::planar::XyPlans;
 use sha2::{Digest, Sha256};
@@ -23,6 +24,8 @@ pub struct Environment {
     pub planner: Arc<Planner>,
     /// The same for the XY table's planned references.
     pub xy_plans: Arc<XyPlans>,
+    /// The same for the `program` estimator's exact-distance indexes.
+    pub indexes: Arc<TrueErrorIndexes>,
 }
 
 /// A model's answer when it cannot do what was asked; the text goes to the log.

@@ -14,10 +14,12 @@ use super::line_arc_parameters;
 use super::path_parameter;
 use crate::framework::model::{DefaultExperiment, Environment, Model, ModelInfo, ModelResult};
 use crate::framework::sample_clock::{check_period, SampleClock};
-use crate::framework::saved_state::{self, StateLayout};
+use crate::framework::saved_state::{self, RestoredState, SavedState, StateLayout};
 use crate::framework::variable_table::{axis_block, variable_table, Axis, AxisUnit, XY};
 use crate::framework::variables::{EnumItem, EnumType, Start, Values, Variable};
-use contour_core::contour::planar::{Estimator, EstimatorKind, FreeCurveEstimator, ON_PATH};
+use contour_core::contour::planar::{
+    Estimator, EstimatorKind, FreeCurveEstimator, SavedEstimator, ON_PATH,
+};
 use contour_core::control::{
     CccConfig, ConfigError, ControllerConfig, CrossCoupledController, FeedForward, FuzzyFactor,
     FuzzyFactors, Parameter, Pid, PidGains,
@@ -191,7 +193,48 @@ const READER: path_parameter::ReaderParameters = path_parameter::ReaderParameter
     tools: TOOL_RADII,
 };
 
-type State = ControllerState<CrossCoupledController<Estimator>, 2>;
+/// The model's state, saved as the controller's [`ControllerState`] (the same bytes).
+#[derive(Clone, serde::Serialize)]
+#[serde(transparent)]
+struct State(ControllerState<CrossCoupledController<Estimator>, 2>);
+
+impl std::ops::Deref for State {
+    type Target = ControllerState<CrossCoupledController<Estimator>, 2>;
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for State {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.0
+    }
+}
+
+/// A restore reads the estimator as saved and resumes it: a `program` estimator finds its
+/// path's index in the environment's cache instead of building it (1.3 ms for the
+/// infinity NURBS, more for a long program), then the state is checked as saved.
+impl RestoredState for State {
+    type Saved = ControllerState<CrossCoupledController<SavedEstimator>, 2>;
+
+    fn restore(saved: Self::Saved, time: f64, environment: &Environment) -> Result<Self, String> {
+        let ControllerState {
+            controller,
+            clock,
+            feed_forward,
+        } = saved;
+        let controller = controller
+            .map_estimator(|e| e.resume(&environment.indexes))
+            .map_err(|e| format!("estimator: {e}"))?;
+        let state = ControllerState {
+            controller,
+            clock,
+            feed_forward,
+        };
+        state.validate(time, environment)?;
+        Ok(State(state))
+    }
+}
 
 impl SavedController<2> for CrossCoupledController<Estimator> {
     const AXES: &'static [Axis] = &XY;
@@ -210,7 +253,7 @@ impl SavedController<2> for CrossCoupledController<Estimator> {
 
     /// The contour PID and the per-axis contour PIDs, the estimator's radii, and every
     /// number finite.
-    fn check_rest(state: &State) -> Result<(), String> {
+    fn check_rest(state: &ControllerState<Self, 2>) -> Result<(), String> {
         let controller = &state.controller;
         let ts = controller.ts();
         controller_parameters::check_pid("contour PID", controller.law().pid(), ts)?;
@@ -328,7 +371,10 @@ fn estimator(
     let mut path = path_parameter::path(spec, values, GEOMETRY, READER, environment)?;
     let warnings = path_parameter::reader_warnings(&mut path);
     let path = path.blended(TOLERANCE.get(values));
-    Ok((Estimator::for_path(kind, &path), warnings))
+    Ok((
+        Estimator::for_path_shared(kind, &path, &environment.indexes),
+        warnings,
+    ))
 }
 
 impl Model for ContourCCC2D {
@@ -338,14 +384,14 @@ impl Model for ContourCCC2D {
         let (estimator, warnings) = estimator(values, &self.environment)?;
         let controller = CrossCoupledController::new(config, estimator).map_err(config_message)?;
         self.warnings = warnings;
-        self.state = Some(State {
+        self.state = Some(State(ControllerState {
             controller,
             clock: SampleClock::new(start_time, config.ts),
             feed_forward: FeedForward::new(
                 FEED_FORWARD.get(values),
                 ACCELERATION_FEED_FORWARD.get(values),
             )?,
-        });
+        }));
         U.set(values, &Vector2::zeros());
         CONTOUR_ERROR.set(values, 0.0);
         ERR.set(values, &Vector2::zeros());
@@ -354,7 +400,7 @@ impl Model for ContourCCC2D {
     }
 
     fn do_step(&mut self, values: &mut Values, time: f64, step: f64) -> ModelResult {
-        let state = self.state.as_mut().ok_or("not initialized")?;
+        let state = &mut self.state.as_mut().ok_or("not initialized")?.0;
         let reference = REF.vector(values);
         let actual = POS.vector(values);
         let (velocity, acceleration) = (VREF.vector(values), AREF.vector(values));
@@ -429,6 +475,62 @@ mod tests {
         values.set_real(FUZZY_FACTORS.at(3).vr(), f64::NAN);
         let e = config(&values).validate().unwrap_err();
         assert!(config_message(e).starts_with("parameter fuzzy.ki = NaN"));
+    }
+
+    /// A `program` estimator's exact-distance index is shared: instances on one path
+    /// build it once, a state restored in the same process finds it, one restored in
+    /// another builds it once; all go on bit for bit, with the same bytes saved.
+    #[test]
+    fn a_restored_program_estimator_finds_its_index() {
+        use crate::framework::variables::Value;
+        use contour_core::path::planar::builtin;
+        use contour_core::path::Curve;
+        let env = Environment::default();
+        let mut values = Values::from_table(&VARIABLES);
+        values.set(PATH.vr(), Value::String("infinity".into()));
+        values.set(ESTIMATOR.vr(), Value::Integer(4));
+        let infinity = builtin::by_name("infinity").unwrap();
+        let feed = |values: &mut Values, k: usize| {
+            let u = k as f64 * 2e-4;
+            let (r, p) = (infinity.eval(u).p, infinity.eval((u - 4e-3).max(0.0)).p);
+            values.set_real(REF.at(0).vr(), r[0]);
+            values.set_real(REF.at(1).vr(), r[1]);
+            values.set_real(POS.at(0).vr(), p[0] + 1e-3);
+            values.set_real(POS.at(1).vr(), p[1]);
+        };
+        let mut a = (INFO.create)(&env);
+        a.initialize(&mut values, 0.0).unwrap();
+        let mut other = (INFO.create)(&env);
+        other.initialize(&mut values.clone(), 0.0).unwrap();
+        assert_eq!(env.indexes.indexes_made(), 1, "one index for two instances");
+        for k in 0..100 {
+            feed(&mut values, k);
+            a.do_step(&mut values, k as f64 * 1e-3, 1e-3).unwrap();
+        }
+        let saved = a.save_state().unwrap();
+        let mut b = (INFO.create)(&env);
+        b.restore_state(&saved, 0.1).unwrap();
+        assert_eq!(env.indexes.indexes_made(), 1, "found, not built again");
+        assert_eq!(b.save_state().unwrap(), saved);
+        let elsewhere = Environment::default();
+        let mut c = (INFO.create)(&elsewhere);
+        c.restore_state(&saved, 0.1).unwrap();
+        assert_eq!(elsewhere.indexes.indexes_made(), 1);
+        let (mut vb, mut vc) = (values.clone(), values.clone());
+        for k in 100..300 {
+            let t = k as f64 * 1e-3;
+            for v in [&mut values, &mut vb, &mut vc] {
+                feed(v, k);
+            }
+            a.do_step(&mut values, t, 1e-3).unwrap();
+            b.do_step(&mut vb, t, 1e-3).unwrap();
+            c.do_step(&mut vc, t, 1e-3).unwrap();
+            assert!(values == vb && values == vc, "sample {k}");
+        }
+        assert!(
+            CONTOUR_ERROR.get(&values).abs() > 1e-4,
+            "a real error is measured"
+        );
     }
 
     #[test]

@@ -64,6 +64,23 @@ pub struct CrossCoupledController<E, const D: usize = 2> {
     estimator: E,
 }
 
+impl<E, const D: usize> CrossCoupledController<E, D> {
+    /// The same controller around the estimator `f` makes of this one: a restored state
+    /// read with its estimator as saved ([`SavedEstimator`](crate::contour::planar::SavedEstimator)),
+    /// resumed.
+    pub fn map_estimator<F, Error>(
+        self,
+        f: impl FnOnce(E) -> Result<F, Error>,
+    ) -> Result<CrossCoupledController<F, D>, Error> {
+        Ok(CrossCoupledController {
+            config: self.config,
+            axes: self.axes,
+            law: self.law,
+            estimator: f(self.estimator)?,
+        })
+    }
+}
+
 impl<E: ContourEstimator<D>, const D: usize> CrossCoupledController<E, D> {
     /// Validates `config` and builds the controller around `estimator`.
     pub fn new(config: ControllerConfig<D>, estimator: E) -> Result<Self, ConfigError> {

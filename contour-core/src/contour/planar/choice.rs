@@ -7,7 +7,10 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
-use super::{ArcEstimator, FreeCurveEstimator, LineEstimator, ProgramEstimator};
+use super::{
+    ArcEstimator, FreeCurveEstimator, LineEstimator, ProgramEstimator, SavedProgramEstimator,
+    TrueErrorIndexes,
+};
 use crate::contour::{ContourEstimate, ContourEstimator};
 use crate::geometry::Vector2;
 use crate::path::planar::Path;
@@ -87,7 +90,43 @@ pub enum Estimator {
     Program(ProgramEstimator),
 }
 
+/// An [`Estimator`] as saved (the same bytes), read without building the `program`
+/// estimator's index: [`SavedEstimator::resume`] finds it in a [`TrueErrorIndexes`].
+#[derive(Deserialize)]
+pub enum SavedEstimator {
+    /// As [`Estimator::FreeCurve`].
+    FreeCurve(FreeCurveEstimator),
+    /// As [`Estimator::Line`].
+    Line(LineEstimator),
+    /// As [`Estimator::Arc`].
+    Arc(ArcEstimator),
+    /// As [`Estimator::Program`].
+    Program(SavedProgramEstimator),
+}
+
+impl SavedEstimator {
+    /// The estimator, a `program` one on the index `indexes` keeps or builds; refused
+    /// (naming the value) when its track does not fit its path.
+    pub fn resume(self, indexes: &TrueErrorIndexes) -> Result<Estimator, String> {
+        Ok(match self {
+            SavedEstimator::FreeCurve(e) => Estimator::FreeCurve(e),
+            SavedEstimator::Line(e) => Estimator::Line(e),
+            SavedEstimator::Arc(e) => Estimator::Arc(e),
+            SavedEstimator::Program(e) => Estimator::Program(e.resume(indexes)?),
+        })
+    }
+}
+
 impl Estimator {
+    /// [`Estimator::for_path`], a `program` estimator on the index `indexes` keeps or
+    /// builds for `path` (instances on one path share it).
+    pub fn for_path_shared(kind: EstimatorKind, path: &Path, indexes: &TrueErrorIndexes) -> Self {
+        match kind {
+            EstimatorKind::Program => Estimator::Program(ProgramEstimator::on(indexes.index(path))),
+            _ => Estimator::for_path(kind, path),
+        }
+    }
+
     /// The estimator of `kind` for following `path`: the exact line/arc estimators use the
     /// path's own geometry when it is a line/arc; on other paths they fall back to the
     /// local line (direction of the last reference move) or the circle through the last
@@ -147,6 +186,30 @@ impl ContourEstimator for Estimator {
 mod tests {
     use super::*;
     use crate::path::planar::builtin;
+
+    /// Every kind's saved bytes read as a [`SavedEstimator`] resume to the estimator that
+    /// wrote them, on the infinity and on the line; a `program` estimator's index is
+    /// built once for the instances and the restores on one path.
+    #[test]
+    fn saved_estimators_resume_as_they_were_with_shared_indexes() {
+        let indexes = TrueErrorIndexes::new();
+        for name in ["infinity", "line"] {
+            let path = builtin::by_name(name).unwrap();
+            for kind in EstimatorKind::ALL {
+                let mut estimator = Estimator::for_path_shared(kind, &path, &indexes);
+                for k in 0..50 {
+                    let r = Vector2::new(k as f64 * 0.05, k as f64 * 0.0375);
+                    estimator.estimate(r, r + Vector2::new(0.001, -0.002));
+                }
+                let bytes = postcard::to_stdvec(&estimator).unwrap();
+                let saved: SavedEstimator = postcard::from_bytes(&bytes).unwrap();
+                let resumed = saved.resume(&indexes).unwrap();
+                assert_eq!(resumed, estimator, "{name} {kind}");
+                assert_eq!(postcard::to_stdvec(&resumed).unwrap(), bytes);
+            }
+        }
+        assert_eq!(indexes.indexes_made(), 2, "one index per path");
+    }
 
     #[test]
     fn names_parse() {

@@ -12,11 +12,13 @@ mod local_circle;
 mod program;
 mod true_error;
 mod true_error_index;
+mod true_error_indexes;
 
 pub use arc::ArcEstimator;
-pub use choice::{Estimator, EstimatorKind};
+pub use choice::{Estimator, EstimatorKind, SavedEstimator};
 pub use free_curve::FreeCurveEstimator;
 pub use line::LineEstimator;
-pub use program::{ProgramEstimator, ON_PATH};
+pub use program::{ProgramEstimator, SavedProgramEstimator, ON_PATH};
 pub use true_error::{true_error, TrueError};
 pub use true_error_index::TrueErrorIndex;
+pub use true_error_indexes::TrueErrorIndexes;

@@ -29,10 +29,12 @@
 //! cost depends on how many moves lie near the tool, not on the program's length, and
 //! nothing is allocated after construction.
 
+use std::sync::Arc;
+
 use serde::{Deserialize, Serialize};
 
 use super::free_curve::DEFAULT_CAPACITY;
-use super::{TrueError, TrueErrorIndex};
+use super::{TrueError, TrueErrorIndex, TrueErrorIndexes};
 use crate::contour::{ContourEstimate, ContourEstimator};
 use crate::geometry::{self, Vector2};
 use crate::path::planar::Path;
@@ -86,20 +88,31 @@ impl Track {
 /// The exact contour error to a programmed path, tracked along it (see the module docs).
 #[derive(Clone, Debug)]
 pub struct ProgramEstimator {
-    index: TrueErrorIndex,
+    /// Shared by the instances on one path ([`TrueErrorIndexes`]).
+    index: Arc<TrueErrorIndex>,
     track: Track,
 }
 
-/// Serialised form: the path and the track; the index is rebuilt on load.
+/// A [`ProgramEstimator`] as saved: its path and its track. Read as it is, it finds its
+/// index in a [`TrueErrorIndexes`] ([`SavedProgramEstimator::resume`]); read as a
+/// `ProgramEstimator`, it builds its own.
 #[derive(Deserialize)]
-struct ProgramEstimatorData {
+pub struct SavedProgramEstimator {
     path: Path,
     track: Track,
 }
 
-/// [`ProgramEstimatorData`] as written, borrowing its parts.
+impl SavedProgramEstimator {
+    /// The estimator, on the index `indexes` keeps or makes for its path; refused (naming
+    /// the value) when the track does not fit the path.
+    pub fn resume(self, indexes: &TrueErrorIndexes) -> Result<ProgramEstimator, String> {
+        ProgramEstimator::checked(indexes.index(&self.path), self.track)
+    }
+}
+
+/// [`SavedProgramEstimator`] as written, borrowing its parts.
 #[derive(Serialize)]
-struct ProgramEstimatorDataRef<'a> {
+struct SavedProgramEstimatorRef<'a> {
     path: &'a Path,
     track: &'a Track,
 }
@@ -107,8 +120,13 @@ struct ProgramEstimatorDataRef<'a> {
 impl ProgramEstimator {
     /// The estimator for `path`, at its start (allocates the index once).
     pub fn new(path: &Path) -> Self {
+        ProgramEstimator::on(Arc::new(TrueErrorIndex::new(path)))
+    }
+
+    /// The estimator for the path of `index`, at its start.
+    pub fn on(index: Arc<TrueErrorIndex>) -> Self {
         ProgramEstimator {
-            index: TrueErrorIndex::new(path),
+            index,
             track: Track::default(),
         }
     }
@@ -217,11 +235,9 @@ impl PartialEq for ProgramEstimator {
     }
 }
 
-impl TryFrom<ProgramEstimatorData> for ProgramEstimator {
-    type Error = String;
-    fn try_from(d: ProgramEstimatorData) -> Result<Self, String> {
-        let index = TrueErrorIndex::new(&d.path);
-        let t = d.track;
+impl ProgramEstimator {
+    /// The estimator on `index` with the saved track `t`, checked against the path.
+    fn checked(index: Arc<TrueErrorIndex>, t: Track) -> Result<Self, String> {
         let chunks = index.chunk_count();
         let length = index.chunk_ends(chunks - 1)[1].0;
         if t.history.len() != WINDOW || t.newest >= WINDOW {
@@ -252,9 +268,16 @@ impl TryFrom<ProgramEstimatorData> for ProgramEstimator {
     }
 }
 
+impl TryFrom<SavedProgramEstimator> for ProgramEstimator {
+    type Error = String;
+    fn try_from(d: SavedProgramEstimator) -> Result<Self, String> {
+        ProgramEstimator::checked(Arc::new(TrueErrorIndex::new(&d.path)), d.track)
+    }
+}
+
 impl Serialize for ProgramEstimator {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        ProgramEstimatorDataRef {
+        SavedProgramEstimatorRef {
             path: self.path(),
             track: &self.track,
         }
@@ -264,7 +287,7 @@ impl Serialize for ProgramEstimator {
 
 impl<'de> Deserialize<'de> for ProgramEstimator {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let data = ProgramEstimatorData::deserialize(d)?;
+        let data = SavedProgramEstimator::deserialize(d)?;
         ProgramEstimator::try_from(data).map_err(serde::de::Error::custom)
     }
 }
@@ -467,9 +490,9 @@ mod tests {
             );
             assert_eq!(restored.estimate(r, p), e.estimate(r, p));
         }
-        let mut data = postcard::from_bytes::<ProgramEstimatorData>(&blob).unwrap();
+        let mut data = postcard::from_bytes::<SavedProgramEstimator>(&blob).unwrap();
         data.track.history[3] = -1.0;
-        let bad = postcard::to_stdvec(&ProgramEstimatorDataRef {
+        let bad = postcard::to_stdvec(&SavedProgramEstimatorRef {
             path: &data.path,
             track: &data.track,
         })

@@ -5,24 +5,16 @@
 //!
 //! [`Planner`]: crate::path::five_axis::Planner
 
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Mutex, Weak};
+use std::sync::Arc;
 
 use super::plan::{XyLimits, XyPlan};
 use super::Path;
 use crate::path::PathError;
+use crate::shared::Shared;
 
 /// Plans XY paths, keeping each plan while an instance holds it, and the one used last.
 #[derive(Debug, Default)]
-pub struct XyPlans {
-    /// Each plan alive with what it was made from (compared in full).
-    plans: Mutex<Vec<(Path, XyLimits, Weak<XyPlan>)>>,
-    /// The plan used last, alive after its instance lets go of it: a restore into an
-    /// instance that has not planned it finds it still.
-    recent: Mutex<Option<Arc<XyPlan>>>,
-    /// Plans made (not found kept).
-    made: AtomicU64,
-}
+pub struct XyPlans(Shared<(Path, XyLimits), XyPlan>);
 
 impl XyPlans {
     /// An empty cache.
@@ -32,33 +24,16 @@ impl XyPlans {
 
     /// How many plans were made, not found kept.
     pub fn plans_made(&self) -> u64 {
-        self.made.load(Ordering::Relaxed)
+        self.0.made()
     }
 
     /// The plan of `path` within `limits`, kept or made now.
     pub fn plan(&self, path: &Path, limits: &XyLimits) -> Result<Arc<XyPlan>, PathError> {
-        {
-            let mut plans = self.plans.lock().unwrap_or_else(|e| e.into_inner());
-            plans.retain(|(_, _, plan)| plan.strong_count() > 0);
-            let kept = plans
-                .iter()
-                .find(|(p, l, _)| p == path && l == limits)
-                .and_then(|(_, _, plan)| plan.upgrade());
-            if let Some(plan) = kept {
-                drop(plans);
-                *self.recent.lock().unwrap_or_else(|e| e.into_inner()) = Some(Arc::clone(&plan));
-                return Ok(plan);
-            }
-        }
-        self.made.fetch_add(1, Ordering::Relaxed);
-        let plan = Arc::new(XyPlan::new(path, limits)?);
-        self.plans.lock().unwrap_or_else(|e| e.into_inner()).push((
-            path.clone(),
-            *limits,
-            Arc::downgrade(&plan),
-        ));
-        *self.recent.lock().unwrap_or_else(|e| e.into_inner()) = Some(Arc::clone(&plan));
-        Ok(plan)
+        self.0.get_or_make(
+            |(p, l)| p == path && l == limits,
+            || (path.clone(), *limits),
+            || XyPlan::new(path, limits),
+        )
     }
 }
 
