@@ -102,13 +102,26 @@ impl FuzzyEngine {
     /// Fuzzification and the rule strengths are shared by the three outputs.
     #[inline]
     pub fn evaluate(&self, e: f64, ec: f64) -> FuzzyOutput {
-        let fe = fuzzify(e);
-        let fc = fuzzify(ec);
-        FuzzyOutput {
-            dkp: infer(&self.tables[0], fe, fc),
-            dki: infer(&self.tables[1], fe, fc),
-            dkd: infer(&self.tables[2], fe, fc),
+        let (fe, fc) = (fuzzify(e), fuzzify(ec));
+        let [kp, ki, kd] = &self.tables;
+        let levels = [
+            clip_levels(kp, fe, fc),
+            clip_levels(ki, fe, fc),
+            clip_levels(kd, fe, fc),
+        ];
+        // Set by set, the three outputs side by side: the centroids are computed together.
+        // Four lanes (the last a copy of the third) pair up in vector registers.
+        let mut by_set = [[0.0; 4]; 7];
+        for (set, lanes) in by_set.iter_mut().enumerate() {
+            *lanes = [
+                levels[0][set],
+                levels[1][set],
+                levels[2][set],
+                levels[2][set],
+            ];
         }
+        let [dkp, dki, dkd, _] = centroids(by_set);
+        FuzzyOutput { dkp, dki, dkd }
     }
 
     /// The clip level of every output set for one table: `levels[j]` is the largest
@@ -126,28 +139,67 @@ pub fn evaluate_table(table: &RuleTable, e: f64, ec: f64) -> f64 {
     infer(table, fuzzify(e), fuzzify(ec))
 }
 
-#[inline]
+// Inlined with `centroid` into `infer`: the levels then stay in registers.
+#[inline(always)]
 fn clip_levels(table: &RuleTable, fe: (usize, f64, f64), fc: (usize, f64, f64)) -> [f64; 7] {
-    let mut h = [0.0_f64; 7];
     let (ie, le, ue) = fe;
     let (ic, lc, uc) = fc;
     // Only the 2 × 2 block of rules around the inputs can fire; a rule of strength 0
     // leaves its level unchanged, so no case analysis is needed.
-    for (i, j, strength) in [
-        (ie, ic, le.min(lc)),
-        (ie, ic + 1, le.min(uc)),
-        (ie + 1, ic, ue.min(lc)),
-        (ie + 1, ic + 1, ue.min(uc)),
-    ] {
-        let slot = &mut h[table[i][j].index()];
-        *slot = slot.max(strength);
+    let fired = [
+        (table[ie][ic].index(), le.min(lc)),
+        (table[ie][ic + 1].index(), le.min(uc)),
+        (table[ie + 1][ic].index(), ue.min(lc)),
+        (table[ie + 1][ic + 1].index(), ue.min(uc)),
+    ];
+    // Each level chosen in registers, not stored at a computed index: the centroids read
+    // the levels two at a time, and a wide read of narrow stores waits for them to land.
+    // A strength times its set's row of the identity is itself there and +0 elsewhere
+    // (strengths are finite and ≥ 0), so every level is the largest strength that fires
+    // its set, or 0, as rule by rule; no branches, and `greater` is one instruction.
+    let mut h = [0.0; 7];
+    for (out, strength) in fired {
+        for (level, one) in h.iter_mut().zip(IDENTITY[out]) {
+            *level = greater(*level, strength * one);
+        }
     }
     h
 }
 
+/// Row `j` picks set `j`.
+const IDENTITY: [[f64; 7]; 7] = {
+    let mut rows = [[0.0; 7]; 7];
+    let mut j = 0;
+    while j < 7 {
+        rows[j][j] = 1.0;
+        j += 1;
+    }
+    rows
+};
+
 #[inline]
 fn infer(table: &RuleTable, fe: (usize, f64, f64), fc: (usize, f64, f64)) -> f64 {
     centroid(&clip_levels(table, fe, fc))
+}
+
+/// The smaller of two numbers neither of which is NaN (`f64::min` also checks for NaN).
+#[inline(always)]
+fn lesser(a: f64, b: f64) -> f64 {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
+/// The larger of two numbers neither of which is NaN (`f64::max` also checks for NaN).
+#[inline(always)]
+fn greater(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
+    }
 }
 
 /// Exact centroid of the aggregate `max_j min(h[j], triangle_j(y))` on [−3, 3].
@@ -171,38 +223,54 @@ fn infer(table: &RuleTable, fe: (usize, f64, f64), fc: (usize, f64, f64)) -> f64
 /// happen, because the memberships of any input sum to one, so some rule fires with
 /// strength ≥ 1/2; the fallback only guards custom or degenerate use. Levels are taken
 /// as clamped to [0, 1], NaN as 0.
-#[inline]
+#[inline(always)]
 pub fn centroid(h: &[f64; 7]) -> f64 {
     // Levels outside [0, 1] (or NaN) cannot come from the rules; clamp them for custom use.
-    let h = h.map(|v| if v > 0.0 { v.min(1.0) } else { 0.0 });
+    let [c] = centroids(h.map(|v| [if v > 0.0 { v.min(1.0) } else { 0.0 }]));
+    c
+}
+
+/// [`centroid`] of `N` aggregates at once, `h[set][k]` the clip level of `set` in the
+/// `k`-th, each in [0, 1] (not NaN, not −0): the same operations in the same order on
+/// each, so every result has the bits [`centroid`] gives it alone; laid out lane by lane,
+/// so the compiler computes the aggregates side by side in vector registers.
+#[inline(always)]
+fn centroids<const N: usize>(h: [[f64; N]; 7]) -> [f64; N] {
+    // Plain loops over constant bounds: unrolled and vectorised across k. Nothing is NaN
+    // or −0, where `lesser` and `f64::min` agree.
     // Set areas (edge sets are half triangles) and the overlaps of neighbours; kept as
     // independent terms so the sums below do not form one long dependency chain.
-    let a: [f64; 7] = std::array::from_fn(|j| {
-        let full = h[j] * (2.0 - h[j]);
-        if j == 0 || j == 6 {
-            0.5 * full
-        } else {
-            full
+    let mut a = [[0.0; N]; 7];
+    for j in 0..7 {
+        for k in 0..N {
+            let full = h[j][k] * (2.0 - h[j][k]);
+            a[j][k] = if j == 0 || j == 6 { 0.5 * full } else { full };
         }
-    });
-    let o: [f64; 6] = std::array::from_fn(|j| {
-        let m = h[j].min(h[j + 1]).min(0.5);
-        m - m * m
-    });
-    // Edge sets: moment about their own centre, toward the inside.
-    let q0 = 1.0 - h[0];
-    let q6 = 1.0 - h[6];
-    let edge = ((1.0 - q0 * q0 * q0) - (1.0 - q6 * q6 * q6)) / 6.0;
-    let area = (a[0] + a[6]) + (a[1] + a[5]) + (a[2] + a[4]) + a[3]
-        - ((o[0] + o[5]) + (o[1] + o[4]) + (o[2] + o[3]));
-    // Moments about y = 0: centres −3 … 3, overlap midpoints −2.5 … 2.5.
-    let moment = 3.0 * (a[6] - a[0]) + 2.0 * (a[5] - a[1]) + (a[4] - a[2]) + edge
-        - (2.5 * (o[5] - o[0]) + 1.5 * (o[4] - o[1]) + 0.5 * (o[3] - o[2]));
-    if area > 0.0 {
-        moment / area
-    } else {
-        0.0
     }
+    let mut o = [[0.0; N]; 6];
+    for j in 0..6 {
+        for k in 0..N {
+            let m = lesser(lesser(h[j][k], h[j + 1][k]), 0.5);
+            o[j][k] = m - m * m;
+        }
+    }
+    let mut c = [0.0; N];
+    for k in 0..N {
+        // Edge sets: moment about their own centre, toward the inside.
+        let q0 = 1.0 - h[0][k];
+        let q6 = 1.0 - h[6][k];
+        let edge = ((1.0 - q0 * q0 * q0) - (1.0 - q6 * q6 * q6)) / 6.0;
+        let area = (a[0][k] + a[6][k]) + (a[1][k] + a[5][k]) + (a[2][k] + a[4][k]) + a[3][k]
+            - ((o[0][k] + o[5][k]) + (o[1][k] + o[4][k]) + (o[2][k] + o[3][k]));
+        // Moments about y = 0: centres −3 … 3, overlap midpoints −2.5 … 2.5.
+        let moment = 3.0 * (a[6][k] - a[0][k])
+            + 2.0 * (a[5][k] - a[1][k])
+            + (a[4][k] - a[2][k])
+            + edge
+            - (2.5 * (o[5][k] - o[0][k]) + 1.5 * (o[4][k] - o[1][k]) + 0.5 * (o[3][k] - o[2][k]));
+        c[k] = if area > 0.0 { moment / area } else { 0.0 };
+    }
+    c
 }
 
 #[cfg(test)]
@@ -397,6 +465,67 @@ mod tests {
                     "e={e} ec={ec}"
                 );
             }
+        }
+    }
+
+    /// The centroid as one aggregate at a time computed it before the engine computed the
+    /// three side by side (f64::min and max, a clamp on every level).
+    fn centroid_one_by_one(h: &[f64; 7]) -> f64 {
+        let h = h.map(|v| if v > 0.0 { v.min(1.0) } else { 0.0 });
+        let a: [f64; 7] = std::array::from_fn(|j| {
+            let full = h[j] * (2.0 - h[j]);
+            if j == 0 || j == 6 {
+                0.5 * full
+            } else {
+                full
+            }
+        });
+        let o: [f64; 6] = std::array::from_fn(|j| {
+            let m = h[j].min(h[j + 1]).min(0.5);
+            m - m * m
+        });
+        let (q0, q6) = (1.0 - h[0], 1.0 - h[6]);
+        let edge = ((1.0 - q0 * q0 * q0) - (1.0 - q6 * q6 * q6)) / 6.0;
+        let area = (a[0] + a[6]) + (a[1] + a[5]) + (a[2] + a[4]) + a[3]
+            - ((o[0] + o[5]) + (o[1] + o[4]) + (o[2] + o[3]));
+        let moment = 3.0 * (a[6] - a[0]) + 2.0 * (a[5] - a[1]) + (a[4] - a[2]) + edge
+            - (2.5 * (o[5] - o[0]) + 1.5 * (o[4] - o[1]) + 0.5 * (o[3] - o[2]));
+        if area > 0.0 {
+            moment / area
+        } else {
+            0.0
+        }
+    }
+
+    /// The three outputs computed side by side have the bits of each computed alone, as
+    /// before, from the rule tables' levels and from any levels (out of [0, 1], NaN).
+    #[test]
+    fn side_by_side_centroids_have_the_bits_of_one_by_one() {
+        let engine = FuzzyEngine::default();
+        let mut points = lcg_points(20_000);
+        for i in -14..=14 {
+            for j in -14..=14 {
+                points.push((i as f64 * 0.25, j as f64 * 0.25));
+            }
+        }
+        points.extend([(f64::NAN, 0.5), (-0.0, 0.0), (3.0, -3.0), (1e300, -1e-300)]);
+        for (e, ec) in points {
+            let out = engine.evaluate(e, ec);
+            let one_by_one: [f64; 3] =
+                std::array::from_fn(|k| centroid_one_by_one(&engine.clip_levels(k, e, ec)));
+            assert_eq!(
+                [out.dkp, out.dki, out.dkd].map(f64::to_bits),
+                one_by_one.map(f64::to_bits),
+                "e={e} ec={ec}"
+            );
+        }
+        for (x, y) in lcg_points(5_000) {
+            let h: [f64; 7] = std::array::from_fn(|j| match j {
+                0 => f64::NAN,
+                3 => -0.0,
+                _ => crate::math::sin(x * (j as f64 + 1.0) + y) * 1.4,
+            });
+            assert_eq!(centroid(&h).to_bits(), centroid_one_by_one(&h).to_bits());
         }
     }
 

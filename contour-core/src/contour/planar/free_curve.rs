@@ -18,7 +18,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::local_circle;
+use super::local_circle::{self, SampleCircle};
 use crate::contour::{ContourEstimate, ContourEstimator};
 use crate::geometry::{self, Vector2};
 
@@ -55,6 +55,13 @@ pub struct FreeCurveEstimator {
     /// `push` measured it. Each chord serves up to four circles, so it is measured once;
     /// derived from the samples, so neither saved nor compared.
     chords: Vec<f64>,
+    /// `circles[i]`: the circle through the samples around `buf[i]` (the one before it,
+    /// it, the one after), kept from when `push` made it: the walk back meets the same
+    /// circles for many samples, and measuring one takes most of an estimate's time. Made
+    /// when its newest sample arrives, off the path from the actual point to the
+    /// estimate; `None` after a restore until first needed. Derived, so neither saved nor
+    /// compared.
+    circles: Vec<Option<SampleCircle>>,
 }
 
 impl PartialEq for FreeCurveEstimator {
@@ -71,6 +78,7 @@ impl TryFrom<FreeCurveData> for FreeCurveEstimator {
         }
         let mut estimator = FreeCurveEstimator {
             chords: vec![0.0; d.buf.len()],
+            circles: vec![None; d.buf.len()],
             buf: d.buf,
             head: d.head,
             len: d.len,
@@ -111,6 +119,7 @@ impl FreeCurveEstimator {
             head: 0,
             len: 0,
             chords: vec![0.0; cap],
+            circles: vec![None; cap],
         }
     }
 
@@ -162,23 +171,44 @@ impl FreeCurveEstimator {
         self.head = (self.head + 1) % cap;
         self.buf[self.head] = r;
         self.chords[self.head] = chord;
+        self.circles[self.head] = None;
         self.len = (self.len + 1).min(cap);
+        if self.len >= 3 {
+            // The sample before the new one now has both neighbours.
+            self.circle(1);
+        }
+    }
+
+    /// The circle through the samples around the `m`-th latest (`1 ≤ m ≤ len − 2`).
+    fn measure_circle(&self, m: usize) -> SampleCircle {
+        SampleCircle::through(
+            [self.get(m + 1), self.get(m), self.get(m - 1)],
+            [self.chord(m), self.chord(m - 1)],
+        )
+    }
+
+    /// [`Self::measure_circle`], kept.
+    fn circle(&mut self, m: usize) -> SampleCircle {
+        let i = self.index(m);
+        match self.circles.get(i).copied().flatten() {
+            Some(circle) => circle,
+            None => {
+                let circle = self.measure_circle(m);
+                if let Some(slot) = self.circles.get_mut(i) {
+                    *slot = Some(circle);
+                }
+                circle
+            }
+        }
     }
 
     /// Circle through the samples centred on `m` (m+1 older, m−1 newer), evaluated at the
     /// sample `k` (which must be one of the three); `None` if unavailable.
-    fn triple(&self, p: Vector2, m: usize, k: usize) -> Option<ContourEstimate> {
+    fn triple(&mut self, p: Vector2, m: usize, k: usize) -> Option<ContourEstimate> {
         if m == 0 || m + 1 >= self.len || k + 1 < m || k > m + 1 {
             return None;
         }
-        let pts = [self.get(m + 1), self.get(m), self.get(m - 1)];
-        let chords = [self.chord(m), self.chord(m - 1)];
-        Some(local_circle::triple_error_with_chords(
-            p,
-            pts,
-            chords,
-            m + 1 - k,
-        ))
+        Some(self.circle(m).error(p, self.get(k), m + 1 - k))
     }
 }
 
@@ -234,6 +264,7 @@ impl ContourEstimator for FreeCurveEstimator {
     fn reset(&mut self) {
         self.head = 0;
         self.len = 0;
+        self.circles.fill(None);
     }
 }
 
@@ -286,6 +317,43 @@ mod tests {
         let mut restored: FreeCurveEstimator = postcard::from_bytes(&bytes).unwrap();
         assert_eq!(restored, original);
         assert_eq!(run(&mut restored, 21, 60), run(&mut original, 21, 60));
+    }
+
+    /// Every circle the estimator kept is the one its samples give now: made when its
+    /// newest sample came, never left from samples the ring has since overwritten, held
+    /// back or reset; and one made after a restore is the same.
+    #[test]
+    fn kept_circles_are_those_of_the_samples_now() {
+        fn check(e: &FreeCurveEstimator) {
+            for m in 1..e.len().saturating_sub(1) {
+                if let Some(kept) = e.circles[e.index(m)] {
+                    assert_eq!(kept, e.measure_circle(m), "m = {m}");
+                }
+            }
+        }
+        let c = |t: f64| Vector2::new(20.0 * math::cos(t), 7.0 * math::sin(2.0 * t));
+        let mut e = FreeCurveEstimator::new(6);
+        for i in 0..80 {
+            // Held references now and then (the ring keeps one), a reset halfway.
+            let t = if i % 7 == 3 { (i - 1) as f64 } else { i as f64 } * 0.01;
+            if i == 40 {
+                e.reset();
+            }
+            let r = e.estimate(c(t), c(t - 0.03) * 1.002);
+            check(&e);
+            if i % 9 == 0 {
+                let bytes = postcard::to_stdvec(&e).unwrap();
+                let mut restored: FreeCurveEstimator = postcard::from_bytes(&bytes).unwrap();
+                let again = restored.estimate(c(t), c(t - 0.03) * 1.002);
+                let mut original = e.clone();
+                let next = original.estimate(c(t), c(t - 0.03) * 1.002);
+                assert_eq!(again, next);
+                check(&restored);
+                assert!(r.error.is_finite());
+            }
+        }
+        // Every circle in use after the last sample was kept.
+        assert!((1..e.len() - 1).all(|m| e.circles[e.index(m)].is_some()));
     }
 
     /// With a lag longer than the buffer the walk stops at the oldest sample, where only

@@ -48,56 +48,89 @@ fn curvature_of(ab: Vector2, bc: Vector2, ab_len: f64, bc_len: f64, ac: &Vector2
     }
 }
 
-/// Unit tangent at an end of the chord `c` (length `len`) of a circle of curvature
-/// `kappa`: the chord direction turned back (at its start) or forward (at its end,
-/// `at_end`) by half the subtended angle.
-fn chord_tangent(c: Vector2, len: f64, kappa: f64, at_end: bool) -> Vector2 {
+/// Half the angle a chord of length `len` subtends on a circle of curvature `kappa`: the
+/// turn between the chord's direction and the tangent at either end.
+fn half_angle(len: f64, kappa: f64) -> f64 {
+    math::asin((0.5 * kappa * len).clamp(-1.0, 1.0))
+}
+
+/// Unit tangent at an end of the chord `c` (length `len`, half angle `half`): the chord
+/// direction turned back (at its start) or forward (at its end, `at_end`) by `half`.
+fn chord_tangent(c: Vector2, len: f64, half: f64, at_end: bool) -> Vector2 {
     if len == 0.0 {
         return Vector2::zeros();
     }
     let dir = c * (1.0 / len);
-    let half = math::asin((0.5 * kappa * len).clamp(-1.0, 1.0));
     let ang = if at_end { half } else { -half };
     let (s, co) = math::sincos(ang);
     Vector2::new(dir[0] * co - dir[1] * s, dir[0] * s + dir[1] * co)
+}
+
+/// The tangent at the middle sample from the tangents there of its two chords.
+fn middle_tangent(t1: Vector2, t2: Vector2) -> Vector2 {
+    let s = t1 + t2;
+    let l = geometry::norm(&s);
+    if l > 0.0 {
+        s * (1.0 / l)
+    } else {
+        t2
+    }
 }
 
 /// Estimate against the circle through `a → b → c` at whichever of the three is `anchor`
 /// (0 = a, 1 = b, 2 = c).
 pub(crate) fn triple_error(p: Vector2, pts: [Vector2; 3], anchor: usize) -> ContourEstimate {
     let [a, b, c] = pts;
-    let chords = [geometry::norm(&(b - a)), geometry::norm(&(c - b))];
-    triple_error_with_chords(p, pts, chords, anchor)
-}
-
-/// [`triple_error`] given the lengths of the chords a → b and b → c, |b − a| and |c − b|
-/// as [`geometry::norm`] measures them (a caller that keeps them measures each once).
-pub(crate) fn triple_error_with_chords(
-    p: Vector2,
-    pts: [Vector2; 3],
-    chords: [f64; 2],
-    anchor: usize,
-) -> ContourEstimate {
-    let [a, b, c] = pts;
     let (ab, bc) = (b - a, c - b);
-    let [ab_len, bc_len] = chords;
+    let [ab_len, bc_len] = [geometry::norm(&ab), geometry::norm(&bc)];
     let k = curvature_of(ab, bc, ab_len, bc_len, &(c - a));
     let t = match anchor {
-        0 => chord_tangent(ab, ab_len, k, false),
-        2 => chord_tangent(bc, bc_len, k, true),
-        _ => {
-            let t1 = chord_tangent(ab, ab_len, k, true);
-            let t2 = chord_tangent(bc, bc_len, k, false);
-            let s = t1 + t2;
-            let l = geometry::norm(&s);
-            if l > 0.0 {
-                s * (1.0 / l)
-            } else {
-                t2
-            }
-        }
+        0 => chord_tangent(ab, ab_len, half_angle(ab_len, k), false),
+        2 => chord_tangent(bc, bc_len, half_angle(bc_len, k), true),
+        _ => middle_tangent(
+            chord_tangent(ab, ab_len, half_angle(ab_len, k), true),
+            chord_tangent(bc, bc_len, half_angle(bc_len, k), false),
+        ),
     };
     circle_error(p, pts[anchor.min(2)], t, k)
+}
+
+/// The circle through three samples `a → b → c`, ready to be evaluated at any of them: its
+/// curvature and the unit tangent of travel at each sample. It depends on the samples
+/// alone, so an estimator that meets the same three again keeps it instead of measuring
+/// it again (the asin, sincos and hypot calls are most of an estimate's cost).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct SampleCircle {
+    kappa: f64,
+    tangents: [Vector2; 3],
+}
+
+impl SampleCircle {
+    /// The circle through `pts`, given the lengths of the chords a → b and b → c as
+    /// [`geometry::norm`] measures them. Evaluated at a sample, it gives the bits of
+    /// [`triple_error`] there.
+    pub(crate) fn through(pts: [Vector2; 3], chords: [f64; 2]) -> Self {
+        let [a, b, c] = pts;
+        let (ab, bc) = (b - a, c - b);
+        let [ab_len, bc_len] = chords;
+        let kappa = curvature_of(ab, bc, ab_len, bc_len, &(c - a));
+        let (ab_half, bc_half) = (half_angle(ab_len, kappa), half_angle(bc_len, kappa));
+        let tangents = [
+            chord_tangent(ab, ab_len, ab_half, false),
+            middle_tangent(
+                chord_tangent(ab, ab_len, ab_half, true),
+                chord_tangent(bc, bc_len, bc_half, false),
+            ),
+            chord_tangent(bc, bc_len, bc_half, true),
+        ];
+        SampleCircle { kappa, tangents }
+    }
+
+    /// The estimate of `p` against this circle at its sample `anchor` (0 = a, 1 = b,
+    /// 2 = c), which is `at`.
+    pub(crate) fn error(&self, p: Vector2, at: Vector2, anchor: usize) -> ContourEstimate {
+        circle_error(p, at, self.tangents[anchor.min(2)], self.kappa)
+    }
 }
 
 /// Mean of two estimates: errors averaged, normals averaged and renormalised.
@@ -134,6 +167,41 @@ mod tests {
         // κ = 0: line distance.
         let e = circle_error(Vector2::new(5.0, -3.0), a, Vector2::new(0.0, 1.0), 0.0);
         assert!((e.error - 4.0).abs() < 1e-15 && e.normal == Vector2::new(-1.0, 0.0));
+    }
+
+    /// A kept circle evaluated at any of its samples gives the bits of the estimate
+    /// measured from the three samples there.
+    #[test]
+    fn a_sample_circle_gives_the_triple_estimates() {
+        use rand::rngs::StdRng;
+        use rand::{RngExt, SeedableRng};
+        let mut rng = StdRng::seed_from_u64(11);
+        for i in 0..20_000 {
+            let scale = [1e-3, 1.0, 50.0][i % 3];
+            let mut v = || {
+                Vector2::new(
+                    rng.random_range(-scale..scale),
+                    rng.random_range(-scale..scale),
+                )
+            };
+            let (a, p) = (v(), v());
+            // Collinear, coincident and sharp triples too.
+            let (b, c) = match i % 5 {
+                0 => (a * 2.0, a * 3.0),
+                1 => (a, v()),
+                _ => (v(), v()),
+            };
+            let pts = [a, b, c];
+            let chords = [geometry::norm(&(b - a)), geometry::norm(&(c - b))];
+            let circle = SampleCircle::through(pts, chords);
+            for anchor in 0..3 {
+                assert_eq!(
+                    circle.error(p, pts[anchor], anchor),
+                    triple_error(p, pts, anchor),
+                    "{pts:?} at {anchor}"
+                );
+            }
+        }
     }
 
     #[test]
