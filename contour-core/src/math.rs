@@ -40,6 +40,38 @@ mod tests {
     use rand::rngs::StdRng;
     use rand::{RngExt, SeedableRng};
 
+    /// The circle estimators turn a chord both ways with one `sincos`: that needs
+    /// sin(−x) = −sin x and cos(−x) = cos x bit for bit, over the reduction's branches.
+    #[test]
+    fn sincos_is_odd_and_even_bit_for_bit() {
+        let mut rng = StdRng::seed_from_u64(3);
+        // Zero, subnormal, tiny, around π/4, 3π/4 and 5π/4 (where the reduction changes).
+        let quarter = std::f64::consts::FRAC_PI_4;
+        let special = [
+            0.0,
+            1e-320,
+            1e-9,
+            0.785,
+            quarter,
+            3.0 * quarter,
+            5.0 * quarter,
+        ];
+        let random = (0..1_000_000).map(|i| match i % 3 {
+            0 => rng.random_range(0.0..1.6),
+            1 => rng.random_range(0.0..100.0),
+            _ => pow(10.0, rng.random_range(-300.0..300.0)),
+        });
+        for x in special.into_iter().chain(random) {
+            let (s, c) = sincos(x);
+            let (sn, cn) = sincos(-x);
+            assert_eq!(
+                (sn.to_bits(), cn.to_bits()),
+                ((-s).to_bits(), c.to_bits()),
+                "{x}"
+            );
+        }
+    }
+
     #[test]
     fn the_quadrant_angle_is_atan2_bit_for_bit() {
         let mut rng = StdRng::seed_from_u64(7);

@@ -109,18 +109,9 @@ impl FuzzyEngine {
             clip_levels(ki, fe, fc),
             clip_levels(kd, fe, fc),
         ];
-        // Set by set, the three outputs side by side: the centroids are computed together.
-        // Four lanes (the last a copy of the third) pair up in vector registers.
-        let mut by_set = [[0.0; 4]; 7];
-        for (set, lanes) in by_set.iter_mut().enumerate() {
-            *lanes = [
-                levels[0][set],
-                levels[1][set],
-                levels[2][set],
-                levels[2][set],
-            ];
-        }
-        let [dkp, dki, dkd, _] = centroids(by_set);
+        // Set by set, ΔKp′ and ΔKi′ side by side in one vector register; ΔKd′ alone.
+        let [dkp, dki] = centroids(std::array::from_fn(|set| [levels[0][set], levels[1][set]]));
+        let [dkd] = centroids(levels[2].map(|level| [level]));
         FuzzyOutput { dkp, dki, dkd }
     }
 

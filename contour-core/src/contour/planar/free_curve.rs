@@ -202,6 +202,32 @@ impl FreeCurveEstimator {
         }
     }
 
+    /// Rε: how many samples back from the newest the distance to `actual` stops
+    /// decreasing. Newest to oldest is the ring's part up to `head` backwards, then the
+    /// rest backwards: two plain loops over slices.
+    fn walk_back(&self, actual: Vector2) -> usize {
+        let (front, back) = self.buf.split_at((self.head + 1).min(self.buf.len()));
+        let front = &front[front.len().saturating_sub(self.len)..];
+        let back = &back[back.len().saturating_sub(self.len - front.len())..];
+        let Some((newest, front)) = front.split_last() else {
+            return 0;
+        };
+        let mut d = geometry::dist2(&actual, newest);
+        let mut k = 0;
+        for part in [front, back] {
+            for r in part.iter().rev() {
+                let dn = geometry::dist2(&actual, r);
+                if dn < d {
+                    d = dn;
+                    k += 1;
+                } else {
+                    return k;
+                }
+            }
+        }
+        k
+    }
+
     /// Circle through the samples centred on `m` (m+1 older, m−1 newer), evaluated at the
     /// sample `k` (which must be one of the three); `None` if unavailable.
     fn triple(&mut self, p: Vector2, m: usize, k: usize) -> Option<ContourEstimate> {
@@ -225,21 +251,7 @@ impl ContourEstimator for FreeCurveEstimator {
             }
             _ => {}
         }
-        // Walk back from the command point while the distance decreases: newest to
-        // oldest is the ring's front part backwards, then its back part backwards.
-        let (front, back) = self.buf.split_at(self.head + 1);
-        let mut older = front.iter().rev().chain(back.iter().rev()).take(self.len);
-        let mut k = 0;
-        let mut d = older.next().map_or(0.0, |r| geometry::dist2(&actual, r));
-        for r in older {
-            let dn = geometry::dist2(&actual, r);
-            if dn < d {
-                d = dn;
-                k += 1;
-            } else {
-                break;
-            }
-        }
+        let k = self.walk_back(actual);
         let re = self.get(k);
         let ahead = k >= 1 && (actual - re).dot(&(self.get(k - 1) - re)) > 0.0;
         // The foot lies between Rε and its neighbour on P's side. Both circles whose three

@@ -48,22 +48,19 @@ fn curvature_of(ab: Vector2, bc: Vector2, ab_len: f64, bc_len: f64, ac: &Vector2
     }
 }
 
-/// Half the angle a chord of length `len` subtends on a circle of curvature `kappa`: the
-/// turn between the chord's direction and the tangent at either end.
-fn half_angle(len: f64, kappa: f64) -> f64 {
-    math::asin((0.5 * kappa * len).clamp(-1.0, 1.0))
-}
-
-/// Unit tangent at an end of the chord `c` (length `len`, half angle `half`): the chord
-/// direction turned back (at its start) or forward (at its end, `at_end`) by `half`.
-fn chord_tangent(c: Vector2, len: f64, half: f64, at_end: bool) -> Vector2 {
+/// The unit tangents at the start and at the end of the chord `c` (length `len`) of a
+/// circle of curvature `kappa`: the chord's direction turned back and forward by half
+/// the angle the chord subtends. One `sincos` serves both ends: it is odd in the sine and
+/// even in the cosine bit for bit (`math`'s tests check it).
+fn chord_tangents(c: Vector2, len: f64, kappa: f64) -> [Vector2; 2] {
     if len == 0.0 {
-        return Vector2::zeros();
+        return [Vector2::zeros(); 2];
     }
     let dir = c * (1.0 / len);
-    let ang = if at_end { half } else { -half };
-    let (s, co) = math::sincos(ang);
-    Vector2::new(dir[0] * co - dir[1] * s, dir[0] * s + dir[1] * co)
+    let half = math::asin((0.5 * kappa * len).clamp(-1.0, 1.0));
+    let (s, co) = math::sincos(half);
+    let turned = |s: f64| Vector2::new(dir[0] * co - dir[1] * s, dir[0] * s + dir[1] * co);
+    [turned(-s), turned(s)]
 }
 
 /// The tangent at the middle sample from the tangents there of its two chords.
@@ -85,11 +82,11 @@ pub(crate) fn triple_error(p: Vector2, pts: [Vector2; 3], anchor: usize) -> Cont
     let [ab_len, bc_len] = [geometry::norm(&ab), geometry::norm(&bc)];
     let k = curvature_of(ab, bc, ab_len, bc_len, &(c - a));
     let t = match anchor {
-        0 => chord_tangent(ab, ab_len, half_angle(ab_len, k), false),
-        2 => chord_tangent(bc, bc_len, half_angle(bc_len, k), true),
+        0 => chord_tangents(ab, ab_len, k)[0],
+        2 => chord_tangents(bc, bc_len, k)[1],
         _ => middle_tangent(
-            chord_tangent(ab, ab_len, half_angle(ab_len, k), true),
-            chord_tangent(bc, bc_len, half_angle(bc_len, k), false),
+            chord_tangents(ab, ab_len, k)[1],
+            chord_tangents(bc, bc_len, k)[0],
         ),
     };
     circle_error(p, pts[anchor.min(2)], t, k)
@@ -114,15 +111,9 @@ impl SampleCircle {
         let (ab, bc) = (b - a, c - b);
         let [ab_len, bc_len] = chords;
         let kappa = curvature_of(ab, bc, ab_len, bc_len, &(c - a));
-        let (ab_half, bc_half) = (half_angle(ab_len, kappa), half_angle(bc_len, kappa));
-        let tangents = [
-            chord_tangent(ab, ab_len, ab_half, false),
-            middle_tangent(
-                chord_tangent(ab, ab_len, ab_half, true),
-                chord_tangent(bc, bc_len, bc_half, false),
-            ),
-            chord_tangent(bc, bc_len, bc_half, true),
-        ];
+        let [ab_start, ab_end] = chord_tangents(ab, ab_len, kappa);
+        let [bc_start, bc_end] = chord_tangents(bc, bc_len, kappa);
+        let tangents = [ab_start, middle_tangent(ab_end, bc_start), bc_end];
         SampleCircle { kappa, tangents }
     }
 
