@@ -187,6 +187,7 @@ bench: fmus ccc-tune contour-eval $(VENV)/.test-installed
 	-$(PYTHON) benches/campaign_scaling.py --json $(BENCH_REPORT)/campaign_scaling.json
 	-$(PYTHON) benches/contour_eval_speed.py --json $(BENCH_REPORT)/contour_eval_speed.json
 	-$(PYTHON) benches/restore_fuzz_speed.py --json $(BENCH_REPORT)/restore_fuzz_speed.json
+	-$(PYTHON) benches/ccc_sample_cost.py --json $(BENCH_REPORT)/ccc_sample_cost.json
 	$(PYTHON) benches/report.py
 
 # Every model's life cycle 10 000 times under valgrind's full memcheck: leaks and

@@ -4,9 +4,8 @@ Reads what the bench parts leave in <target>/bench-report/ (<target> is $CARGO_T
 else target/): fmu_abi.json (benches/fmu_abi.rs), c_harness.json and
 c_harness_callgrind.json (benches/c_harness/run.sh), fuzzy_vs_skfuzzy.json,
 tuning_vs_pyswarms_fmu.json, pso_tables.json, native_throughput.json, campaign_scaling.json,
-contour_eval_speed.json and restore_fuzz_speed.json (the Python
-benches' --json), plus
-criterion's own estimates in <target>/criterion/. Prints the page and writes it to
+contour_eval_speed.json, restore_fuzz_speed.json and ccc_sample_cost.json (the Python
+benches' --json), plus criterion's own estimates in <target>/criterion/. Prints the page and writes it to
 <target>/bench-report/report.md. A figure that is missing, or older than the run's start
 (a leftover of an earlier run), is shown as "not measured".
 
@@ -142,6 +141,17 @@ def page():
                 verdict = f"; target <= {target:g}x: " + ("met" if r <= target else "MISSED")
             lines.append(line(f"{model} / bare, {name}", r,
                               f"{ns:.1f} vs {bare_ns:.1f} ns per sample{verdict}" if ns and bare_ns else ""))
+    cost = load("ccc_sample_cost.json")
+    base, goal = cost.get("baseline_rev", "the baseline"), cost.get("target_ratio", 8)
+    after = dig(cost, "over_bare", "after", "importer_loop")
+    detail = ""
+    if after:
+        detail = (f"{base}: {dig(cost, 'over_bare', 'before', 'importer_loop'):.2f}x; target <= {goal:g}x: "
+                  + ("met" if after <= goal else "MISSED")
+                  + f"; outputs identical: {'yes' if cost.get('identical_outputs') else 'NO'}")
+    lines.append(line(f"ContourCCC2D / bare, importer loop, beside {base}", after, detail))
+    lines.append(line(f"ContourCCC2D calls only, this build / {base}",
+                      dig(cost, "calls_only_after_over_before"), "", "{:.3f}x"))
     counted = [f"{name} {int(count):,}" for name, count in instructions.items()
                if isinstance(count, (int, float))]
     lines.append("  instructions per sample, calls only (callgrind): "
