@@ -16,6 +16,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::lanes::F64x2;
 use super::rules::{RuleTable, Term, FUZZY_PID_RULES};
 
 /// Lower and upper edge of the normalised universe; inputs are clamped to it.
@@ -104,14 +105,20 @@ impl FuzzyEngine {
     pub fn evaluate(&self, e: f64, ec: f64) -> FuzzyOutput {
         let (fe, fc) = (fuzzify(e), fuzzify(ec));
         let [kp, ki, kd] = &self.tables;
-        let levels = [
+        let (p, i, d) = (
             clip_levels(kp, fe, fc),
             clip_levels(ki, fe, fc),
             clip_levels(kd, fe, fc),
-        ];
-        // Set by set, ΔKp′ and ΔKi′ side by side in one vector register; ΔKd′ alone.
-        let [dkp, dki] = centroids(std::array::from_fn(|set| [levels[0][set], levels[1][set]]));
-        let [dkd] = centroids(levels[2].map(|level| [level]));
+        );
+        // ΔKp′ and ΔKi′ side by side in the two lanes of one vector register, ΔKd′ in both
+        // of another (plain loops: closures here were left uninlined).
+        let (mut pi, mut dd) = ([F64x2::splat(0.0); 7], [F64x2::splat(0.0); 7]);
+        for set in 0..7 {
+            pi[set] = F64x2([p[set], i[set]]);
+            dd[set] = F64x2::splat(d[set]);
+        }
+        let [dkp, dki] = centroids(pi).0;
+        let [dkd, _] = centroids(dd).0;
         FuzzyOutput { dkp, dki, dkd }
     }
 
@@ -130,67 +137,31 @@ pub fn evaluate_table(table: &RuleTable, e: f64, ec: f64) -> f64 {
     infer(table, fuzzify(e), fuzzify(ec))
 }
 
-// Inlined with `centroid` into `infer`: the levels then stay in registers.
 #[inline(always)]
 fn clip_levels(table: &RuleTable, fe: (usize, f64, f64), fc: (usize, f64, f64)) -> [f64; 7] {
+    let mut h = [0.0_f64; 7];
     let (ie, le, ue) = fe;
     let (ic, lc, uc) = fc;
     // Only the 2 × 2 block of rules around the inputs can fire; a rule of strength 0
     // leaves its level unchanged, so no case analysis is needed.
-    let fired = [
-        (table[ie][ic].index(), le.min(lc)),
-        (table[ie][ic + 1].index(), le.min(uc)),
-        (table[ie + 1][ic].index(), ue.min(lc)),
-        (table[ie + 1][ic + 1].index(), ue.min(uc)),
-    ];
-    // Each level chosen in registers, not stored at a computed index: the centroids read
-    // the levels two at a time, and a wide read of narrow stores waits for them to land.
-    // A strength times its set's row of the identity is itself there and +0 elsewhere
-    // (strengths are finite and ≥ 0), so every level is the largest strength that fires
-    // its set, or 0, as rule by rule; no branches, and `greater` is one instruction.
-    let mut h = [0.0; 7];
-    for (out, strength) in fired {
-        for (level, one) in h.iter_mut().zip(IDENTITY[out]) {
-            *level = greater(*level, strength * one);
-        }
+    // The memberships are in [0, 1], never NaN or −0 (`fuzzify`), where plain
+    // comparisons give f64::min's and max's bits without their NaN checks.
+    let lesser = |a: f64, b: f64| if b < a { b } else { a };
+    for (i, j, strength) in [
+        (ie, ic, lesser(le, lc)),
+        (ie, ic + 1, lesser(le, uc)),
+        (ie + 1, ic, lesser(ue, lc)),
+        (ie + 1, ic + 1, lesser(ue, uc)),
+    ] {
+        let slot = &mut h[table[i][j].index()];
+        *slot = if strength > *slot { strength } else { *slot };
     }
     h
 }
 
-/// Row `j` picks set `j`.
-const IDENTITY: [[f64; 7]; 7] = {
-    let mut rows = [[0.0; 7]; 7];
-    let mut j = 0;
-    while j < 7 {
-        rows[j][j] = 1.0;
-        j += 1;
-    }
-    rows
-};
-
 #[inline]
 fn infer(table: &RuleTable, fe: (usize, f64, f64), fc: (usize, f64, f64)) -> f64 {
     centroid(&clip_levels(table, fe, fc))
-}
-
-/// The smaller of two numbers neither of which is NaN (`f64::min` also checks for NaN).
-#[inline(always)]
-fn lesser(a: f64, b: f64) -> f64 {
-    if b < a {
-        b
-    } else {
-        a
-    }
-}
-
-/// The larger of two numbers neither of which is NaN (`f64::max` also checks for NaN).
-#[inline(always)]
-fn greater(a: f64, b: f64) -> f64 {
-    if b > a {
-        b
-    } else {
-        a
-    }
 }
 
 /// Exact centroid of the aggregate `max_j min(h[j], triangle_j(y))` on [−3, 3].
@@ -214,54 +185,42 @@ fn greater(a: f64, b: f64) -> f64 {
 /// happen, because the memberships of any input sum to one, so some rule fires with
 /// strength ≥ 1/2; the fallback only guards custom or degenerate use. Levels are taken
 /// as clamped to [0, 1], NaN as 0.
-#[inline(always)]
 pub fn centroid(h: &[f64; 7]) -> f64 {
     // Levels outside [0, 1] (or NaN) cannot come from the rules; clamp them for custom use.
-    let [c] = centroids(h.map(|v| [if v > 0.0 { v.min(1.0) } else { 0.0 }]));
-    c
+    let h = h.map(|v| if v > 0.0 { v.min(1.0) } else { 0.0 });
+    centroids(h.map(F64x2::splat)).0[0]
 }
 
-/// [`centroid`] of `N` aggregates at once, `h[set][k]` the clip level of `set` in the
-/// `k`-th, each in [0, 1] (not NaN, not −0): the same operations in the same order on
-/// each, so every result has the bits [`centroid`] gives it alone; laid out lane by lane,
-/// so the compiler computes the aggregates side by side in vector registers.
+/// [`centroid`] of two aggregates at once, one in each lane, from levels in [0, 1] (not
+/// NaN, not −0): each lane gets the operations of the formula in its order, so the bits
+/// are those of one aggregate computed alone, and the lanes never mix, which keeps the
+/// compiler to one vector instruction per operation.
 #[inline(always)]
-fn centroids<const N: usize>(h: [[f64; N]; 7]) -> [f64; N] {
-    // Plain loops over constant bounds: unrolled and vectorised across k. Nothing is NaN
-    // or −0, where `lesser` and `f64::min` agree.
+fn centroids(h: [F64x2; 7]) -> F64x2 {
+    let (one, two, half) = (F64x2::splat(1.0), F64x2::splat(2.0), F64x2::splat(0.5));
     // Set areas (edge sets are half triangles) and the overlaps of neighbours; kept as
     // independent terms so the sums below do not form one long dependency chain.
-    let mut a = [[0.0; N]; 7];
-    for j in 0..7 {
-        for k in 0..N {
-            let full = h[j][k] * (2.0 - h[j][k]);
-            a[j][k] = if j == 0 || j == 6 { 0.5 * full } else { full };
-        }
+    let mut a = [F64x2::splat(0.0); 7];
+    for (j, (a, &h)) in a.iter_mut().zip(&h).enumerate() {
+        let full = h * (two - h);
+        *a = if j == 0 || j == 6 { half * full } else { full };
     }
-    let mut o = [[0.0; N]; 6];
-    for j in 0..6 {
-        for k in 0..N {
-            let m = lesser(lesser(h[j][k], h[j + 1][k]), 0.5);
-            o[j][k] = m - m * m;
-        }
+    let mut o = [F64x2::splat(0.0); 6];
+    for (o, pair) in o.iter_mut().zip(h.windows(2)) {
+        let m = pair[0].lesser(pair[1]).lesser(half);
+        *o = m - m * m;
     }
-    let mut c = [0.0; N];
-    for k in 0..N {
-        // Edge sets: moment about their own centre, toward the inside.
-        let q0 = 1.0 - h[0][k];
-        let q6 = 1.0 - h[6][k];
-        let edge = ((1.0 - q0 * q0 * q0) - (1.0 - q6 * q6 * q6)) / 6.0;
-        let area = (a[0][k] + a[6][k]) + (a[1][k] + a[5][k]) + (a[2][k] + a[4][k]) + a[3][k]
-            - ((o[0][k] + o[5][k]) + (o[1][k] + o[4][k]) + (o[2][k] + o[3][k]));
-        // Moments about y = 0: centres −3 … 3, overlap midpoints −2.5 … 2.5.
-        let moment = 3.0 * (a[6][k] - a[0][k])
-            + 2.0 * (a[5][k] - a[1][k])
-            + (a[4][k] - a[2][k])
-            + edge
-            - (2.5 * (o[5][k] - o[0][k]) + 1.5 * (o[4][k] - o[1][k]) + 0.5 * (o[3][k] - o[2][k]));
-        c[k] = if area > 0.0 { moment / area } else { 0.0 };
-    }
-    c
+    // Edge sets: moment about their own centre, toward the inside.
+    let q0 = one - h[0];
+    let q6 = one - h[6];
+    let edge = ((one - q0 * q0 * q0) - (one - q6 * q6 * q6)) / F64x2::splat(6.0);
+    let area = (a[0] + a[6]) + (a[1] + a[5]) + (a[2] + a[4]) + a[3]
+        - ((o[0] + o[5]) + (o[1] + o[4]) + (o[2] + o[3]));
+    // Moments about y = 0: centres −3 … 3, overlap midpoints −2.5 … 2.5.
+    let times = F64x2::splat;
+    let moment = times(3.0) * (a[6] - a[0]) + times(2.0) * (a[5] - a[1]) + (a[4] - a[2]) + edge
+        - (times(2.5) * (o[5] - o[0]) + times(1.5) * (o[4] - o[1]) + half * (o[3] - o[2]));
+    (moment / area).where_positive(area)
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@ mod cross_coupled;
 mod feed_forward;
 mod five_axis;
 mod fuzzy;
+mod lanes;
 mod pid;
 mod rules;
 mod velocity_drive;

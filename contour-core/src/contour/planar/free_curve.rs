@@ -168,7 +168,12 @@ impl FreeCurveEstimator {
             return;
         }
         let cap = self.buf.len();
-        self.head = (self.head + 1) % cap;
+        // No `%`: a division costs more than the rest of the push's bookkeeping.
+        self.head = if self.head + 1 < cap {
+            self.head + 1
+        } else {
+            0
+        };
         self.buf[self.head] = r;
         self.chords[self.head] = chord;
         self.circles[self.head] = None;
@@ -187,19 +192,14 @@ impl FreeCurveEstimator {
         )
     }
 
-    /// [`Self::measure_circle`], kept.
-    fn circle(&mut self, m: usize) -> SampleCircle {
-        let i = self.index(m);
-        match self.circles.get(i).copied().flatten() {
-            Some(circle) => circle,
-            None => {
-                let circle = self.measure_circle(m);
-                if let Some(slot) = self.circles.get_mut(i) {
-                    *slot = Some(circle);
-                }
-                circle
-            }
+    /// [`Self::measure_circle`], kept (and lent, not copied).
+    fn circle(&mut self, m: usize) -> &SampleCircle {
+        let i = self.index(m).min(self.circles.len() - 1);
+        if self.circles[i].is_none() {
+            self.circles[i] = Some(self.measure_circle(m));
         }
+        // Never inserts: the slot was filled just above if it was empty.
+        self.circles[i].get_or_insert_default()
     }
 
     /// Rε: how many samples back from the newest the distance to `actual` stops
@@ -234,7 +234,8 @@ impl FreeCurveEstimator {
         if m == 0 || m + 1 >= self.len || k + 1 < m || k > m + 1 {
             return None;
         }
-        Some(self.circle(m).error(p, self.get(k), m + 1 - k))
+        let at = self.get(k);
+        Some(self.circle(m).error(p, at, m + 1 - k))
     }
 }
 
