@@ -152,6 +152,9 @@ def page():
     lines.append(line(f"ContourCCC2D / bare, importer loop, beside {base}", after, detail))
     lines.append(line(f"ContourCCC2D calls only, this build / {base}",
                       dig(cost, "calls_only_after_over_before"), "", "{:.3f}x"))
+    lines.append(line("ContourCCC2D, program estimator / bare, importer loop",
+                      dig(cost, "over_bare", "program", "importer_loop"),
+                      f"calls {dig(cost, 'program_over_free_curve') or 0:.2f}x the free-curve estimator's"))
     counted = [f"{name} {int(count):,}" for name, count in instructions.items()
                if isinstance(count, (int, float))]
     lines.append("  instructions per sample, calls only (callgrind): "

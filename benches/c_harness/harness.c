@@ -1,7 +1,7 @@
 /* The C harness of issue 21: what one sample costs an importer written in C.
  *
  *   harness [--samples N] [--passes P] [--warmup W] [--json FILE] [--only LABEL]
- *           [--dump FILE] LABEL=LIBRARY:MODEL_DESCRIPTION ...
+ *           [--dump FILE] [--set LABEL:NAME=VALUE ...] LABEL=LIBRARY:MODEL_DESCRIPTION ...
  *
  * Each model is dlopen'ed from LIBRARY (an FMU's binaries/linux64/<id>.so), its GUID,
  * model identifier and Real inputs and outputs read from MODEL_DESCRIPTION (the FMU's
@@ -36,6 +36,10 @@
  * --toggle-collect=run_calls_only: instructions / (N * (W + P)) is then the instruction
  * count of one sample's calls (benches/c_harness/run.sh --callgrind).
  *
+ * --set LABEL:NAME=VALUE sets the Integer, Enumeration or String parameter NAME of model
+ * LABEL before initialization (ContourCCC2D's estimator and path: the program estimator
+ * beside the free-curve one; benches/ccc_sample_cost.py).
+ *
  * --dump FILE writes every output of every calls_only sample (doubles, in the machine's
  * byte order): two builds of a library compute the same outputs if their dumps are equal
  * byte for byte (run with --only LABEL and the same N, P and W).
@@ -67,6 +71,8 @@ enum signal { REF_X, REF_Y, POS_X, POS_Y, U_X, U_Y, ZERO, SIGNALS };
 #define INSIDE 0.050
 #define PI 3.14159265358979323846
 
+#define MAX_SETTINGS 8
+
 typedef struct {
     const char *label;
     const char *library;
@@ -81,6 +87,10 @@ typedef struct {
     fmi2SetRealTYPE *set_real;
     fmi2GetRealTYPE *get_real;
     fmi2DoStepTYPE *do_step;
+    fmi2SetIntegerTYPE *set_integer;
+    fmi2SetStringTYPE *set_string;
+    const char *setting[MAX_SETTINGS]; /* NAME=VALUE */
+    size_t n_settings;
     fmi2Component c;
     fmi2ValueReference in_vr[MAX_VARS];
     enum signal in_signal[MAX_VARS];
@@ -173,6 +183,53 @@ static inline void circle(double t, double value[SIGNALS]) {
     value[ZERO] = 0.0;
 }
 
+/* The value reference and type element ("Integer", "Enumeration", "String", ...) of the
+   variable called `name` in a modelDescription.xml; dies if there is none. */
+static fmi2ValueReference variable(const char *path, const char *wanted, char *type,
+                                   size_t size) {
+    char *xml = read_file(path);
+    for (const char *v = strstr(xml, "<ScalarVariable"); v; v = strstr(v + 1, "<ScalarVariable")) {
+        const char *head_end = strchr(v, '>');
+        char name[256], vr[32];
+        if (!head_end || !attribute(v, head_end, "name", name, sizeof name) || strcmp(name, wanted))
+            continue;
+        if (!attribute(v, head_end, "valueReference", vr, sizeof vr)) break;
+        const char *element = head_end + 1;
+        while (*element && *element != '<') element++;
+        size_t n = strcspn(element + 1, " />\n\t");
+        if (!*element || n >= size) break;
+        memcpy(type, element + 1, n);
+        type[n] = 0;
+        free(xml);
+        return (fmi2ValueReference)strtoul(vr, NULL, 10);
+    }
+    die("%s: no variable %s", path, wanted);
+    return 0;
+}
+
+/* Applies the model's --set NAME=VALUE settings (before initialization). */
+static void apply_settings(Model *m) {
+    for (size_t i = 0; i < m->n_settings; i++) {
+        char name[256], type[32];
+        const char *eq = strchr(m->setting[i], '=');
+        if (!eq || (size_t)(eq - m->setting[i]) >= sizeof name) die("bad --set %s", m->setting[i]);
+        memcpy(name, m->setting[i], (size_t)(eq - m->setting[i]));
+        name[eq - m->setting[i]] = 0;
+        fmi2ValueReference vr = variable(m->description_path, name, type, sizeof type);
+        fmi2Status status;
+        if (!strcmp(type, "String")) {
+            fmi2String value = eq + 1;
+            status = m->set_string(m->c, &vr, 1, &value);
+        } else if (!strcmp(type, "Integer") || !strcmp(type, "Enumeration")) {
+            fmi2Integer value = (fmi2Integer)strtol(eq + 1, NULL, 10);
+            status = m->set_integer(m->c, &vr, 1, &value);
+        } else {
+            die("%s: --set takes Integer, Enumeration or String variables, not %s", name, type);
+        }
+        if (status != fmi2OK) die("%s: setting %s failed", m->label, m->setting[i]);
+    }
+}
+
 /* GUID, model identifier and the Real inputs and outputs of a modelDescription.xml. */
 static void read_description(Model *m) {
     char *xml = read_file(m->description_path);
@@ -233,9 +290,14 @@ static void start(Model *m) {
     m->set_real = (fmi2SetRealTYPE *)symbol(library, m->library, "fmi2SetReal");
     m->get_real = (fmi2GetRealTYPE *)symbol(library, m->library, "fmi2GetReal");
     m->do_step = (fmi2DoStepTYPE *)symbol(library, m->library, "fmi2DoStep");
+    if (m->n_settings) {
+        m->set_integer = (fmi2SetIntegerTYPE *)symbol(library, m->library, "fmi2SetInteger");
+        m->set_string = (fmi2SetStringTYPE *)symbol(library, m->library, "fmi2SetString");
+    }
     m->c = m->instantiate(m->label, fmi2CoSimulation, m->guid, NULL, &CALLBACKS, fmi2False,
                           fmi2False);
     if (!m->c) die("%s: fmi2Instantiate(%s, %s) failed", m->label, m->identifier, m->guid);
+    apply_settings(m);
     if (m->setup_experiment(m->c, fmi2False, 0.0, 0.0, fmi2False, 0.0) != fmi2OK ||
         m->enter_initialization(m->c) != fmi2OK || m->exit_initialization(m->c) != fmi2OK)
         die("%s: initialization failed", m->label);
@@ -314,6 +376,8 @@ int main(int argc, char **argv) {
     const char *json = NULL, *only = NULL;
     Model models[MAX_MODELS];
     size_t n = 0;
+    const char *settings[MAX_MODELS * MAX_SETTINGS];
+    size_t n_settings = 0;
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         if (!strcmp(arg, "--samples") && i + 1 < argc) samples = strtoul(argv[++i], NULL, 10);
@@ -321,6 +385,10 @@ int main(int argc, char **argv) {
         else if (!strcmp(arg, "--warmup") && i + 1 < argc) warmup = strtoul(argv[++i], NULL, 10);
         else if (!strcmp(arg, "--json") && i + 1 < argc) json = argv[++i];
         else if (!strcmp(arg, "--only") && i + 1 < argc) only = argv[++i];
+        else if (!strcmp(arg, "--set") && i + 1 < argc) {
+            if (n_settings == MAX_MODELS * MAX_SETTINGS) die("too many --set");
+            settings[n_settings++] = argv[++i];
+        }
         else if (!strcmp(arg, "--dump") && i + 1 < argc) {
             if (!(dump = fopen(argv[++i], "wb"))) die("cannot write %s", argv[i]);
         }
@@ -339,7 +407,18 @@ int main(int argc, char **argv) {
     }
     if (!n || !samples || !passes)
         die("usage: harness [--samples N] [--passes P] [--warmup W] [--json FILE] "
-            "[--only LABEL] [--dump FILE] LABEL=LIB:XML ...");
+            "[--only LABEL] [--dump FILE] [--set LABEL:NAME=VALUE ...] LABEL=LIB:XML ...");
+    for (size_t k = 0; k < n_settings; k++) {
+        const char *colon = strchr(settings[k], ':');
+        size_t found = n;
+        for (size_t i = 0; colon && i < n; i++)
+            if (strlen(models[i].label) == (size_t)(colon - settings[k]) &&
+                !strncmp(models[i].label, settings[k], (size_t)(colon - settings[k])))
+                found = i;
+        if (found == n) die("--set %s: expected LABEL:NAME=VALUE for a model given", settings[k]);
+        if (models[found].n_settings == MAX_SETTINGS) die("too many --set for %s", models[found].label);
+        models[found].setting[models[found].n_settings++] = colon + 1;
+    }
     if (only) {
         size_t kept = 0;
         for (size_t i = 0; i < n; i++)
