@@ -18,7 +18,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::local_circle::{self, SampleCircle};
+use super::local_circle::{self, CircleStart, SampleCircle};
 use crate::contour::{ContourEstimate, ContourEstimator};
 use crate::geometry::{self, Vector2};
 
@@ -56,12 +56,21 @@ pub struct FreeCurveEstimator {
     /// derived from the samples, so neither saved nor compared.
     chords: Vec<f64>,
     /// `circles[i]`: the circle through the samples around `buf[i]` (the one before it,
-    /// it, the one after), kept from when `push` made it: the walk back meets the same
-    /// circles for many samples, and measuring one takes most of an estimate's time. Made
-    /// when its newest sample arrives, off the path from the actual point to the
-    /// estimate; `None` after a restore until first needed. Derived, so neither saved nor
-    /// compared.
-    circles: Vec<Option<SampleCircle>>,
+    /// it, the one after), kept: the walk back meets the same circles for many samples,
+    /// and measuring one takes most of an estimate's time. Started once its newest sample
+    /// has arrived and finished on the next sample, each time after the estimate (off the
+    /// path from the actual point to it); measured when first needed after a restore.
+    /// Derived, so neither saved nor compared.
+    circles: Vec<KeptCircle>,
+}
+
+/// A circle beside the ring, as far as it has been measured.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+enum KeptCircle {
+    #[default]
+    Unmeasured,
+    Started(CircleStart),
+    Measured(SampleCircle),
 }
 
 impl PartialEq for FreeCurveEstimator {
@@ -78,7 +87,7 @@ impl TryFrom<FreeCurveData> for FreeCurveEstimator {
         }
         let mut estimator = FreeCurveEstimator {
             chords: vec![0.0; d.buf.len()],
-            circles: vec![None; d.buf.len()],
+            circles: vec![KeptCircle::Unmeasured; d.buf.len()],
             buf: d.buf,
             head: d.head,
             len: d.len,
@@ -119,7 +128,7 @@ impl FreeCurveEstimator {
             head: 0,
             len: 0,
             chords: vec![0.0; cap],
-            circles: vec![None; cap],
+            circles: vec![KeptCircle::Unmeasured; cap],
         }
     }
 
@@ -176,30 +185,58 @@ impl FreeCurveEstimator {
         };
         self.buf[self.head] = r;
         self.chords[self.head] = chord;
-        self.circles[self.head] = None;
+        self.circles[self.head] = KeptCircle::Unmeasured;
         self.len = (self.len + 1).min(cap);
-        if self.len >= 3 {
-            // The sample before the new one now has both neighbours.
-            self.circle(1);
-        }
     }
 
-    /// The circle through the samples around the `m`-th latest (`1 ≤ m ≤ len − 2`).
-    fn measure_circle(&self, m: usize) -> SampleCircle {
-        SampleCircle::through(
+    /// The samples around the `m`-th latest (`1 ≤ m ≤ len − 2`), oldest first, and the
+    /// lengths of their two chords.
+    fn around(&self, m: usize) -> ([Vector2; 3], [f64; 2]) {
+        (
             [self.get(m + 1), self.get(m), self.get(m - 1)],
             [self.chord(m), self.chord(m - 1)],
         )
     }
 
-    /// [`Self::measure_circle`], kept (and lent, not copied).
-    fn circle(&mut self, m: usize) -> &SampleCircle {
+    /// The circle through the samples around the `m`-th latest, measured now.
+    #[cfg(test)]
+    fn measure_circle(&self, m: usize) -> SampleCircle {
+        let (pts, chords) = self.around(m);
+        SampleCircle::through(pts, chords)
+    }
+
+    /// The circle through the samples around the `m`-th latest, kept: measured, or
+    /// finished, if it was not yet.
+    fn circle(&mut self, m: usize) -> &KeptCircle {
         let i = self.index(m).min(self.circles.len() - 1);
-        if self.circles[i].is_none() {
-            self.circles[i] = Some(self.measure_circle(m));
+        let start = match self.circles[i] {
+            KeptCircle::Measured(_) => None,
+            KeptCircle::Started(start) => Some(start),
+            KeptCircle::Unmeasured => {
+                let (pts, chords) = self.around(m);
+                Some(SampleCircle::start(pts, chords))
+            }
+        };
+        if let Some(start) = start {
+            let (pts, chords) = self.around(m);
+            self.circles[i] = KeptCircle::Measured(SampleCircle::finish(start, pts, chords));
         }
-        // Never inserts: the slot was filled just above if it was empty.
-        self.circles[i].get_or_insert_default()
+        &self.circles[i]
+    }
+
+    /// After an estimate: starts the circle around the sample before the newest (its
+    /// newer neighbour has just arrived) and finishes the one started last time.
+    fn measure_ahead(&mut self) {
+        if self.len >= 3 {
+            let i = self.index(1).min(self.circles.len() - 1);
+            if self.circles[i] == KeptCircle::Unmeasured {
+                let (pts, chords) = self.around(1);
+                self.circles[i] = KeptCircle::Started(SampleCircle::start(pts, chords));
+            }
+        }
+        if self.len >= 4 {
+            self.circle(2);
+        }
     }
 
     /// Rε: how many samples back from the newest the distance to `actual` stops
@@ -235,7 +272,10 @@ impl FreeCurveEstimator {
             return None;
         }
         let at = self.get(k);
-        Some(self.circle(m).error(p, at, m + 1 - k))
+        match self.circle(m) {
+            KeptCircle::Measured(circle) => Some(circle.error(p, at, m + 1 - k)),
+            _ => None,
+        }
     }
 }
 
@@ -264,20 +304,22 @@ impl ContourEstimator for FreeCurveEstimator {
         } else {
             self.triple(actual, k + 1, k)
         };
-        match (centred, beside) {
+        let result = match (centred, beside) {
             (Some(a), Some(b)) => local_circle::mean(a, b),
             (Some(e), None) | (None, Some(e)) => e,
             // Rε is the oldest sample: the circle (Rε, Rε+1, Rε+2); len ≥ 3 guarantees it.
             (None, None) => self
                 .triple(actual, k.saturating_sub(1), k)
                 .unwrap_or_default(),
-        }
+        };
+        self.measure_ahead();
+        result
     }
 
     fn reset(&mut self) {
         self.head = 0;
         self.len = 0;
-        self.circles.fill(None);
+        self.circles.fill(KeptCircle::Unmeasured);
     }
 }
 
@@ -339,8 +381,13 @@ mod tests {
     fn kept_circles_are_those_of_the_samples_now() {
         fn check(e: &FreeCurveEstimator) {
             for m in 1..e.len().saturating_sub(1) {
-                if let Some(kept) = e.circles[e.index(m)] {
-                    assert_eq!(kept, e.measure_circle(m), "m = {m}");
+                let (pts, chords) = e.around(m);
+                match e.circles[e.index(m)] {
+                    KeptCircle::Measured(kept) => assert_eq!(kept, e.measure_circle(m), "m = {m}"),
+                    KeptCircle::Started(kept) => {
+                        assert_eq!(kept, SampleCircle::start(pts, chords), "m = {m}")
+                    }
+                    KeptCircle::Unmeasured => {}
                 }
             }
         }
@@ -365,8 +412,10 @@ mod tests {
                 assert!(r.error.is_finite());
             }
         }
-        // Every circle in use after the last sample was kept.
-        assert!((1..e.len() - 1).all(|m| e.circles[e.index(m)].is_some()));
+        // After the last sample: the circle around the sample before the newest started,
+        // every older one measured.
+        assert!(matches!(e.circles[e.index(1)], KeptCircle::Started(_)));
+        assert!((2..e.len() - 1).all(|m| matches!(e.circles[e.index(m)], KeptCircle::Measured(_))));
     }
 
     /// With a lag longer than the buffer the walk stops at the oldest sample, where only

@@ -48,16 +48,20 @@ fn curvature_of(ab: Vector2, bc: Vector2, ab_len: f64, bc_len: f64, ac: &Vector2
     }
 }
 
-/// The unit tangents at the start and at the end of the chord `c` (length `len`) of a
-/// circle of curvature `kappa`: the chord's direction turned back and forward by half
-/// the angle the chord subtends. One `sincos` serves both ends: it is odd in the sine and
-/// even in the cosine bit for bit (`math`'s tests check it).
-fn chord_tangents(c: Vector2, len: f64, kappa: f64) -> [Vector2; 2] {
+/// Half the angle a chord of length `len` subtends on a circle of curvature `kappa`.
+fn half_angle(len: f64, kappa: f64) -> f64 {
+    math::asin((0.5 * kappa * len).clamp(-1.0, 1.0))
+}
+
+/// The unit tangents at the start and at the end of the chord `c` (length `len`, half
+/// angle `half`): the chord's direction turned back and forward by `half`. One `sincos`
+/// serves both ends: it is odd in the sine and even in the cosine bit for bit (`math`'s
+/// tests check it).
+fn chord_tangents(c: Vector2, len: f64, half: f64) -> [Vector2; 2] {
     if len == 0.0 {
         return [Vector2::zeros(); 2];
     }
     let dir = c * (1.0 / len);
-    let half = math::asin((0.5 * kappa * len).clamp(-1.0, 1.0));
     let (s, co) = math::sincos(half);
     let turned = |s: f64| Vector2::new(dir[0] * co - dir[1] * s, dir[0] * s + dir[1] * co);
     [turned(-s), turned(s)]
@@ -81,13 +85,12 @@ pub(crate) fn triple_error(p: Vector2, pts: [Vector2; 3], anchor: usize) -> Cont
     let (ab, bc) = (b - a, c - b);
     let [ab_len, bc_len] = [geometry::norm(&ab), geometry::norm(&bc)];
     let k = curvature_of(ab, bc, ab_len, bc_len, &(c - a));
+    let ab_tangents = || chord_tangents(ab, ab_len, half_angle(ab_len, k));
+    let bc_tangents = || chord_tangents(bc, bc_len, half_angle(bc_len, k));
     let t = match anchor {
-        0 => chord_tangents(ab, ab_len, k)[0],
-        2 => chord_tangents(bc, bc_len, k)[1],
-        _ => middle_tangent(
-            chord_tangents(ab, ab_len, k)[1],
-            chord_tangents(bc, bc_len, k)[0],
-        ),
+        0 => ab_tangents()[0],
+        2 => bc_tangents()[1],
+        _ => middle_tangent(ab_tangents()[1], bc_tangents()[0]),
     };
     circle_error(p, pts[anchor.min(2)], t, k)
 }
@@ -102,19 +105,46 @@ pub(crate) struct SampleCircle {
     tangents: [Vector2; 3],
 }
 
+/// The first half of measuring a [`SampleCircle`]: its curvature and the half angle each
+/// chord subtends. Measured on one sample and finished on the next, the two halves are
+/// two short chains of dependent operations instead of one long one (hypot, a division,
+/// asin; then sincos, hypot, a division), which the processor overlaps with other work.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct CircleStart {
+    kappa: f64,
+    halves: [f64; 2],
+}
+
 impl SampleCircle {
     /// The circle through `pts`, given the lengths of the chords a → b and b → c as
     /// [`geometry::norm`] measures them. Evaluated at a sample, it gives the bits of
     /// [`triple_error`] there.
+    #[cfg(test)]
     pub(crate) fn through(pts: [Vector2; 3], chords: [f64; 2]) -> Self {
+        Self::finish(Self::start(pts, chords), pts, chords)
+    }
+
+    /// [`Self::through`]'s first half.
+    pub(crate) fn start(pts: [Vector2; 3], chords: [f64; 2]) -> CircleStart {
         let [a, b, c] = pts;
-        let (ab, bc) = (b - a, c - b);
         let [ab_len, bc_len] = chords;
-        let kappa = curvature_of(ab, bc, ab_len, bc_len, &(c - a));
-        let [ab_start, ab_end] = chord_tangents(ab, ab_len, kappa);
-        let [bc_start, bc_end] = chord_tangents(bc, bc_len, kappa);
-        let tangents = [ab_start, middle_tangent(ab_end, bc_start), bc_end];
-        SampleCircle { kappa, tangents }
+        let kappa = curvature_of(b - a, c - b, ab_len, bc_len, &(c - a));
+        CircleStart {
+            kappa,
+            halves: [half_angle(ab_len, kappa), half_angle(bc_len, kappa)],
+        }
+    }
+
+    /// [`Self::through`] from its first half, measured on the same samples.
+    pub(crate) fn finish(start: CircleStart, pts: [Vector2; 3], chords: [f64; 2]) -> Self {
+        let [a, b, c] = pts;
+        let [ab_len, bc_len] = chords;
+        let [ab_start, ab_end] = chord_tangents(b - a, ab_len, start.halves[0]);
+        let [bc_start, bc_end] = chord_tangents(c - b, bc_len, start.halves[1]);
+        SampleCircle {
+            kappa: start.kappa,
+            tangents: [ab_start, middle_tangent(ab_end, bc_start), bc_end],
+        }
     }
 
     /// The estimate of `p` against this circle at its sample `anchor` (0 = a, 1 = b,
