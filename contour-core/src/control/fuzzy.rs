@@ -398,16 +398,21 @@ mod tests {
         }
     }
 
-    #[test]
-    fn fast_clip_levels_equal_brute_force() {
-        let engine = FuzzyEngine::default();
-        let mut points = lcg_points(2000);
-        for i in -12..=12 {
-            for j in -12..=12 {
+    /// `n` pseudo-random points and the grid of step 0.25 out to ±`r`/4.
+    fn points_and_grid(n: usize, r: i32) -> Vec<(f64, f64)> {
+        let mut points = lcg_points(n);
+        for i in -r..=r {
+            for j in -r..=r {
                 points.push((i as f64 * 0.25, j as f64 * 0.25));
             }
         }
-        for (e, ec) in points {
+        points
+    }
+
+    #[test]
+    fn fast_clip_levels_equal_brute_force() {
+        let engine = FuzzyEngine::default();
+        for (e, ec) in points_and_grid(2000, 12) {
             for (k, table) in engine.tables().iter().enumerate() {
                 assert_eq!(
                     engine.clip_levels(k, e, ec),
@@ -452,12 +457,7 @@ mod tests {
     #[test]
     fn side_by_side_centroids_have_the_bits_of_one_by_one() {
         let engine = FuzzyEngine::default();
-        let mut points = lcg_points(20_000);
-        for i in -14..=14 {
-            for j in -14..=14 {
-                points.push((i as f64 * 0.25, j as f64 * 0.25));
-            }
-        }
+        let mut points = points_and_grid(20_000, 14);
         points.extend([(f64::NAN, 0.5), (-0.0, 0.0), (3.0, -3.0), (1e300, -1e-300)]);
         for (e, ec) in points {
             let out = engine.evaluate(e, ec);

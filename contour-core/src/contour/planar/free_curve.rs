@@ -209,16 +209,12 @@ impl FreeCurveEstimator {
     /// finished, if it was not yet.
     fn circle(&mut self, m: usize) -> &KeptCircle {
         let i = self.index(m).min(self.circles.len() - 1);
-        let start = match self.circles[i] {
-            KeptCircle::Measured(_) => None,
-            KeptCircle::Started(start) => Some(start),
-            KeptCircle::Unmeasured => {
-                let (pts, chords) = self.around(m);
-                Some(SampleCircle::start(pts, chords))
-            }
-        };
-        if let Some(start) = start {
+        if !matches!(self.circles[i], KeptCircle::Measured(_)) {
             let (pts, chords) = self.around(m);
+            let start = match self.circles[i] {
+                KeptCircle::Started(start) => start,
+                _ => SampleCircle::start(pts, chords),
+            };
             self.circles[i] = KeptCircle::Measured(SampleCircle::finish(start, pts, chords));
         }
         &self.circles[i]

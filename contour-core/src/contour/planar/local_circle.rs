@@ -190,8 +190,21 @@ mod tests {
         assert!((e.error - 4.0).abs() < 1e-15 && e.normal == Vector2::new(-1.0, 0.0));
     }
 
+    /// The tangent at one end of a chord as it was measured before one `sincos` served
+    /// both ends: its own asin and its own sincos of ±half the angle.
+    fn chord_tangent_one_end(c: Vector2, len: f64, kappa: f64, at_end: bool) -> Vector2 {
+        if len == 0.0 {
+            return Vector2::zeros();
+        }
+        let dir = c * (1.0 / len);
+        let half = math::asin((0.5 * kappa * len).clamp(-1.0, 1.0));
+        let (s, co) = math::sincos(if at_end { half } else { -half });
+        Vector2::new(dir[0] * co - dir[1] * s, dir[0] * s + dir[1] * co)
+    }
+
     /// A kept circle evaluated at any of its samples gives the bits of the estimate
-    /// measured from the three samples there.
+    /// measured from the three samples there, and of the estimate as it was measured
+    /// before (each end of a chord on its own).
     #[test]
     fn a_sample_circle_gives_the_triple_estimates() {
         use rand::rngs::StdRng;
@@ -215,12 +228,20 @@ mod tests {
             let pts = [a, b, c];
             let chords = [geometry::norm(&(b - a)), geometry::norm(&(c - b))];
             let circle = SampleCircle::through(pts, chords);
+            let (ab, bc) = (b - a, c - b);
+            let k = curvature_of(ab, bc, chords[0], chords[1], &(c - a));
+            let before = [
+                chord_tangent_one_end(ab, chords[0], k, false),
+                middle_tangent(
+                    chord_tangent_one_end(ab, chords[0], k, true),
+                    chord_tangent_one_end(bc, chords[1], k, false),
+                ),
+                chord_tangent_one_end(bc, chords[1], k, true),
+            ];
             for anchor in 0..3 {
-                assert_eq!(
-                    circle.error(p, pts[anchor], anchor),
-                    triple_error(p, pts, anchor),
-                    "{pts:?} at {anchor}"
-                );
+                let kept = circle.error(p, pts[anchor], anchor);
+                assert_eq!(kept, triple_error(p, pts, anchor), "{pts:?} at {anchor}");
+                assert_eq!(kept, circle_error(p, pts[anchor], before[anchor], k));
             }
         }
     }
