@@ -30,9 +30,11 @@ ccc-tune:
 	$(CARGO) build --release -p contour-tune --bin ccc-tune
 
 # The distribution build (fmu-build/src/platform.rs): every FMU in target/fmu and
-# target/fmu-si with linux64 (glibc 2.28), win64 and aarch64-linux binaries of one build,
-# compiled by Debian's rustc-web with the standard library built from its sources, and each
-# platform's contour-cosim in target/cross/<triple>/release. About 7 minutes on 2 cores.
+# target/fmu-si with linux64 (glibc 2.28), win64 and aarch64-linux binaries of one build
+# (the FMI 3.0 FMUs in target/fmu3 and target/fmu3-si, the same binaries under
+# x86_64-linux, x86_64-windows and aarch64-linux), compiled by Debian's rustc-web with the
+# standard library built from its sources, and each platform's contour-cosim in
+# target/cross/<triple>/release. About 7 minutes on 2 cores.
 fmus-all: cross-toolchain
 	$(CARGO) run --release -p fmu-build -- --platforms all
 	$(CARGO) build --release -p contour-cosim

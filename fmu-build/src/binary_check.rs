@@ -1,5 +1,6 @@
 //! What the packager checks in every platform's library before it zips it into an FMU:
-//! that it exports exactly the 34 functions of FMI 2.0 Co-Simulation (read from the ELF
+//! that it exports exactly the 34 functions of FMI 2.0 Co-Simulation and the 75 of FMI 3.0
+//! (one library serves both standards' FMUs; read from the ELF
 //! dynamic symbol table or the PE export table, the tables an importer's dlsym and
 //! GetProcAddress look in; for the untested macOS builds, the Mach-O exports), that all binaries of one FMU carry the same build identity,
 //! and, for Linux, the newest glibc symbol version it needs.
@@ -10,7 +11,7 @@ use object::read::elf::{ElfFile64, FileHeader};
 use object::{Object, ObjectKind};
 
 use contour_fmu::build_identity;
-use contour_fmu::fmi2::FMI2_CO_SIMULATION;
+use contour_fmu::fmi::{FMI2_CO_SIMULATION, FMI3_FUNCTIONS};
 
 use crate::platform::Platform;
 
@@ -84,15 +85,7 @@ pub fn check(platform: Platform, bytes: &[u8], what: &str) -> Result<Checked, St
             .collect(),
         _ => exported,
     };
-    let expected: BTreeSet<String> = FMI2_CO_SIMULATION.iter().map(|s| s.to_string()).collect();
-    let missing: Vec<_> = expected.difference(&exported).collect();
-    let extra: Vec<_> = exported.difference(&expected).collect();
-    if !missing.is_empty() || !extra.is_empty() {
-        return Err(format!(
-            "{what}: must export exactly the 34 fmi2 Co-Simulation functions; \
-             missing {missing:?}, extra {extra:?}"
-        ));
-    }
+    exports_exactly_fmi(&exported).map_err(|e| format!("{what}: {e}"))?;
     let build_id = build_identity::read(bytes)
         .ok_or_else(|| format!("{what}: carries no contour-fmu build identity"))?
         .to_string();
@@ -101,6 +94,29 @@ pub fn check(platform: Platform, bytes: &[u8], what: &str) -> Result<Checked, St
         _ => None,
     };
     Ok(Checked { build_id, glibc })
+}
+
+/// Refuses a set of exported names that is not exactly FMI 2.0 Co-Simulation's 34 functions
+/// and FMI 3.0's 75 (an importer of either standard looks each of its own up; anything
+/// more is a symbol that leaked).
+fn exports_exactly_fmi(exported: &BTreeSet<String>) -> Result<(), String> {
+    let expected: BTreeSet<String> = FMI2_CO_SIMULATION
+        .iter()
+        .chain(&FMI3_FUNCTIONS)
+        .map(|s| s.to_string())
+        .collect();
+    let missing: Vec<_> = expected.difference(exported).collect();
+    let extra: Vec<_> = exported.difference(&expected).collect();
+    if missing.is_empty() && extra.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "must export exactly the {} fmi2 Co-Simulation functions and the {} fmi3 \
+             functions; missing {missing:?}, extra {extra:?}",
+            FMI2_CO_SIMULATION.len(),
+            FMI3_FUNCTIONS.len()
+        ))
+    }
 }
 
 /// Refuses binaries of one FMU that come from different source trees.
@@ -176,6 +192,52 @@ mod tests {
         assert_eq!(parse_glibc("GLIBC_2.2.5"), Some((2, 2)));
         assert_eq!(parse_glibc("GLIBC_PRIVATE"), None);
         assert_eq!(parse_glibc("GCC_3.0"), None);
+    }
+
+    fn names(lists: &[&[&str]]) -> BTreeSet<String> {
+        lists
+            .iter()
+            .flat_map(|l| l.iter())
+            .map(|s| s.to_string())
+            .collect()
+    }
+
+    #[test]
+    fn both_standards_functions_and_nothing_else_are_required() {
+        assert_eq!(
+            exports_exactly_fmi(&names(&[&FMI2_CO_SIMULATION, &FMI3_FUNCTIONS])),
+            Ok(())
+        );
+        // A library of FMI 2.0 only (as before the fmi3 exports) is refused, naming them.
+        let e = exports_exactly_fmi(&names(&[&FMI2_CO_SIMULATION])).unwrap_err();
+        assert!(
+            e.contains("exactly the 34 fmi2 Co-Simulation functions and the 75 fmi3")
+                && e.contains("\"fmi3DoStep\"")
+                && e.contains("extra []"),
+            "{e}"
+        );
+        // So is one without a fmi2 function, and one that exports a function of its own.
+        let mut without = names(&[&FMI2_CO_SIMULATION, &FMI3_FUNCTIONS]);
+        without.remove("fmi2DoStep");
+        let e = exports_exactly_fmi(&without).unwrap_err();
+        assert!(e.contains("missing [\"fmi2DoStep\"]"), "{e}");
+        let mut leaked = names(&[&FMI2_CO_SIMULATION, &FMI3_FUNCTIONS]);
+        leaked.insert("rust_eh_personality".into());
+        let e = exports_exactly_fmi(&leaked).unwrap_err();
+        assert!(
+            e.contains("missing [], extra [\"rust_eh_personality\"]"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn the_two_lists_are_disjoint_and_complete() {
+        assert_eq!(
+            names(&[&FMI2_CO_SIMULATION, &FMI3_FUNCTIONS]).len(),
+            34 + 75
+        );
+        assert!(FMI2_CO_SIMULATION.iter().all(|f| f.starts_with("fmi2")));
+        assert!(FMI3_FUNCTIONS.iter().all(|f| f.starts_with("fmi3")));
     }
 
     #[test]

@@ -1,5 +1,5 @@
 //! `documentation/index.html` of an FMU: what it does, its variables (from the table),
-//! and a minimal fmpy example.
+//! and a minimal fmpy example, in the words of the FMU's standard.
 
 use std::fmt::Write;
 
@@ -7,6 +7,7 @@ use contour_fmu::framework::interface::{Interface, UnitSystem};
 use contour_fmu::framework::variables::{Causality, Start, Variability};
 
 use crate::escape;
+use crate::standard::Standard;
 
 fn start_text(start: Start) -> String {
     match start {
@@ -17,7 +18,7 @@ fn start_text(start: Start) -> String {
     }
 }
 
-pub fn render(interface: &Interface) -> String {
+pub fn render(interface: &Interface, standard: Standard) -> String {
     let model = interface.model;
     let mut rows = String::new();
     for v in &interface.variables {
@@ -36,9 +37,8 @@ pub fn render(interface: &Interface) -> String {
             _ => start_text(v.start),
         };
         let type_name = match v.enumeration {
-            // Set and read with fmi2SetInteger / fmi2GetInteger.
             Some(e) => format!("Enumeration {} ({})", e.name, e.listing()),
-            None => v.var_type().name().to_string(),
+            None => standard.type_name(v.var_type()).to_string(),
         };
         let range = match (v.min, v.max) {
             (None, None) => String::new(),
@@ -91,7 +91,8 @@ pre {{ background: #f4f4f4; padding: 0.8em; }}
 <h1>{id}</h1>
 <p>{description}</p>
 <p>{units}</p>
-<p>FMI 2.0 Co-Simulation, Linux x86-64. Inputs: {inputs}. Outputs: {outputs}.
+<p>{standard} Co-Simulation; the platforms are the folders under <code>binaries/</code>.
+Inputs: {inputs}. Outputs: {outputs}.{time}
 Default experiment: {start} s to {stop} s with {step} s steps; any communication step
 size is accepted.</p>
 <h2>Variables</h2>
@@ -104,9 +105,9 @@ result = simulate_fmu("{id}.fmu", stop_time={stop}, output_interval={step})
 print(result.dtype.names)</pre>
 <h2>Behaviour at the FMI boundary</h2>
 <ul>
-<li>Calls in the wrong state return <code>fmi2Error</code> and log <code>&lt;function&gt;: illegal call sequence</code>.</li>
-<li>Non-finite or out-of-range values are refused with <code>fmi2Error</code>; the previous value stays. Enumerations are set with <code>fmi2SetInteger</code>; a value that is not one of the items is refused.</li>
-<li>Parameters are checked again in <code>fmi2ExitInitializationMode</code>; on error the instance stays in initialization mode so they can be corrected.</li>
+<li>Calls in the wrong state return <code>{p}Error</code> and log <code>&lt;function&gt;: illegal call sequence</code>.</li>
+<li>Non-finite or out-of-range values are refused with <code>{p}Error</code>; the previous value stays. Enumerations are set with <code>{enumeration_setter}</code>; a value that is not one of the items is refused.</li>
+<li>Parameters are checked again in <code>{p}ExitInitializationMode</code>; on error the instance stays in initialization mode so they can be corrected.</li>
 <li>FMU states can be saved, restored and serialized (a versioned, checksummed byte format); a restored state brings its mode with it, so it can be set right after instantiation. Restored bytes are validated like parameters; handles that are not live FMU states of the instance are refused.</li>
 <li>Log categories: logEvents, logStatusWarning, logStatusError, logStatusFatal, logAll. Errors are always logged.</li>
 </ul>
@@ -114,6 +115,16 @@ print(result.dtype.names)</pre>
 </html>
 "#,
         id = model.identifier,
+        standard = standard.name(),
+        p = standard.prefix(),
+        enumeration_setter = standard.enumeration_setter(),
+        time = match standard {
+            Standard::Fmi2 => String::new(),
+            Standard::Fmi3 => format!(
+                "\nThe independent variable <code>time</code> (s) has value reference {}.",
+                interface.time_vr()
+            ),
+        },
         description = escape(&interface.description()),
         units = match interface.units {
             UnitSystem::Si if !interface.converts() => "SI build: this model has no lengths, so its units are those of the mm build, SI already; it exists so that an SI loop takes every FMU from one folder.",

@@ -1,12 +1,14 @@
 //! The packager's pieces: each model's `modelDescription.xml` and documentation are
-//! rendered from its variable table, then zipped with each platform's shared library
-//! (built and checked first) into a `.fmu`.
+//! rendered from its variable table, for FMI 2.0 and for FMI 3.0, then zipped with each
+//! platform's shared library (built and checked first; one library serves both standards)
+//! into a `.fmu`.
 
 pub mod binary_check;
 pub mod documentation;
 pub mod model_description;
 pub mod package;
 pub mod platform;
+pub mod standard;
 
 /// Escapes text for XML/HTML attribute values and element content.
 pub fn escape(text: &str) -> String {

@@ -1,35 +1,42 @@
 //! `cargo run --release -p fmu-build [-- --bless] [--platforms host|all|LIST] [--out DIR]
 //! [--resource MODEL=FILE]…`: builds the library in release mode, for this machine or for
 //! every platform (`platform.rs`), checks each binary (`binary_check.rs`) and writes one
-//! `.fmu` per model and unit system carrying them all: the mm build to `target/fmu/` (or
-//! DIR), the SI build to `target/fmu-si/` (or DIR-si).
-//! `--bless` rewrites the committed `modelDescription/<Model>.xml` (and
-//! `modelDescription/si/<Model>.xml`) files from the code; each `--resource` puts FILE
-//! into MODEL's `resources/` folder in both builds.
+//! `.fmu` per model, unit system and FMI standard carrying them all: FMI 2.0 in mm to
+//! `target/fmu/` (or DIR), in SI to `target/fmu-si/` (DIR-si), FMI 3.0 in mm to
+//! `target/fmu3/` (DIR3) and in SI to `target/fmu3-si/` (DIR3-si); one library serves all.
+//! `--bless` rewrites the committed `modelDescription/[fmi3/][si/]<Model>.xml` files from
+//! the code; each `--resource` puts FILE into MODEL's `resources/` folder in every build.
 //! PathInterpolator5X always carries the example CL part `examples/cl/blade.cl` as
 //! `resources/blade.cl`. The loops' SSP files (`python/contour_fmu/loops/*.ssd`, and
-//! `loops/si/` for the SI build) go beside the FMUs, where their components' sources are.
+//! `loops/si/` for the SI build) go beside the FMI 2.0 FMUs, where their components' sources
+//! are (SSP 1.0 knows FMI 1.0 and 2.0 only).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use contour_fmu::fmi::{FMI2_CO_SIMULATION, FMI3_FUNCTIONS};
 use contour_fmu::framework::interface::{Interface, UnitSystem};
 use contour_fmu::models;
 use fmu_build::model_description;
 use fmu_build::package::{self, Binaries, Resource};
 use fmu_build::platform::{self, Platform, GLIBC_FLOOR};
+use fmu_build::standard::Standard;
 
 const USAGE: &str = "usage: fmu-build [--bless] [--platforms host|all|LIST] [--out DIR] [--resource MODEL=FILE]...\n\
-  builds the contour-fmu library (release) and packages target/fmu/<Model>.fmu (mm)\n\
-  and target/fmu-si/<Model>.fmu (SI)\n\
-  --bless                rewrite modelDescription/<Model>.xml from the variable tables\n\
+  builds the contour-fmu library (release) and packages, from that one library,\n\
+  FMI 2.0: target/fmu/<Model>.fmu (mm) and target/fmu-si/<Model>.fmu (SI),\n\
+  FMI 3.0: target/fmu3/<Model>.fmu (mm) and target/fmu3-si/<Model>.fmu (SI)\n\
+  --bless                rewrite modelDescription/<Model>.xml (FMI 2.0) and\n\
+                         modelDescription/fmi3/<Model>.xml (FMI 3.0), si/ beside each,\n\
+                         from the variable tables\n\
   --platforms host       (default) one binary, built for this machine by the workspace's cargo\n\
-  --platforms all        linux64, win64 and aarch64-linux, built by the pinned distribution\n\
+  --platforms all        linux64, win64 and aarch64-linux (FMI 3.0: x86_64-linux,\n\
+                         x86_64-windows, aarch64-linux), built by the pinned distribution\n\
                          toolchain (make fmus-all installs it; docs/usage.md)\n\
   --platforms LIST       some of them, comma-separated (e.g. linux64,win64); also the\n\
                          untested darwin64 and aarch64-darwin (linked, never run here)\n\
-  --out DIR              write the .fmu files to DIR and DIR-si instead of <target>/fmu\n\
-                         and <target>/fmu-si\n\
+  --out DIR              write the .fmu files to DIR, DIR-si, DIR3 and DIR3-si instead of\n\
+                         <target>/fmu, <target>/fmu-si, <target>/fmu3 and <target>/fmu3-si\n\
   --resource MODEL=FILE  put FILE into MODEL's resources/ folder under its own name\n\
                          (repeatable; e.g. PathInterpolator2D=part.json, then set the\n\
                          FMU's parameter path = \"part.json\")";
@@ -105,9 +112,11 @@ fn build_binaries(root: &Path, platforms: &Platforms) -> Result<Binaries, String
             " (UNTESTED: nothing here runs it)"
         };
         println!(
-            "binaries/{}: build {}, exports the 34 fmi2 functions{glibc}{untested}",
+            "binaries/{}: build {}, exports the {} fmi2 and {} fmi3 functions{glibc}{untested}",
             platform.folder(),
-            checked.build_id
+            checked.build_id,
+            FMI2_CO_SIMULATION.len(),
+            FMI3_FUNCTIONS.len()
         );
         if let (Platforms::Distribution(_), Some(needed)) = (platforms, checked.glibc) {
             if needed > GLIBC_FLOOR {
@@ -170,9 +179,9 @@ fn run(args: &[String]) -> Result<(), String> {
     let out = out.unwrap_or_else(|| target_dir(&root).join("fmu"));
 
     let mut stale = Vec::new();
-    for interface in packaged() {
-        let xml = model_description::render(interface);
-        let committed = committed_description(&root, interface);
+    for (standard, interface) in packaged() {
+        let xml = standard.model_description(interface);
+        let committed = model_description::committed(&root, interface, standard);
         if bless {
             let committed_dir = committed.parent().expect("a file in a folder");
             std::fs::create_dir_all(committed_dir).map_err(|e| e.to_string())?;
@@ -185,12 +194,10 @@ fn run(args: &[String]) -> Result<(), String> {
     }
 
     let binaries = build_binaries(&root, &platforms)?;
-    for interface in packaged() {
-        let out = match interface.units {
-            UnitSystem::Millimetre => out.clone(),
-            UnitSystem::Si => si_folder(&out),
-        };
-        let fmu = package::write_fmu_with_resources(interface, &binaries, &out, &resources)?;
+    for (standard, interface) in packaged() {
+        let folder = standard.output_folder(&out, interface.units);
+        let fmu =
+            package::write_fmu_with_resources(interface, standard, &binaries, &folder, &resources)?;
         println!("wrote {}", fmu.display());
         for r in resources
             .iter()
@@ -199,8 +206,14 @@ fn run(args: &[String]) -> Result<(), String> {
             println!("  resources/{} <- {}", r.name, r.source.display());
         }
     }
-    copy_loops(&root.join(LOOPS), &out)?;
-    copy_loops(&root.join(LOOPS).join("si"), &si_folder(&out))?;
+    copy_loops(
+        &root.join(LOOPS),
+        &Standard::Fmi2.output_folder(&out, UnitSystem::Millimetre),
+    )?;
+    copy_loops(
+        &root.join(LOOPS).join("si"),
+        &Standard::Fmi2.output_folder(&out, UnitSystem::Si),
+    )?;
     if !stale.is_empty() {
         eprintln!(
             "warning: the committed model descriptions differ from the code (the FMUs use the code's): {}\n\
@@ -209,13 +222,6 @@ fn run(args: &[String]) -> Result<(), String> {
         );
     }
     Ok(())
-}
-
-/// The SI build's folder beside the mm build's `out`: `out`-si.
-fn si_folder(out: &Path) -> PathBuf {
-    let mut name = out.as_os_str().to_owned();
-    name.push("-si");
-    PathBuf::from(name)
 }
 
 /// Copies every `.ssd` of `from` into `to` (an SSD's start values are in the units of the
@@ -239,21 +245,15 @@ fn copy_loops(from: &Path, to: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// The interfaces packaged: both unit systems of every model [`models::all`] lists.
-fn packaged() -> impl Iterator<Item = &'static Interface> {
-    models::interfaces()
-        .iter()
-        .filter(|i| models::all().iter().any(|m| std::ptr::eq(*m, i.model)))
-}
-
-/// Where the committed copy of an interface's model description lives.
-fn committed_description(root: &Path, interface: &Interface) -> PathBuf {
-    let dir = root.join("modelDescription");
-    let dir = match interface.units {
-        UnitSystem::Millimetre => dir,
-        UnitSystem::Si => dir.join("si"),
-    };
-    dir.join(format!("{}.xml", interface.model.identifier))
+/// The FMUs packaged: both standards of both unit systems of every model [`models::all`]
+/// lists, FMI 2.0 first.
+fn packaged() -> impl Iterator<Item = (Standard, &'static Interface)> {
+    Standard::ALL.into_iter().flat_map(|standard| {
+        models::interfaces()
+            .iter()
+            .filter(|i| models::all().iter().any(|m| std::ptr::eq(*m, i.model)))
+            .map(move |i| (standard, i))
+    })
 }
 
 fn main() -> ExitCode {

@@ -1,6 +1,6 @@
-//! Zips one FMU: `modelDescription.xml`, one library per platform
-//! (`binaries/<platform>/<id>.<so|dll>`), `documentation/index.html` and, on request, files
-//! under `resources/`.
+//! Zips one FMU of a standard: `modelDescription.xml`, one library per platform
+//! (`binaries/<platform>/<id>.<so|dll>`, the platform folder named as the standard names it),
+//! `documentation/index.html` and, on request, files under `resources/`.
 
 use std::fs::File;
 use std::io::Write;
@@ -13,11 +13,13 @@ use contour_fmu::framework::interface::Interface;
 use contour_fmu::models;
 
 use crate::binary_check::{self, Checked};
+use crate::documentation;
 use crate::platform::{Binary, Platform};
-use crate::{documentation, model_description};
+use crate::standard::Standard;
 
 /// The libraries one FMU carries, read and checked ([`binary_check`]): each exports exactly
-/// the fmi2 Co-Simulation functions, all come from one source tree, one per platform.
+/// the fmi2 Co-Simulation and the fmi3 functions, all come from one source tree, one per
+/// platform.
 #[derive(Debug)]
 pub struct Binaries {
     libraries: Vec<(Platform, Vec<u8>, Checked)>,
@@ -158,20 +160,23 @@ pub fn check_unique(resources: &[Resource]) -> Result<(), String> {
     Ok(())
 }
 
-/// Writes `<out_dir>/<id>.fmu` holding each of `binaries` under the name FMI requires:
-/// `binaries/<platform>/<modelIdentifier>.<so|dll>`. No resources.
+/// Writes `<out_dir>/<id>.fmu`, an FMU of `standard` holding each of `binaries` under the
+/// name that standard requires: `binaries/<platform>/<modelIdentifier>.<so|dll>`. No
+/// resources.
 pub fn write_fmu(
     interface: &Interface,
+    standard: Standard,
     binaries: &Binaries,
     out_dir: &Path,
 ) -> Result<PathBuf, String> {
-    write_fmu_with_resources(interface, binaries, out_dir, &[])
+    write_fmu_with_resources(interface, standard, binaries, out_dir, &[])
 }
 
 /// As [`write_fmu`], plus every entry of `resources` whose `model` is this model's
 /// identifier as `resources/<name>` (entries for other models are skipped).
 pub fn write_fmu_with_resources(
     interface: &Interface,
+    standard: Standard,
     binaries: &Binaries,
     out_dir: &Path,
     resources: &[Resource],
@@ -194,13 +199,13 @@ pub fn write_fmu_with_resources(
         File::create(&partial).map_err(|e| format!("cannot create {}: {e}", partial.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(CompressionMethod::Deflated);
-    let xml = model_description::render(interface);
-    let html = documentation::render(interface);
+    let xml = standard.model_description(interface);
+    let html = documentation::render(interface, standard);
     let mut entries: Vec<(String, &[u8])> = vec![("modelDescription.xml".into(), xml.as_bytes())];
     for (platform, bytes, _) in &binaries.libraries {
         let name = format!(
             "binaries/{}/{}.{}",
-            platform.folder(),
+            standard.binaries_folder(*platform),
             model.identifier,
             platform.library_extension()
         );

@@ -38,13 +38,25 @@ impl Platform {
     /// Built only when named: nothing here can run them.
     pub const UNTESTED: [Platform; 2] = [Platform::Darwin64, Platform::Aarch64Darwin];
 
-    /// The folder under `binaries/`.
+    /// The folder under `binaries/` in an FMI 2.0 FMU.
     pub fn folder(self) -> &'static str {
         match self {
             Platform::Linux64 => "linux64",
             Platform::Win64 => "win64",
             Platform::Aarch64Linux => "aarch64-linux",
             Platform::Darwin64 => "darwin64",
+            Platform::Aarch64Darwin => "aarch64-darwin",
+        }
+    }
+
+    /// The folder under `binaries/` in an FMI 3.0 FMU: FMI 3.0's platform tuple
+    /// `<arch>-<sys>`, for the same library.
+    pub fn fmi3_folder(self) -> &'static str {
+        match self {
+            Platform::Linux64 => "x86_64-linux",
+            Platform::Win64 => "x86_64-windows",
+            Platform::Aarch64Linux => "aarch64-linux",
+            Platform::Darwin64 => "x86_64-darwin",
             Platform::Aarch64Darwin => "aarch64-darwin",
         }
     }

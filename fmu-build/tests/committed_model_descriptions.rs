@@ -1,42 +1,36 @@
-//! The committed `modelDescription/<Model>.xml` (mm) and `modelDescription/si/<Model>.xml`
-//! files must be exactly what the code renders: review sees every interface change, and
-//! a stale file fails here.
+//! The committed model descriptions, `modelDescription/<Model>.xml` (FMI 2.0, mm),
+//! `modelDescription/si/<Model>.xml` (SI) and the same under `modelDescription/fmi3/`
+//! (FMI 3.0), must be exactly what the code renders: review sees every interface change,
+//! and a stale file fails here.
+
+mod common;
 
 use std::path::Path;
 
-use contour_fmu::framework::interface::{Interface, UnitSystem};
+use common::packaged;
+use contour_fmu::framework::interface::UnitSystem;
 use contour_fmu::models;
-use fmu_build::model_description;
-
-/// Both interfaces of every packaged model.
-fn packaged() -> Vec<&'static Interface> {
-    models::all()
-        .into_iter()
-        .flat_map(|m| UnitSystem::ALL.map(|units| models::interface(m, units)))
-        .collect()
-}
+use fmu_build::model_description::{self, fmi2};
+use fmu_build::standard::Standard;
 
 #[test]
 fn committed_xml_matches_the_code() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../modelDescription");
-    for interface in packaged() {
-        let folder = match interface.units {
-            UnitSystem::Millimetre => dir.clone(),
-            UnitSystem::Si => dir.join("si"),
-        };
-        let model = interface.model;
-        let path = folder.join(format!("{}.xml", model.identifier));
-        let committed = std::fs::read_to_string(&path).unwrap_or_else(|e| {
-            panic!(
-                "{}: {e}; run `cargo run -p fmu-build -- --bless`",
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    for standard in Standard::ALL {
+        for interface in packaged() {
+            let path = model_description::committed(&root, interface, standard);
+            let committed = std::fs::read_to_string(&path).unwrap_or_else(|e| {
+                panic!(
+                    "{}: {e}; run `cargo run --release -p fmu-build -- --bless`",
+                    path.display()
+                )
+            });
+            assert!(
+                committed == standard.model_description(interface),
+                "{} is stale: run `cargo run --release -p fmu-build -- --bless` and commit it",
                 path.display()
-            )
-        });
-        assert!(
-            committed == model_description::render(interface),
-            "{} is stale: run `cargo run --release -p fmu-build -- --bless` and commit it",
-            path.display()
-        );
+            );
+        }
     }
 }
 
@@ -44,7 +38,7 @@ fn committed_xml_matches_the_code() {
 fn every_output_is_listed_once_in_outputs_and_initial_unknowns() {
     for interface in packaged() {
         let model = interface.model;
-        let xml = model_description::render(interface);
+        let xml = fmi2::render(interface);
         let outputs = model
             .variables
             .iter()
@@ -114,7 +108,13 @@ fn the_si_interface_is_the_mm_one_in_metres() {
                 (x, y) => assert_eq!(x, y, "{}", a.name),
             }
         }
-        let xml = model_description::render(si);
+        let xml = fmi2::render(si);
+        let xml3 = Standard::Fmi3.model_description(si);
+        assert!(
+            !xml3.contains("unit=\"mm"),
+            "{}: a length in mm (FMI 3.0)",
+            model.identifier
+        );
         assert!(
             !xml.contains("unit=\"mm"),
             "{}: a length in mm",

@@ -2,57 +2,25 @@
 //! of the zip, byte for byte, and nowhere else; bad requests are refused before anything
 //! is written.
 
-use std::io::Read;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 mod common;
 
-use contour_fmu::models;
-use fmu_build::package::{self, Binaries, Resource};
-use fmu_build::platform::{Binary, Platform};
+use common::{entries, host_binaries};
+use contour_fmu::framework::interface::{Interface, UnitSystem};
+use fmu_build::package::{self, Resource};
+use fmu_build::standard::Standard;
 
 /// The documented example of the README (a rational cubic NURBS).
 const NURBS: &str = r#"{"degree": 3, "knots": [0, 0, 0, 0, 0.5, 1, 1, 1, 1],
  "control_points": [[0, 0], [10, 5], [20, 0], [30, 5], [40, 0]], "weights": [1, 1, 2, 1, 1]}"#;
 
-/// A fresh scratch folder per test (no temp-file crate needed).
 fn scratch(test: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("fmu_build_resources_{}_{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch("resources", test)
 }
 
-fn model(identifier: &str) -> &'static contour_fmu::framework::interface::Interface {
-    let model = models::all()
-        .into_iter()
-        .find(|m| m.identifier == identifier)
-        .unwrap();
-    models::interface(
-        model,
-        contour_fmu::framework::interface::UnitSystem::Millimetre,
-    )
-}
-
-/// The host's library as cargo built it for this test run.
-fn host_binaries() -> Binaries {
-    let file = common::host_library();
-    let platform = Platform::host().expect("tests run on a platform FMUs carry");
-    Binaries::load(&[Binary { platform, file }]).unwrap()
-}
-
-/// Name → bytes of every file in the zip.
-fn entries(fmu: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut zip = zip::ZipArchive::new(std::fs::File::open(fmu).unwrap()).unwrap();
-    (0..zip.len())
-        .map(|i| {
-            let mut f = zip.by_index(i).unwrap();
-            let mut bytes = Vec::new();
-            f.read_to_end(&mut bytes).unwrap();
-            (f.name().to_string(), bytes)
-        })
-        .collect()
+fn model(identifier: &str) -> &'static Interface {
+    common::interface(identifier, UnitSystem::Millimetre)
 }
 
 #[test]
@@ -66,9 +34,14 @@ fn a_nurbs_file_lands_in_the_interpolators_resources_folder() {
     assert_eq!(resources[0].name, "part.json");
 
     let out = dir.join("fmu");
-    let fmu =
-        package::write_fmu_with_resources(model("PathInterpolator2D"), &library, &out, &resources)
-            .unwrap();
+    let fmu = package::write_fmu_with_resources(
+        model("PathInterpolator2D"),
+        Standard::Fmi2,
+        &library,
+        &out,
+        &resources,
+    )
+    .unwrap();
     let files = entries(&fmu);
     let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
     for expected in [
@@ -92,14 +65,20 @@ fn a_nurbs_file_lands_in_the_interpolators_resources_folder() {
     assert!(contour_core::path::nurbs_file::parse_nurbs::<2>(text, "part.json").is_ok());
 
     // The other models' FMUs carry no resources.
-    let controller =
-        package::write_fmu_with_resources(model("ContourCCC2D"), &library, &out, &resources)
-            .unwrap();
+    let controller = package::write_fmu_with_resources(
+        model("ContourCCC2D"),
+        Standard::Fmi2,
+        &library,
+        &out,
+        &resources,
+    )
+    .unwrap();
     assert!(entries(&controller)
         .iter()
         .all(|(n, _)| !n.starts_with("resources/")));
     // Without --resource nothing changes: no resources/ entry at all.
-    let plain = package::write_fmu(model("PathInterpolator2D"), &library, &out).unwrap();
+    let plain =
+        package::write_fmu(model("PathInterpolator2D"), Standard::Fmi2, &library, &out).unwrap();
     assert!(entries(&plain)
         .iter()
         .all(|(n, _)| !n.starts_with("resources/")));
@@ -155,6 +134,7 @@ fn bad_resource_requests_are_refused_with_a_clear_message() {
     let library = host_binaries();
     assert!(package::write_fmu_with_resources(
         model("PathInterpolator2D"),
+        Standard::Fmi2,
         &library,
         &dir.join("fmu"),
         &twice

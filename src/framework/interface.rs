@@ -42,6 +42,8 @@ pub struct Interface {
     /// Interface value = model value × scale, by value reference (1 but for lengths in SI).
     pub scale: Vec<f64>,
     pub guid: String,
+    /// The FMI 3.0 `instantiationToken`: distinct from the FMI 2.0 GUID.
+    pub instantiation_token: String,
 }
 
 impl Interface {
@@ -64,16 +66,19 @@ impl Interface {
                 }
             }
         }
-        let guid = match units {
-            UnitSystem::Millimetre => model.guid(),
-            UnitSystem::Si => model.guid_of(&variables, units.name()),
+        let name = match units {
+            UnitSystem::Millimetre => "",
+            UnitSystem::Si => units.name(),
         };
+        let guid = model.guid_of(&variables, name);
+        let instantiation_token = model.instantiation_token_of(&variables, name);
         Interface {
             model,
             units,
             variables,
             scale,
             guid,
+            instantiation_token,
         }
     }
 
@@ -91,6 +96,12 @@ impl Interface {
                 self.model.description
             ),
         }
+    }
+
+    /// The value reference of FMI 3.0's independent variable `time` (s): the first after
+    /// the table's (FMI 2.0 has no such variable).
+    pub fn time_vr(&self) -> u32 {
+        self.variables.len() as u32
     }
 
     /// Whether any value is scaled at the interface.

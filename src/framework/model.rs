@@ -119,8 +119,20 @@ impl ModelInfo {
     /// it keeps). A named interface gets a GUID of its own even where its table is the
     /// model's (a model without lengths).
     pub fn guid_of(&self, variables: &[Variable], interface: &str) -> String {
+        self.token_of(b"fmi2-cs\0", variables, interface)
+    }
+
+    /// The FMI 3.0 `instantiationToken` of the model with the table `variables` as its
+    /// interface named `interface`: [`ModelInfo::guid_of`]'s hash under another prefix,
+    /// so an FMI 3.0 description never matches an FMI 2.0 binary's check, nor the reverse.
+    pub fn instantiation_token_of(&self, variables: &[Variable], interface: &str) -> String {
+        self.token_of(b"fmi3-cs\0", variables, interface)
+    }
+
+    /// A GUID-shaped hash of `standard`, the identifier, the interface and the table.
+    fn token_of(&self, standard: &[u8], variables: &[Variable], interface: &str) -> String {
         let mut hash = Sha256::new();
-        hash.update(b"fmi2-cs\0");
+        hash.update(standard);
         hash.update(self.identifier.as_bytes());
         if !interface.is_empty() {
             hash.update(b"\0interface\0");

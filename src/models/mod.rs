@@ -1,5 +1,5 @@
 //! The FMUs: each is a plain Rust type with a variable table and a step function, built
-//! on [`crate::framework`]; `crate::fmi2` adapts them to the C ABI. Adding an FMU is one
+//! on [`crate::framework`]; `crate::fmi` adapts them to the C ABI. Adding an FMU is one
 //! file here and one line in [`all`].
 
 pub mod axis_variables;
@@ -73,6 +73,11 @@ pub fn interface(model: &ModelInfo, units: UnitSystem) -> &'static Interface {
 /// The interface whose GUID this is.
 pub fn by_guid(guid: &str) -> Option<&'static Interface> {
     interfaces().iter().find(|i| i.guid == guid)
+}
+
+/// The interface whose FMI 3.0 instantiation token this is.
+pub fn by_instantiation_token(token: &str) -> Option<&'static Interface> {
+    interfaces().iter().find(|i| i.instantiation_token == token)
 }
 
 #[cfg(test)]

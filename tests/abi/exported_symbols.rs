@@ -1,15 +1,16 @@
 //! The built FMU library exports exactly the functions of FMI 2.0 Co-Simulation (the
-//! common functions plus the Co-Simulation ones, FMI 2.0.4 section 2.1 and 4.2) and nothing
-//! else: no Model Exchange functions (the model descriptions declare Co-Simulation only),
-//! no helper of a dependency, no Rust symbol. Read from the ELF dynamic symbol table, the
-//! table an importer's dlsym looks in.
+//! common functions plus the Co-Simulation ones, FMI 2.0.4 section 2.1 and 4.2) and every
+//! function of FMI 3.0's fmi3Functions.h (importers such as fmpy look each one up), and
+//! nothing else: no FMI 2.0 Model Exchange functions (the model descriptions declare
+//! Co-Simulation only), no helper of a dependency, no Rust symbol. Read from the ELF
+//! dynamic symbol table, the table an importer's dlsym looks in.
 
 use std::collections::BTreeSet;
 
 use object::{Object, ObjectSymbol, SymbolKind};
 
 #[test]
-fn the_library_exports_exactly_the_fmi2_co_simulation_functions() {
+fn the_library_exports_exactly_the_fmi2_co_simulation_and_the_fmi3_functions() {
     let path = crate::common::library_path();
     let data =
         std::fs::read(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
@@ -33,14 +34,31 @@ fn the_library_exports_exactly_the_fmi2_co_simulation_functions() {
 
     let expected: BTreeSet<String> = crate::common::FMI2_CO_SIMULATION
         .iter()
+        .chain(&contour_fmu::fmi::FMI3_FUNCTIONS)
         .map(|s| s.to_string())
         .collect();
-    assert_eq!(expected.len(), 34);
+    assert_eq!(expected.len(), 34 + 75);
+    // The list is the header's: every function fmi3Functions.h exports.
+    let header = include_str!("../../third_party/fmi3/fmi3Functions.h");
+    let declared: BTreeSet<String> = header
+        .lines()
+        .filter_map(|line| line.strip_prefix("FMI3_Export "))
+        .filter_map(|rest| rest.split_whitespace().nth(1))
+        .map(|name| name.trim_end_matches(';').to_string())
+        .collect();
+    let listed: BTreeSet<String> = contour_fmu::fmi::FMI3_FUNCTIONS
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    assert_eq!(
+        declared, listed,
+        "FMI3_FUNCTIONS is not fmi3Functions.h's list"
+    );
     let missing: Vec<_> = expected.difference(&functions).collect();
     let extra: Vec<_> = functions.difference(&expected).collect();
     assert!(
         missing.is_empty() && extra.is_empty() && others.is_empty(),
-        "{}: missing fmi2 functions {missing:?}; unexpected exported functions {extra:?}; \
+        "{}: missing functions {missing:?}; unexpected exported functions {extra:?}; \
          unexpected exported non-functions {others:?}",
         path.display()
     );

@@ -8,8 +8,11 @@ mod common;
 
 #[cfg(feature = "test-hooks")]
 mod bad_inputs;
+#[cfg(feature = "test-hooks")]
+mod bad_inputs_fmi3;
 #[cfg(target_os = "linux")]
 mod exported_symbols;
+mod fmi3;
 mod fmu_state;
 #[cfg(feature = "test-hooks")]
 mod handles;

@@ -45,9 +45,10 @@ def slide_fmu(tmp_path_factory):
     return str(out / "FrictionSlide.fmu")
 
 
-def drive_units(fmu_dir, slide, ccc, coulomb=COULOMB):
-    """The SI loop's units, in stepping order, with their start values."""
-    si = fmu_dir.parent / "fmu-si"
+def drive_units(fmu_dir, slide, ccc, coulomb=COULOMB, build="fmu-si"):
+    """The SI loop's units, in stepping order, with their start values; our FMUs from
+    `build` (fmu-si: FMI 2.0, fmu3-si: FMI 3.0)."""
+    si = fmu_dir.parent / build
     mechanics = dict(m=J * K**2, b=B * K**2, Fc=coulomb * K)
     drive = dict(Kvp=CT * KVP * K**2, Kvi=CT * KVI * K**2, effortMax=1e9)
     return [
@@ -60,9 +61,9 @@ def drive_units(fmu_dir, slide, ccc, coulomb=COULOMB):
     ]
 
 
-def drive_loop(fmu_dir, slide, step, ccc, coulomb=COULOMB, stop=2.0):
+def drive_loop(fmu_dir, slide, step, ccc, coulomb=COULOMB, stop=2.0, build="fmu-si"):
     """The SI loop: positions in mm at every communication point."""
-    units = drive_units(fmu_dir, slide, ccc, coulomb)
+    units = drive_units(fmu_dir, slide, ccc, coulomb, build)
     with Master(units, drive_loop_connections(), step, stop, initial=drive_loop_start()) as master:
         before, _ = master.run([("axis_x", "x"), ("axis_y", "x")])
     return np.column_stack([before["axis_x.x"], before["axis_y.x"]]) * 1e3
@@ -132,3 +133,11 @@ def test_the_drive_loop_with_a_pythonfmu_plant_runs_in_contour_cosim_as_in_fmpy(
     assert np.ptp(ours[:, 1]) > 1.0  # mm: the loop moved along the circle
     with pytest.raises(native.RunFailed, match="a pythonfmu FMU: load libpython first"):
         native.run(ssd, parameter_set="default", stop=stop, env={"LD_PRELOAD": ""})
+
+
+def test_the_drive_loop_through_fmi3_gives_the_fmi2_trajectory_bit_for_bit(fmu_dir, slide_fmu):
+    """Our FMI 3.0 SI FMUs (controller, drives, interpolator) with the pythonfmu slide (FMI
+    2.0) in one fmpy master: the FMI 2.0 build's positions, bit for bit."""
+    runs = [drive_loop(fmu_dir, slide_fmu, 1e-3, True, stop=0.5, build=build)
+            for build in ("fmu-si", "fmu3-si")]
+    assert np.array_equal(runs[0].view(np.uint64), runs[1].view(np.uint64))

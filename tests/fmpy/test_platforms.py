@@ -1,10 +1,11 @@
 """The FMUs for the platforms users model on: every FMU of `fmu-build --platforms all` (what
-`make fmus-all` ships) carries linux64, win64 and aarch64-linux binaries of one build, and
-the win64 binary under Wine and the aarch64 binary under QEMU compute what the linux64
-binary computes, bit for bit: the loops through each platform's contour-cosim, the
-bad-input catalogue's statuses and messages, saved states carried from one platform to
-another, resource locations with a drive and a share. The binaries are read by binutils
-(objdump), not by the packager's own reader."""
+`make fmus-all` ships) carries linux64, win64 and aarch64-linux binaries of one build
+(FMI 3.0's: x86_64-linux, x86_64-windows, aarch64-linux, the same libraries), and the
+win64 binary under Wine and the aarch64 binary under QEMU compute what the linux64 binary
+computes, bit for bit: the loops through each platform's contour-cosim, the bad-input
+catalogue's statuses and messages, saved states carried from one platform to another,
+resource locations with a drive and a share, and FMI 3.0 calls, which compute what FMI 2.0
+calls do. The binaries are read by binutils (objdump), not by the packager's own reader."""
 
 import os
 import re
@@ -20,6 +21,9 @@ from fmpy.validation import validate_fmu
 from helpers.checkout import REPO, target_dir
 
 PLATFORMS = ("linux64", "win64", "aarch64-linux")
+# FMI 3.0's names of the same platforms (its binaries/ folders).
+FMI3_PLATFORMS = {"linux64": "x86_64-linux", "win64": "x86_64-windows",
+                  "aarch64-linux": "aarch64-linux"}
 TRIPLES = {"linux64": "x86_64-unknown-linux-gnu", "win64": "x86_64-pc-windows-gnu",
            "aarch64-linux": "aarch64-unknown-linux-gnu"}
 EXTENSIONS = {"linux64": "so", "win64": "dll", "aarch64-linux": "so"}
@@ -68,6 +72,7 @@ def programs(distribution, tmp_path_factory):
         folder.mkdir()
         exe = ".exe" if platform == "win64" else ""
         subprocess.run([COMPILERS[platform], "-O2", "-Wall", "-I", str(REPO / "third_party" / "fmi2"),
+                        "-I", str(REPO / "third_party" / "fmi3"),
                         "-o", str(folder / f"fmi_probe{exe}"), str(PROBE)]
                        + ([] if platform == "win64" else ["-ldl"]), check=True)
         cosim = target_dir() / "cross" / TRIPLES[platform] / "release" / f"contour-cosim{exe}"
@@ -96,25 +101,31 @@ def unpacked(fmu, folder):
     return folder
 
 
-def library(folder, platform, identifier):
-    return folder / "binaries" / platform / f"{identifier}.{EXTENSIONS[platform]}"
+def library(folder, platform, identifier, fmi3=False):
+    return (folder / "binaries" / (FMI3_PLATFORMS[platform] if fmi3 else platform)
+            / f"{identifier}.{EXTENSIONS[platform]}")
 
 
-def all_fmus(distribution):
-    si = Path(f"{distribution}-si")
-    return sorted(distribution.glob("*.fmu")) + sorted(si.glob("*.fmu"))
+def all_fmus(distribution, fmi3=False):
+    """The FMI 2.0 FMUs of the distribution (mm, then SI), or its FMI 3.0 ones."""
+    first = Path(f"{distribution}3") if fmi3 else distribution
+    return sorted(first.glob("*.fmu")) + sorted(Path(f"{first}-si").glob("*.fmu"))
 
 
-def test_every_fmu_carries_three_platforms_of_one_build(distribution, tmp_path):
-    fmus = all_fmus(distribution)
+@pytest.mark.parametrize("fmi3", [False, True], ids=["FMI 2.0", "FMI 3.0"])
+def test_every_fmu_carries_three_platforms_of_one_build(distribution, tmp_path, fmi3):
+    fmus = all_fmus(distribution, fmi3)
     assert len(fmus) == 16
     builds = set()
     for fmu in fmus:
-        identifier = read_model_description(str(fmu)).coSimulation.modelIdentifier
+        md = read_model_description(str(fmu))
+        assert md.fmiVersion == ("3.0" if fmi3 else "2.0"), fmu
+        identifier = md.coSimulation.modelIdentifier
         folder = unpacked(fmu, tmp_path / fmu.parent.name / fmu.stem)
-        assert sorted(p.name for p in (folder / "binaries").iterdir()) == sorted(PLATFORMS)
+        folders = [FMI3_PLATFORMS[p] if fmi3 else p for p in PLATFORMS]
+        assert sorted(p.name for p in (folder / "binaries").iterdir()) == sorted(folders)
         for platform in PLATFORMS:
-            data = library(folder, platform, identifier).read_bytes()
+            data = library(folder, platform, identifier, fmi3).read_bytes()
             found = re.findall(rb"contour-fmu build ([0-9a-f]{32})", data)
             assert len(found) == 1, (fmu, platform)
             builds.add(found[0])
@@ -132,7 +143,8 @@ def exports(platform, path):
             if " DF .text" in line and " g " in line}
 
 
-def test_each_binary_exports_the_34_functions_and_linux_needs_glibc_2_28(distribution, tmp_path):
+def test_each_binary_exports_the_fmi2_and_fmi3_functions_and_linux_needs_glibc_2_28(
+        distribution, tmp_path):
     header = (REPO / "third_party" / "fmi2" / "fmi2Functions.h").read_text()
     # The standard's own list: the FMI2_Export declarations of the header, less Model
     # Exchange's functions (section 3.2.2 of FMI 2.0.4), which these FMUs do not provide.
@@ -142,6 +154,11 @@ def test_each_binary_exports_the_34_functions_and_linux_needs_glibc_2_28(distrib
                       "fmi2GetNominalsOfContinuousStates"}
     standard = set(re.findall(r"FMI2_Export (fmi2\w+)TYPE", header)) - model_exchange
     assert len(standard) == 34
+    # And every function FMI 3.0's header exports (importers look each one up).
+    fmi3 = set(re.findall(r"FMI3_Export fmi3\w+TYPE\s+(fmi3\w+);",
+                          (REPO / "third_party" / "fmi3" / "fmi3Functions.h").read_text()))
+    assert len(fmi3) == 75
+    standard |= fmi3
     folder = unpacked(distribution / "ContourCCC2D.fmu", tmp_path / "ccc")
     for platform in PLATFORMS:
         path = library(folder, platform, "ContourCCC2D")
@@ -161,7 +178,7 @@ def test_each_binary_exports_the_34_functions_and_linux_needs_glibc_2_28(distrib
 
 
 def test_fmpy_validates_the_multi_platform_fmus(distribution):
-    for fmu in all_fmus(distribution):
+    for fmu in all_fmus(distribution) + all_fmus(distribution, fmi3=True):
         assert validate_fmu(str(fmu)) == [], fmu
 
 
@@ -201,9 +218,9 @@ def vrs(fmu):
     return {v.name: v.valueReference for v in read_model_description(str(fmu)).modelVariables}
 
 
-def probe(platform, programs, folder, identifier, *script):
-    done = run(platform, programs, "fmi_probe", library(folder, platform, identifier), *script,
-               check=False)
+def probe(platform, programs, folder, identifier, *script, fmi3=False):
+    done = run(platform, programs, "fmi_probe", library(folder, platform, identifier, fmi3),
+               *script, check=False)
     assert done.returncode == 0, f"{platform}: {done.stdout}\n{done.stderr}"
     return done.stdout
 
@@ -320,3 +337,37 @@ def test_a_state_saved_on_one_platform_continues_bit_for_bit_on_the_others(
                                saved[saver], "steps", 300, 0.3, 0.001, len(watched), *watched)
             assert transcript.split("free state -> 0\n", 1)[1] == continued["linux64"], \
                 f"saved by {saver}, restored by {loader}"
+
+
+def test_fmi3_calls_compute_what_fmi2_calls_do_on_every_platform(distribution, programs, tmp_path):
+    """ContourCCC2D through fmi3 on each platform: the FMI 2.0 transcript's values, bit for
+    bit, steps and a state saved and restored through FMI 3.0 included."""
+    fmu2, fmu3 = distribution / "ContourCCC2D.fmu", Path(f"{distribution}3") / "ContourCCC2D.fmu"
+    guid, token = read_model_description(str(fmu2)).guid, \
+        read_model_description(str(fmu3)).instantiationToken
+    v = vrs(fmu2)
+    assert vrs(fmu3) == {**v, "time": len(v)}
+    inputs = [("pos.x", "0.25"), ("ref.x", "1"), ("ref.y", "0.5")]
+    # 100 steps from 0, then 50 from 0.1, reading three outputs after each.
+    read = [v["u.x"], v["u.y"], v["contourError"]]
+    first, then = ["100", "0", "0.001", "3", *read], ["50", "0.1", "0.001", "3", *read]
+    folders = {3: unpacked(fmu3, tmp_path / "three"), 2: unpacked(fmu2, tmp_path / "two")}
+    for platform in PLATFORMS:
+        state = tmp_path / f"{platform}.state"
+        # A Windows program reads the state through Wine's drive Z:, the Unix root.
+        state_arg = f"Z:{state}" if platform == "win64" else str(state)
+        three = ["inst3", "c", token, "-", "enter3", "0", "exit3",
+                 *[a for name, x in inputs for a in ("setr3", v[name], x)],
+                 "steps3", *first, "save3", state_arg, "steps3", *then,
+                 "load3", state_arg, "steps3", *then, "free3"]
+        two = ["inst", "c", guid, "-", "setup", "0", "enter", "exit",
+               *[a for name, x in inputs for a in ("setr", v[name], x)],
+               "steps", *first, "steps", *then, "free"]
+        transcript3 = probe(platform, programs, folders[3], "ContourCCC2D", *three, fmi3=True)
+        transcript2 = probe(platform, programs, folders[2], "ContourCCC2D", *two)
+        reals3 = [line for line in transcript3.splitlines() if line.startswith("real ")]
+        reals2 = [line for line in transcript2.splitlines() if line.startswith("real ")]
+        assert len(reals2) == 3 * 150, platform
+        # FMI 3.0: 100 steps, 50 more, then the same 50 again from the restored state.
+        assert reals3 == reals2 + reals2[-150:], platform
+        assert "deserialize -> 0" in transcript3 and "set state -> 0" in transcript3

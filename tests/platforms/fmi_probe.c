@@ -16,6 +16,13 @@
  *     save FILE                 fmi2GetFMUstate + fmi2SerializeFMUstate into FILE
  *     load FILE                 FILE's bytes through fmi2DeSerializeFMUstate + fmi2SetFMUstate
  *     load-corrupt              a state of 64 bytes of garbage through fmi2DeSerializeFMUstate
+ *   The same through FMI 3.0 (the instance of the last inst3):
+ *     inst3 NAME TOKEN PATH|-   fmi3InstantiateCoSimulation (logging on; '-' is NULL)
+ *     enter3 T0 | exit3 | free3 fmi3EnterInitializationMode (the experiment from T0) ...
+ *     setr3 VR VALUE | getr3 VR fmi3SetFloat64, fmi3GetFloat64
+ *     steps3 N T0 H K VR1..VRK  N fmi3DoStep of H from T0, printing the K reals after each
+ *     save3 FILE | load3 FILE   fmi3 state serialized into FILE, or FILE's bytes restored
+ * Reals print alike through both standards, so a transcript's "real" lines compare.
  */
 #include <inttypes.h>
 #include <stdarg.h>
@@ -24,6 +31,7 @@
 #include <string.h>
 
 #include "fmi2Functions.h"
+#include "fmi3Functions.h"
 
 #ifdef _WIN32
 #include <windows.h>
@@ -71,7 +79,39 @@ static void print_real(unsigned vr, double value) {
     printf("real %u %016" PRIx64 "\n", vr, bits);
 }
 
-static void status(const char *what, fmi2Status s) { printf("%s -> %d\n", what, (int)s); }
+/* A status of either standard (their values agree: OK 0 ... Fatal 4). */
+static void status(const char *what, int s) { printf("%s -> %d\n", what, s); }
+
+/* FMI 3.0's log callback: the message itself, no format. */
+static void logger3(fmi3InstanceEnvironment env, fmi3Status s, fmi3String category,
+                    fmi3String message) {
+    (void)env;
+    printf("log %d %s: %s\n", (int)s, category ? category : "(null)", message ? message : "");
+}
+
+/* A file's bytes (malloc'ed; the caller frees them), or exit. */
+static unsigned char *read_file(const char *file, size_t *size) {
+    FILE *in = fopen(file, "rb");
+    long length = -1;
+    if (in != NULL && fseek(in, 0, SEEK_END) == 0) length = ftell(in);
+    if (length < 0 || fseek(in, 0, SEEK_SET) != 0) {
+        printf("cannot read %s\n", file);
+        exit(2);
+    }
+    unsigned char *bytes = malloc((size_t)length + 1);
+    *size = fread(bytes, 1, (size_t)length, in);
+    fclose(in);
+    return bytes;
+}
+
+static void write_file(const char *file, const void *bytes, size_t size) {
+    FILE *out = fopen(file, "wb");
+    if (out == NULL || fwrite(bytes, 1, size, out) != size) {
+        printf("cannot write %s\n", file);
+        exit(2);
+    }
+    fclose(out);
+}
 
 int main(int argc, char **argv) {
     if (argc < 2) {
@@ -178,29 +218,14 @@ int main(int argc, char **argv) {
             status("state size", F(fmi2SerializedFMUstateSize)(c, state, &size));
             fmi2Byte *bytes = malloc(size ? size : 1);
             status("serialize", F(fmi2SerializeFMUstate)(c, state, bytes, size));
-            FILE *out = fopen(file, "wb");
-            if (out == NULL || fwrite(bytes, 1, size, out) != size) {
-                printf("cannot write %s\n", file);
-                return 2;
-            }
-            fclose(out);
+            write_file(file, bytes, size);
             free(bytes);
             status("free state", F(fmi2FreeFMUstate)(c, &state));
         } else if (!strcmp(cmd, "load") || !strcmp(cmd, "load-corrupt")) {
             size_t size = 64;
             fmi2Byte *bytes = NULL;
             if (!strcmp(cmd, "load")) {
-                const char *file = ARG();
-                FILE *in = fopen(file, "rb");
-                long length = -1;
-                if (in != NULL && fseek(in, 0, SEEK_END) == 0) length = ftell(in);
-                if (length < 0 || fseek(in, 0, SEEK_SET) != 0) {
-                    printf("cannot read %s\n", file);
-                    return 2;
-                }
-                bytes = malloc((size_t)length + 1);
-                size = fread(bytes, 1, (size_t)length, in);
-                fclose(in);
+                bytes = (fmi2Byte *)read_file(ARG(), &size);
             } else {
                 bytes = malloc(size);
                 for (size_t k = 0; k < size; k++) bytes[k] = (fmi2Byte)(k * 37 + 11);
@@ -211,6 +236,77 @@ int main(int argc, char **argv) {
             if (s == fmi2OK) {
                 status("set state", F(fmi2SetFMUstate)(c, state));
                 status("free state", F(fmi2FreeFMUstate)(c, &state));
+            }
+            free(bytes);
+        } else if (!strcmp(cmd, "inst3")) {
+            const char *name = ARG(), *token = ARG(), *path = ARG();
+            c = F(fmi3InstantiateCoSimulation)(name, token, strcmp(path, "-") ? path : NULL,
+                                               false, true, false, false, NULL, 0, NULL,
+                                               logger3, NULL);
+            printf("instantiate -> %s\n", c ? "component" : "NULL");
+        } else if (!strcmp(cmd, "enter3")) {
+            double t0 = strtod(ARG(), NULL);
+            status("enter", F(fmi3EnterInitializationMode)(c, false, 0.0, t0, false, 0.0));
+        } else if (!strcmp(cmd, "exit3")) {
+            status("exit", F(fmi3ExitInitializationMode)(c));
+        } else if (!strcmp(cmd, "free3")) {
+            F(fmi3FreeInstance)(c);
+            c = NULL;
+            printf("freed\n");
+        } else if (!strcmp(cmd, "setr3")) {
+            fmi3ValueReference vr = (fmi3ValueReference)strtoul(ARG(), NULL, 10);
+            fmi3Float64 v = strtod(ARG(), NULL);
+            status("setr", F(fmi3SetFloat64)(c, &vr, 1, &v, 1));
+        } else if (!strcmp(cmd, "getr3")) {
+            fmi3ValueReference vr = (fmi3ValueReference)strtoul(ARG(), NULL, 10);
+            fmi3Float64 v = 0;
+            status("getr", F(fmi3GetFloat64)(c, &vr, 1, &v, 1));
+            print_real(vr, v);
+        } else if (!strcmp(cmd, "steps3")) {
+            long n = strtol(ARG(), NULL, 10);
+            double t0 = strtod(ARG(), NULL), h = strtod(ARG(), NULL);
+            int count = (int)strtol(ARG(), NULL, 10), first = i;
+            if (count < 0 || first + count > argc) {
+                fprintf(stderr, "steps3: fewer value references than %d\n", count);
+                return 2;
+            }
+            i += count;
+            for (long k = 0; k < n; k++) {
+                bool event = true, terminate = true, early = true;
+                double last = -1.0;
+                fmi3Status s = F(fmi3DoStep)(c, t0 + (double)k * h, h, true, &event, &terminate,
+                                             &early, &last);
+                if (s != fmi3OK || event || terminate || early) {
+                    printf("step %ld -> %d (%d %d %d)\n", k, (int)s, event, terminate, early);
+                    break;
+                }
+                for (int j = first; j < first + count; j++) {
+                    fmi3ValueReference vr = (fmi3ValueReference)strtoul(argv[j], NULL, 10);
+                    fmi3Float64 v = 0;
+                    if (F(fmi3GetFloat64)(c, &vr, 1, &v, 1) != fmi3OK) printf("getr %u failed\n", vr);
+                    print_real(vr, v);
+                }
+            }
+        } else if (!strcmp(cmd, "save3")) {
+            const char *file = ARG();
+            fmi3FMUState state = NULL;
+            size_t size = 0;
+            status("get state", F(fmi3GetFMUState)(c, &state));
+            status("state size", F(fmi3SerializedFMUStateSize)(c, state, &size));
+            fmi3Byte *bytes = malloc(size ? size : 1);
+            status("serialize", F(fmi3SerializeFMUState)(c, state, bytes, size));
+            write_file(file, bytes, size);
+            free(bytes);
+            status("free state", F(fmi3FreeFMUState)(c, &state));
+        } else if (!strcmp(cmd, "load3")) {
+            size_t size = 0;
+            fmi3Byte *bytes = read_file(ARG(), &size);
+            fmi3FMUState state = NULL;
+            fmi3Status s = F(fmi3DeserializeFMUState)(c, bytes, size, &state);
+            status("deserialize", s);
+            if (s == fmi3OK) {
+                status("set state", F(fmi3SetFMUState)(c, state));
+                status("free state", F(fmi3FreeFMUState)(c, &state));
             }
             free(bytes);
         } else {

@@ -1,6 +1,6 @@
-//! `cargo run -p xtask -- bindings [--check]`: regenerates the committed FMI 2.0 bindings
-//! from third_party/fmi2/, or with `--check` only verifies them (exit status 1 when a
-//! committed file is out of date).
+//! `cargo run -p xtask -- bindings [--check]`: regenerates the committed FMI 2.0 and FMI 3.0
+//! bindings from third_party/fmi2/ and third_party/fmi3/, or with `--check` only verifies
+//! them (exit status 1 when a committed file is out of date).
 
 use std::fs;
 use std::process::ExitCode;
@@ -8,7 +8,7 @@ use std::process::ExitCode;
 const USAGE: &str = "\
 usage: cargo run -p xtask -- bindings [--check]
 
-bindings          regenerate the FMI 2.0 bindings from third_party/fmi2/ with bindgen
+bindings          regenerate the FMI 2.0 and 3.0 bindings from third_party/fmi2/ and fmi3/ with bindgen
                   (needs libclang; Debian: libclang-dev) and write the files that changed
 bindings --check  regenerate in memory only; fail if a committed file differs";
 

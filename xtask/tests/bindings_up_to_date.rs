@@ -1,4 +1,4 @@
-//! The committed FMI 2.0 bindings are exactly what bindgen makes of the vendored headers
+//! The committed FMI 2.0 and FMI 3.0 bindings are exactly what bindgen makes of the vendored headers
 //! (`cargo run -p xtask -- bindings` regenerates them). Needs libclang (Debian:
 //! libclang-dev); the FMU library itself builds without it.
 

@@ -1,6 +1,7 @@
-"""Engine: FMUs' log messages kept in Python, fmpy's FMI 2.0 callbacks with a logger that
+"""Engine: FMUs' log messages kept in Python: fmpy's FMI 2.0 callbacks with a logger that
 collects the messages (formatted by fmpy's native proxy, which applies the variadic "%s"
-arguments the way a C importer would). Used by the campaigns' runner and the tests."""
+arguments the way a C importer would), and FMI 3.0's log callback (the message itself, no
+format). Used by the masters, the campaigns' runner and the tests."""
 
 from ctypes import byref
 
@@ -17,11 +18,13 @@ def _text(value):
 
 
 class FmuLog:
-    """Give `callbacks` to FMU2Slave.instantiate; `records` then holds every message of
-    status `least` or worse, as (instance name, status, category, message)."""
+    """Give `callbacks` to FMU2Slave.instantiate, or `fmi3_callback(name)` to
+    FMU3Slave.instantiate as its logMessage; `records` then holds every message of status
+    `least` or worse, as (instance name, status, category, message)."""
 
     def __init__(self, least=OK):
         self.records = []
+        self.least = least
 
         def log(_env, name, status, category, message):
             if status >= least:
@@ -32,6 +35,13 @@ class FmuLog:
         self.callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self.callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         addLoggerProxy(byref(self.callbacks))
+
+    def fmi3_callback(self, name):
+        """FMI 3.0's log callback for the instance `name` (FMI 3.0 passes no instance name)."""
+        def log(_env, status, category, message):
+            if status >= self.least:
+                self.records.append((name, status, _text(category), _text(message)))
+        return log
 
     def clear(self):
         self.records.clear()

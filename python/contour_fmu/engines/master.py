@@ -1,6 +1,6 @@
-"""Engine: the fmpy master, a small fixed-step co-simulation master on fmpy's FMU2Slave
-(closed_loop, five_axis_closed_loop; contour_fmu.master.closed_loop is the documented
-entry point).
+"""Engine: the fmpy master, a small fixed-step co-simulation master on fmpy's FMU2Slave and
+FMU3Slave: FMI 2.0 and FMI 3.0 Co-Simulation FMUs, in any mix (closed_loop,
+five_axis_closed_loop; contour_fmu.master.closed_loop is the documented entry point).
 
 Connects FMU outputs to inputs and steps every FMU with one communication step. Two
 coupling schemes:
@@ -20,21 +20,21 @@ from pathlib import Path
 
 import numpy as np
 from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
 
 from ..loops.wiring import FIVE_AXIS, LOOPS, TWO_AXIS
+from .slaves import PYTHON_TYPES, accessors, kind, open_slave, start
 from .stepping import SCHEMES, Stepping
 
 
 def co_simulation_description(path):
-    """The model description of the FMI 2.0 Co-Simulation FMU at `path`. Anything else is
-    refused with a ValueError naming the file and saying why: a master steps its FMUs
-    through fmi2DoStep, which an FMU exported for Model Exchange only does not have (it
-    needs an ODE solver that the FMU does not carry)."""
+    """The model description of the FMI 2.0 or FMI 3.0 Co-Simulation FMU at `path`.
+    Anything else is refused with a ValueError naming the file and saying why: a master
+    steps its FMUs through fmi2DoStep or fmi3DoStep, which an FMU exported for Model
+    Exchange only does not have (it needs an ODE solver that the FMU does not carry)."""
     md = read_model_description(str(path))
-    if md.fmiVersion != "2.0":
+    if md.fmiVersion not in ("2.0", "3.0"):
         raise ValueError(f"{path}: an FMI {md.fmiVersion} FMU; these masters run FMI 2.0 "
-                         f"Co-Simulation FMUs")
+                         f"and FMI 3.0 Co-Simulation FMUs")
     if md.coSimulation is None:
         raise ValueError(
             f"{path}: exported for Model Exchange only (no <CoSimulation> in its model "
@@ -69,7 +69,7 @@ def check_connections(descriptions, connections):
         return found
     for src, out, dst, inp in connections:
         a, b = variable(src, out), variable(dst, inp)
-        if a.type != b.type:
+        if kind(a.type) != kind(b.type):
             raise ValueError(f"connection {src}.{out} -> {dst}.{inp}: a {a.type} onto a {b.type}")
         ua, ub = _unit(a), _unit(b)
         if ua and ub and ua != ub:
@@ -80,20 +80,14 @@ def check_connections(descriptions, connections):
 
 
 def set_value(slave, variable, value):
-    """Sets one variable (an fmpy model variable) of an FMU2Slave, by its type."""
-    vr = [variable.valueReference]
-    if variable.type == "Real":
-        slave.setReal(vr, [float(value)])
-    elif variable.type in ("Integer", "Enumeration"):
-        slave.setInteger(vr, [int(value)])
-    elif variable.type == "Boolean":
-        slave.setBoolean(vr, [bool(value)])
-    else:
-        slave.setString(vr, [str(value)])
+    """Sets one variable (an fmpy model variable) of a slave of either standard, by its
+    type."""
+    _, put = accessors(slave, variable.type)
+    put([variable.valueReference], [PYTHON_TYPES[kind(variable.type)](value)])
 
 
 def free_all(slaves):
-    """Terminates (when it can) and frees every FMU2Slave: a failed run still frees its
+    """Terminates (when it can) and frees every slave: a failed run still frees its
     instances."""
     for slave in slaves:
         try:
@@ -132,13 +126,10 @@ class Master:
             md = descriptions[u.name]
             directory = extract(u.path)
             self._dirs.append(directory)
-            slave = FMU2Slave(guid=md.guid, unzipDirectory=directory,
-                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=u.name)
+            slave = open_slave(md, directory, u.name)
             self.slaves[u.name] = slave
             self.variables[u.name] = {v.name: v for v in md.modelVariables}
-            slave.instantiate(callbacks=None if self.log is None else self.log.callbacks)
-            slave.setupExperiment(startTime=0.0, stopTime=self.stop)
-            slave.enterInitializationMode()
+            start(slave, self.stop, self.log)
             for name, value in u.start_values.items():
                 self.set(u.name, name, value)
         for src, out, dst, inp in self.initial:
@@ -156,15 +147,9 @@ class Master:
         set_value(self.slaves[unit], self.variables[unit][name], value)
 
     def get(self, unit, name):
-        slave, v = self.slaves[unit], self.variables[unit][name]
-        vr = [v.valueReference]
-        if v.type == "Real":
-            return slave.getReal(vr)[0]
-        if v.type in ("Integer", "Enumeration"):
-            return slave.getInteger(vr)[0]
-        if v.type == "Boolean":
-            return slave.getBoolean(vr)[0]
-        return slave.getString(vr)[0]
+        v = self.variables[unit][name]
+        get, _ = accessors(self.slaves[unit], v.type)
+        return get([v.valueReference])[0]
 
     def run(self, record):
         """Steps from 0 to the stop time (contour_fmu.engines.stepping). Returns two structured

@@ -1,5 +1,5 @@
 """Engine: the fixed-step stepping loop of the fmpy master (contour_fmu.engines.master) and
-of the campaigns' runner: FMU2Slaves stepped one communication step at a time in a given
+of the campaigns' runner: fmpy slaves (FMI 2.0 or 3.0) stepped one communication step at a time in a given
 order, their connections and the recorded variables resolved to value references once.
 
 Two coupling schemes (contour_fmu.engines.master explains them): "gauss-seidel", each
@@ -10,23 +10,13 @@ recorded variables of one FMU and type read with one get: the values are those o
 call per variable.
 """
 
+from .slaves import PYTHON_TYPES, accessors, kind
+
 SCHEMES = ("gauss-seidel", "jacobi")
-_PYTHON_TYPES = {"Real": float, "Integer": int, "Enumeration": int, "Boolean": bool, "String": str}
-
-
-def _accessors(slave, kind):
-    """(get, set) of an FMU2Slave for variables of type `kind`."""
-    if kind == "Real":
-        return slave.getReal, slave.setReal
-    if kind in ("Integer", "Enumeration"):
-        return slave.getInteger, slave.setInteger
-    if kind == "Boolean":
-        return slave.getBoolean, slave.setBoolean
-    return (lambda vrs: [s.decode() for s in slave.getString(vrs)]), slave.setString
 
 
 class Stepping:
-    """The loop over `slaves` (unit -> FMU2Slave, in stepping order)."""
+    """The loop over `slaves` (unit -> fmpy slave of either standard, in stepping order)."""
 
     def __init__(self, slaves, variables, connections, scheme="gauss-seidel"):
         """variables: unit -> {name: fmpy model variable}; connections: (source unit,
@@ -49,10 +39,10 @@ class Stepping:
             source, target = self.variables[src][out], self.variables[dst][inp]
             key = (src, dst, source.type, target.type)
             if key != last or src == dst:
-                get, _ = _accessors(self.slaves[src], source.type)
-                _, put = _accessors(self.slaves[dst], target.type)
-                if source.type != target.type:
-                    get = lambda vrs, get=get, convert=_PYTHON_TYPES[target.type]: [  # noqa: E731
+                get, _ = accessors(self.slaves[src], source.type)
+                _, put = accessors(self.slaves[dst], target.type)
+                if kind(source.type) != kind(target.type):
+                    get = lambda vrs, get=get, convert=PYTHON_TYPES[kind(target.type)]: [  # noqa: E731
                         convert(v) for v in get(vrs)]
                 groups.append((get, [], put, []))
             groups[-1][1].append(source.valueReference)
@@ -67,7 +57,7 @@ class Stepping:
             variable = self.variables[unit][name]
             key = (unit, variable.type)
             if key != last:
-                reads.append((_accessors(self.slaves[unit], variable.type)[0], []))
+                reads.append((accessors(self.slaves[unit], variable.type)[0], []))
             reads[-1][1].append(variable.valueReference)
             last = key
         return reads

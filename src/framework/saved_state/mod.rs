@@ -3,7 +3,7 @@
 //! restored state ([`SavedState`], [`Model::check_state`](super::model::Model::check_state)),
 //! the checks every number in it can get ([`all_finite`], [`all_positive`], from `walk`),
 //! and the state methods of a sampled model written once (`sampled_state_methods!`).
-//! The FMI side (the snapshot around it, handles, ownership) is `crate::fmi2::fmu_state`.
+//! The FMI side (the snapshot around it, handles, ownership) is `crate::fmi::fmu_state`.
 
 pub mod bytes;
 mod walk;

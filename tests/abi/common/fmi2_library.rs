@@ -4,7 +4,7 @@
 // Do not edit: regenerate. `cargo run -p xtask -- bindings --check` fails when
 // this file is out of date.
 #![allow(non_camel_case_types, non_snake_case, non_upper_case_globals, dead_code)]
-#![allow(clippy::missing_safety_doc, clippy::too_many_arguments)]
+#![allow(clippy::missing_safety_doc, clippy::too_many_arguments, clippy::type_complexity)]
 use fmi2_bindings::*;
 
 pub struct Fmi2Binding {

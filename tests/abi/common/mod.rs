@@ -16,6 +16,10 @@ pub use fmi2_bindings::*;
 #[rustfmt::skip]
 mod fmi2_library;
 pub use fmi2_library::*;
+// FMI 3.0: `Fmi3Binding` (generated from third_party/fmi3/) and an instance wrapper.
+#[rustfmt::skip]
+mod fmi3_library;
+pub mod fmi3;
 // The same functions linked statically instead (tests/abi/no_alloc.rs, benches/fmu_abi.rs).
 pub mod linked;
 
@@ -56,7 +60,7 @@ pub const DISCARD: fmi2Status = fmi2Status_fmi2Discard;
 pub const ERROR: fmi2Status = fmi2Status_fmi2Error;
 pub const FATAL: fmi2Status = fmi2Status_fmi2Fatal;
 
-pub use contour_fmu::fmi2::FMI2_CO_SIMULATION;
+pub use contour_fmu::fmi::FMI2_CO_SIMULATION;
 
 /// The cdylib cargo built with this test binary: `cargo test` leaves it beside the test
 /// in target/<profile>/deps/, `cargo build` in target/<profile>/.
@@ -431,7 +435,7 @@ impl Drop for Instance {
 }
 
 // ---------------------------------------------------------------------------------------
-// Serialized FMU states, opened and resealed by hand (the layout of src/fmi2/fmu_state.rs:
+// Serialized FMU states, opened and resealed by hand (the layout of src/fmi/fmu_state.rs:
 // magic, format version, postcard payload, CRC-32), to hand the library bytes that pass
 // the checksum but carry a bad value inside.
 

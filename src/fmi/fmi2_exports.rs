@@ -1,80 +1,38 @@
 //! The 34 exported `fmi2*` functions of FMI 2.0 Co-Simulation. Each one only converts C
 //! arguments and hands over to [`Instance`]; [`dispatch`] supplies what all share: the
-//! instance lookup in the registry, the lock, the state machine, logging and panic capture.
+//! instance lookup in the registry (an FMI 3.0 instance is refused), the lock, the state
+//! machine, logging and panic capture.
 
 #![allow(non_snake_case)]
 
-use std::ffi::{c_char, CStr};
+use std::ffi::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::ptr;
 
 use fmi2_bindings::*;
 
+use super::c_args::{array, array_mut, c_str, slice, slice_mut};
 use super::instance::Instance;
-use super::logger::{Category, Logger};
-use super::registry;
+use super::logger::{Callback, Category, Logger};
 use super::resource_uri::resource_dir;
-use super::slab::is_handle;
-use super::state_machine::{Call, Mode};
+use super::standard::Standard;
+use super::state_calls;
+use super::state_machine::Call;
 use super::status::{Failure, Outcome, Status};
-use crate::framework::model::Environment;
 use crate::framework::variables::{Value, VarType};
 use crate::models;
 
-fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
-    payload
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| payload.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "unknown panic".into())
-}
-
-/// Runs one instance function: looks `c` up in the registry, which locks the instance for
-/// the call (a NULL, freed or foreign pointer is `fmi2Error` without touching it; there is
-/// no instance to log to), checks the mode, runs `body`, logs a failure, and turns a panic
-/// into `fmi2Fatal` (the instance then only accepts `fmi2FreeInstance` and
-/// `fmi2FreeFMUstate`).
+/// [`super::dispatch::dispatch`] for an FMI 2.0 instance.
 #[inline]
 fn dispatch(
     c: fmi2Component,
     call: Call,
     body: impl FnOnce(&mut Instance) -> Outcome,
 ) -> fmi2Status {
-    let handle = c as usize;
-    let result = catch_unwind(AssertUnwindSafe(|| {
-        let mut instance = registry::instance(handle)?;
-        let status = if !call.is_allowed_in(instance.mode) {
-            refuse_in_this_mode(&instance, call)
-        } else {
-            if instance.logger.is_enabled(Category::All) {
-                trace(&instance, call);
-            }
-            match body(&mut instance) {
-                Ok(()) => Status::Ok,
-                Err(failure) => instance.report(call, &failure),
-            }
-        };
-        // Sent after the lock is released: the importer's logger may call us back.
-        let outbox = instance.logger.take();
-        drop(instance);
-        if let Some(outbox) = outbox {
-            outbox.send();
-        }
-        Some(status)
-    }));
-    match result {
-        Ok(Some(status)) => status.code(),
-        Ok(None) => Status::Error.code(),
-        Err(payload) => fatal(handle, call, payload),
-    }
+    super::dispatch::dispatch(Standard::Fmi2, c as usize, call, body)
 }
 
-/// [`dispatch`] for `fmi2SetReal` and `fmi2GetReal`: `fast` does the call's common case
-/// with the instance locked once and none of the general path's bookkeeping, or declines
-/// (`None`, having changed nothing); then [`dispatch`] runs `body`, the call in full (it
-/// looks the instance up again: if another thread freed it meanwhile, the call is refused
-/// as if it had come a moment later). `fast` does exactly what `body` does in the case it
-/// accepts, in a mode the state machine allows and with `logAll` off (no trace to log).
+/// [`super::dispatch::dispatch_fast`] for an FMI 2.0 instance.
 #[inline(always)]
 fn dispatch_fast(
     c: fmi2Component,
@@ -82,133 +40,7 @@ fn dispatch_fast(
     fast: impl FnOnce(&mut Instance) -> Option<()>,
     body: impl FnOnce(&mut Instance) -> Outcome,
 ) -> fmi2Status {
-    let handle = c as usize;
-    let done = catch_unwind(AssertUnwindSafe(|| {
-        let mut instance = registry::instance(handle)?;
-        if !call.is_allowed_in(instance.mode) || instance.logger.is_enabled(Category::All) {
-            return None;
-        }
-        fast(&mut instance)?;
-        let outbox = instance.logger.take();
-        drop(instance);
-        if let Some(outbox) = outbox {
-            outbox.send();
-        }
-        Some(())
-    }));
-    match done {
-        Ok(Some(())) => Status::Ok.code(),
-        Ok(None) => dispatch_out_of_line(c, call, body),
-        Err(payload) => fatal(handle, call, payload),
-    }
-}
-
-#[inline(never)]
-fn dispatch_out_of_line(
-    c: fmi2Component,
-    call: Call,
-    body: impl FnOnce(&mut Instance) -> Outcome,
-) -> fmi2Status {
-    dispatch(c, call, body)
-}
-
-// The rare paths of `dispatch`, out of line: the per-sample calls stay short.
-
-#[cold]
-#[inline(never)]
-fn refuse_in_this_mode(instance: &Instance, call: Call) -> Status {
-    let failure = Failure::error(format!("illegal call sequence (state {:?})", instance.mode));
-    instance.report(call, &failure)
-}
-
-#[cold]
-#[inline(never)]
-fn trace(instance: &Instance, call: Call) {
-    let trace = format!("{} called", call.name());
-    instance.logger.log(Status::Ok, Category::All, &trace);
-}
-
-/// After a panic in a call: marks the instance Fatal (if it is still there: the guard was
-/// dropped as the panic unwound, so another thread may have freed it) and logs why.
-#[cold]
-#[inline(never)]
-fn fatal(handle: usize, call: Call, payload: Box<dyn std::any::Any + Send>) -> fmi2Status {
-    let message = panic_text(payload.as_ref());
-    let _ = catch_unwind(AssertUnwindSafe(|| {
-        let Some(mut instance) = registry::instance(handle) else {
-            return;
-        };
-        instance.mode = Mode::Fatal;
-        instance.report(
-            call,
-            &Failure {
-                status: Status::Fatal,
-                message: format!("internal error (panic): {message}"),
-            },
-        );
-        let outbox = instance.logger.take();
-        drop(instance);
-        if let Some(outbox) = outbox {
-            outbox.send();
-        }
-    }));
-    Status::Fatal.code()
-}
-
-/// A slice from a C array, refusing NULL with a non-zero length.
-#[inline]
-unsafe fn slice<'a, T>(data: *const T, len: usize, what: &str) -> Outcome<&'a [T]> {
-    if len == 0 {
-        Ok(&[])
-    } else if data.is_null() {
-        Err(null_array(what, len))
-    } else {
-        Ok(std::slice::from_raw_parts(data, len))
-    }
-}
-
-#[inline]
-unsafe fn slice_mut<'a, T>(data: *mut T, len: usize, what: &str) -> Outcome<&'a mut [T]> {
-    if len == 0 {
-        Ok(&mut [])
-    } else if data.is_null() {
-        Err(null_array(what, len))
-    } else {
-        Ok(std::slice::from_raw_parts_mut(data, len))
-    }
-}
-
-/// A slice from a C array for a fast path: `None` for NULL with a non-zero length.
-#[inline(always)]
-unsafe fn array<'a, T>(data: *const T, len: usize) -> Option<&'a [T]> {
-    match len {
-        0 => Some(&[]),
-        _ if data.is_null() => None,
-        _ => Some(std::slice::from_raw_parts(data, len)),
-    }
-}
-
-#[inline(always)]
-unsafe fn array_mut<'a, T>(data: *mut T, len: usize) -> Option<&'a mut [T]> {
-    match len {
-        0 => Some(&mut []),
-        _ if data.is_null() => None,
-        _ => Some(std::slice::from_raw_parts_mut(data, len)),
-    }
-}
-
-#[cold]
-#[inline(never)]
-fn null_array(what: &str, len: usize) -> Failure {
-    Failure::error(format!("{what} is NULL but its length is {len}"))
-}
-
-unsafe fn c_str<'a>(text: fmi2String) -> Option<&'a str> {
-    if text.is_null() {
-        None
-    } else {
-        CStr::from_ptr(text).to_str().ok()
-    }
+    super::dispatch::dispatch_fast(Standard::Fmi2, c as usize, call, fast, body)
 }
 
 // ---------------------------------------------------------------------------------------
@@ -245,7 +77,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
         functions.logger?;
         let name = c_str(instanceName).unwrap_or("");
         let logger = Logger::new(
-            functions.logger,
+            Callback::fmi2(functions.logger),
             functions.componentEnvironment,
             name,
             loggingOn != 0,
@@ -280,12 +112,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 known.join(", ")
             ));
         };
-        let mut environment = Environment {
-            resource_dir: None,
-            planner: super::plans::planner(),
-            xy_plans: super::plans::xy_plans(),
-            indexes: super::plans::true_error_indexes(),
-        };
+        let mut environment = super::plans::environment();
         if !fmuResourceLocation.is_null() {
             match c_str(fmuResourceLocation)
                 .ok_or_else(|| "resource location is not UTF-8".to_string())
@@ -299,26 +126,15 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 ),
             }
         }
-        let instance = Instance::with_interface(interface, environment, logger, name);
+        let instance =
+            Instance::with_interface(Standard::Fmi2, interface, environment, logger, name);
         instance.log_event(&format!(
             "instantiated {} with the {} interface (GUID {guid}, {})",
             interface.model.identifier,
             interface.units.name(),
             crate::build_identity::described()
         ));
-        instance.logger.flush();
-        match registry::add_instance(instance) {
-            Ok(handle) => Some(handle as fmi2Component),
-            Err(instance) => {
-                instance.logger.log(
-                    Status::Error,
-                    Category::StatusError,
-                    "fmi2Instantiate: too many live instances in this process",
-                );
-                instance.logger.flush();
-                None
-            }
-        }
+        super::dispatch::register(instance, "fmi2Instantiate").map(|h| h as fmi2Component)
     }));
     match result {
         Ok(Some(c)) => c,
@@ -331,16 +147,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
 /// foreign `c` is ignored.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-    // Nothing happens for a handle that is not a live instance.
-    dispatch(c, Call::FreeInstance, |instance| {
-        instance.log_event("freed");
-        Ok(())
-    });
-    // Unregistered whatever the log call did (even a panic in it must not leak the
-    // instance), once a call still running on another thread has ended. The instance,
-    // with its FMU states, is dropped here, outside the registry.
-    let removed = registry::remove_instance(c as usize);
-    let _ = catch_unwind(AssertUnwindSafe(move || drop(removed)));
+    super::dispatch::free_instance(Standard::Fmi2, c as usize);
 }
 
 /// # Safety
@@ -607,42 +414,12 @@ pub unsafe extern "C" fn fmi2SetString(
 // ---------------------------------------------------------------------------------------
 // FMU state
 
-/// The variable behind an `fmi2FMUstate*` argument. The argument must be the address of
-/// the importer's variable; if it is one of our FMU state handles instead (see
-/// `fmi2FreeFMUstate`), it is no address at all, so it is refused before it is
-/// dereferenced.
-///
-/// # Safety
-/// `slot` is NULL, one of our handles, or points to a writable `fmi2FMUstate`.
-unsafe fn state_slot<'a>(slot: *mut fmi2FMUstate) -> Outcome<&'a mut fmi2FMUstate> {
-    if is_handle(slot as usize) {
-        // Live or freed, a handle of ours is not an address (see slab.rs).
-        return Err(Failure::error(
-            "the FMUstate* argument is an FMU state, not the address of a variable holding one",
-        ));
-    }
-    slot.as_mut()
-        .ok_or_else(|| Failure::error("FMUstate (the address of the variable) is NULL"))
-}
-
 /// # Safety
 /// `state` points to a variable holding NULL or a state this instance returned earlier.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
     dispatch(c, Call::FmuState("fmi2GetFMUstate"), |instance| {
-        let slot = state_slot(state)?;
-        let existing = *slot as usize;
-        // FMI 2.0: a non-NULL *FMUstate is an earlier state to be overwritten.
-        if existing != 0 && !instance.states.contains(existing) {
-            return Err(instance.states.unknown(existing));
-        }
-        let bytes = instance.snapshot()?;
-        if existing == 0 {
-            *slot = instance.states.add(bytes) as fmi2FMUstate;
-        } else {
-            instance.states.overwrite(existing, bytes)?;
-        }
-        Ok(())
+        state_calls::get(instance, state)
     })
 }
 
@@ -656,49 +433,15 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, state: fmi2FMUstate) 
 }
 
 /// # Safety
-/// `state` is NULL, points to a variable holding NULL or a state of this instance, or (the
-/// importer bug handled below) is a state of this instance itself.
+/// `state` is NULL, points to a variable holding NULL or a state of this instance, or (an
+/// importer bug, see [`state_calls::free`]) is a state of this instance itself.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeFMUstate(
     c: fmi2Component,
     state: *mut fmi2FMUstate,
 ) -> fmi2Status {
     dispatch(c, Call::FreeFmuState, |instance| {
-        let handle = state as usize;
-        // fmusim 0.0.39 calls fmi2FreeFMUstate(c, FMUState): the state instead of the
-        // address of the variable holding it. Dereferencing it (as the standard signature
-        // asks) would read our own state object as a pointer and then free whatever that
-        // points to: the SIGSEGV this used to be. Handles are never user-space addresses
-        // (slab.rs), so the misuse is recognised exactly, also with a freed state.
-        // We free the state and answer fmi2OK (with a warning in the log):
-        // - memory stays safe either way: the importer's variable keeps the stale value,
-        //   but every later use of it is looked up here first and refused, never read;
-        // - refusing would leak the state until fmi2FreeInstance and, worse, end fmusim's
-        //   run (it aborts on any status above fmi2OK), although the intent is clear.
-        if instance.states.contains(handle) {
-            instance.states.free(handle)?;
-            instance.log_warning(&format!(
-                "fmi2FreeFMUstate: the argument is the FMU state {handle:#x} itself, not the \
-                 address of a variable holding it (an importer bug); the state was freed, \
-                 the importer's variable could not be set to NULL"
-            ));
-            return Ok(());
-        }
-        if is_handle(handle) {
-            // The same misuse with another instance's state or a freed one: refused, and
-            // never dereferenced (a handle is not an address).
-            return Err(instance.states.unknown(handle));
-        }
-        // FMI 2.0: a NULL pointer (or a variable holding NULL) is ignored.
-        let Some(slot) = state.as_mut() else {
-            return Ok(());
-        };
-        if slot.is_null() {
-            return Ok(());
-        }
-        instance.states.free(*slot as usize)?;
-        *slot = ptr::null_mut();
-        Ok(())
+        state_calls::free(instance, state)
     })
 }
 
@@ -713,13 +456,7 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     dispatch(
         c,
         Call::FmuState("fmi2SerializedFMUstateSize"),
-        |instance| {
-            let bytes = instance.states.bytes(state as usize)?;
-            *size
-                .as_mut()
-                .ok_or_else(|| Failure::error("size is NULL"))? = bytes.len();
-            Ok(())
-        },
+        |instance| state_calls::serialized_size(instance, state, size),
     )
 }
 
@@ -734,16 +471,7 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     size: usize,
 ) -> fmi2Status {
     dispatch(c, Call::FmuState("fmi2SerializeFMUstate"), |instance| {
-        let bytes = instance.states.bytes(state as usize)?;
-        if size < bytes.len() {
-            return Err(Failure::error(format!(
-                "buffer of {size} bytes is too small for the state's {} bytes",
-                bytes.len()
-            )));
-        }
-        let out = slice_mut(serializedState as *mut u8, bytes.len(), "serializedState")?;
-        out.copy_from_slice(bytes);
-        Ok(())
+        state_calls::serialize(instance, state, serializedState as *mut u8, size)
     })
 }
 
@@ -757,18 +485,7 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     state: *mut fmi2FMUstate,
 ) -> fmi2Status {
     dispatch(c, Call::FmuState("fmi2DeSerializeFMUstate"), |instance| {
-        let slot = state_slot(state)?;
-        let bytes = slice(serializedState as *const u8, size, "serializedState")?;
-        instance.check_snapshot(bytes)?;
-        let existing = *slot as usize;
-        // A state of this instance is reused; anything else in the variable (NULL, or
-        // whatever an importer left there) is replaced by a new state, never read.
-        if instance.states.contains(existing) {
-            instance.states.overwrite(existing, bytes.to_vec())?;
-        } else {
-            *slot = instance.states.add(bytes.to_vec()) as fmi2FMUstate;
-        }
-        Ok(())
+        state_calls::deserialize(instance, serializedState as *const u8, size, state)
     })
 }
 

@@ -7,6 +7,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::standard::Standard;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Mode {
     Instantiated,
@@ -40,11 +42,16 @@ pub enum Call {
     FmuState(&'static str),
     FreeFmuState,
     GetDirectionalDerivative,
+    /// FMI 3.0 only; allowed where the directional derivative is.
+    GetAdjointDerivative,
     SetRealInputDerivatives,
     GetRealOutputDerivatives,
     DoStep,
     CancelStep,
     Status(&'static str),
+    /// An FMI 3.0 function these FMUs do not support (Model Exchange, Scheduled Execution,
+    /// clocks, configuration and event mode): answered with an error in any live mode.
+    Unsupported(&'static str),
 }
 
 const INST: u8 = Mode::Instantiated.bit();
@@ -78,12 +85,15 @@ impl Call {
             // As for fmi2FreeInstance: after a fatal error the importer must still be able
             // to release the states it holds; freeing one only drops its bytes.
             Call::FreeFmuState => ALIVE | FATAL,
-            Call::GetDirectionalDerivative => INIT | STEP | FAIL | TERM | ERR,
+            Call::GetDirectionalDerivative | Call::GetAdjointDerivative => {
+                INIT | STEP | FAIL | TERM | ERR
+            }
             Call::SetRealInputDerivatives => INST | INIT | STEP,
             Call::GetRealOutputDerivatives => STEP | FAIL | TERM | ERR,
             Call::DoStep => STEP,
             Call::CancelStep => NEVER,
             Call::Status(_) => STEP | FAIL | TERM,
+            Call::Unsupported(_) => ALIVE,
         }
     }
 
@@ -93,23 +103,38 @@ impl Call {
     }
 
     /// The C function's name, for log messages.
-    pub fn name(self) -> &'static str {
+    /// The function's name in `standard` (calls that exist in one standard only are made
+    /// by that standard's exports alone).
+    pub fn name(self, standard: Standard) -> &'static str {
+        let fmi3 = standard == Standard::Fmi3;
         match self {
+            Call::SetDebugLogging if fmi3 => "fmi3SetDebugLogging",
             Call::SetDebugLogging => "fmi2SetDebugLogging",
+            Call::FreeInstance if fmi3 => "fmi3FreeInstance",
             Call::FreeInstance => "fmi2FreeInstance",
             Call::SetupExperiment => "fmi2SetupExperiment",
+            Call::EnterInitializationMode if fmi3 => "fmi3EnterInitializationMode",
             Call::EnterInitializationMode => "fmi2EnterInitializationMode",
+            Call::ExitInitializationMode if fmi3 => "fmi3ExitInitializationMode",
             Call::ExitInitializationMode => "fmi2ExitInitializationMode",
+            Call::Terminate if fmi3 => "fmi3Terminate",
             Call::Terminate => "fmi2Terminate",
+            Call::Reset if fmi3 => "fmi3Reset",
             Call::Reset => "fmi2Reset",
+            Call::FreeFmuState if fmi3 => "fmi3FreeFMUState",
             Call::FreeFmuState => "fmi2FreeFMUstate",
             Call::GetValues(name)
             | Call::SetValues(name)
             | Call::FmuState(name)
-            | Call::Status(name) => name,
+            | Call::Status(name)
+            | Call::Unsupported(name) => name,
+            Call::GetDirectionalDerivative if fmi3 => "fmi3GetDirectionalDerivative",
             Call::GetDirectionalDerivative => "fmi2GetDirectionalDerivative",
+            Call::GetAdjointDerivative => "fmi3GetAdjointDerivative",
             Call::SetRealInputDerivatives => "fmi2SetRealInputDerivatives",
+            Call::GetRealOutputDerivatives if fmi3 => "fmi3GetOutputDerivatives",
             Call::GetRealOutputDerivatives => "fmi2GetRealOutputDerivatives",
+            Call::DoStep if fmi3 => "fmi3DoStep",
             Call::DoStep => "fmi2DoStep",
             Call::CancelStep => "fmi2CancelStep",
         }

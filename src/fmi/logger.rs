@@ -1,11 +1,13 @@
 //! The importer's logger callback, with the five log categories of our model
-//! descriptions. Messages are always passed as the argument of a `"%s"` format, so a
-//! `%` in a message can never be read as a conversion.
+//! descriptions: FMI 2.0's (variadic, with the instance name; messages are always passed as
+//! the argument of a `"%s"` format, so a `%` in a message can never be read as a
+//! conversion) or FMI 3.0's (the message as it is, no format arguments).
 
 use std::cell::RefCell;
 use std::ffi::{c_char, CStr, CString};
 
 use fmi2_bindings::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status, fmi2String};
+use fmi3_bindings::{fmi3InstanceEnvironment, fmi3LogMessageCallback, fmi3Status, fmi3String};
 
 use super::status::Status;
 
@@ -76,24 +78,51 @@ impl Category {
     }
 }
 
+/// The importer's callback of either standard.
+#[derive(Clone, Copy)]
+pub enum Callback {
+    Fmi2(
+        unsafe extern "C" fn(
+            fmi2ComponentEnvironment,
+            fmi2String,
+            fmi2Status,
+            fmi2String,
+            fmi2String,
+            ...
+        ),
+    ),
+    Fmi3(unsafe extern "C" fn(fmi3InstanceEnvironment, fmi3Status, fmi3String, fmi3String)),
+}
+
+impl Callback {
+    pub fn fmi2(callback: fmi2CallbackLogger) -> Option<Callback> {
+        callback.map(Callback::Fmi2)
+    }
+
+    pub fn fmi3(callback: fmi3LogMessageCallback) -> Option<Callback> {
+        callback.map(Callback::Fmi3)
+    }
+}
+
 /// Where an instance's messages go. Messages are queued while the instance is locked and
 /// sent once the lock is released ([`Logger::take`] then [`Outbox::send`]): an importer's
 /// logger may call back into the same instance, which must not deadlock.
 pub struct Logger {
-    callback: fmi2CallbackLogger,
-    environment: fmi2ComponentEnvironment,
+    callback: Option<Callback>,
+    /// The importer's `componentEnvironment` (FMI 2.0) or `instanceEnvironment` (FMI 3.0).
+    environment: *mut std::ffi::c_void,
     instance_name: CString,
     enabled: [bool; 5],
     pending: RefCell<Vec<Message>>,
 }
 
-// SAFETY: `Logger` is not `Send` by itself only because of the importer's
-// `componentEnvironment` pointer (and the `RefCell` makes it `!Sync`, which is fine: it is
-// only ever used through `&mut Instance` behind the instance's mutex). We never dereference
-// that pointer; we only hand it back to the importer's own logger callback, as FMI 2.0
-// requires. FMI 2.0 lets an importer call an instance from any thread as long as calls on
-// one instance do not overlap, and the instance mutex serialises them, so moving the logger
-// (inside its instance) to another thread cannot create a data race on our side.
+// SAFETY: `Logger` is not `Send` by itself only because of the importer's environment
+// pointer (and the `RefCell` makes it `!Sync`, which is fine: it is only ever used through
+// `&mut Instance` behind the instance's mutex). We never dereference that pointer; we only
+// hand it back to the importer's own logger callback, as both standards require. They let
+// an importer call an instance from any thread as long as calls on one instance do not
+// overlap, and the instance mutex serialises them, so moving the logger (inside its
+// instance) to another thread cannot create a data race on our side.
 unsafe impl Send for Logger {}
 
 struct Message {
@@ -104,23 +133,16 @@ struct Message {
 
 /// Messages taken out of a [`Logger`], ready to be sent without holding the instance.
 pub struct Outbox {
-    callback: unsafe extern "C" fn(
-        fmi2ComponentEnvironment,
-        fmi2String,
-        fmi2Status,
-        fmi2String,
-        fmi2String,
-        ...
-    ),
-    environment: fmi2ComponentEnvironment,
+    callback: Callback,
+    environment: *mut std::ffi::c_void,
     instance_name: CString,
     messages: Vec<Message>,
 }
 
 impl Logger {
     pub fn new(
-        callback: fmi2CallbackLogger,
-        environment: fmi2ComponentEnvironment,
+        callback: Option<Callback>,
+        environment: *mut std::ffi::c_void,
         instance_name: &str,
         logging_on: bool,
     ) -> Self {
@@ -201,18 +223,25 @@ impl Outbox {
     pub fn send(self) {
         let format: &CStr = c"%s";
         for m in &self.messages {
+            let category = m.category.name_c().as_ptr();
+            let text = m.text.as_ptr() as *const c_char;
             // SAFETY: the importer guaranteed the callback and its environment stay valid
             // for the instance's lifetime; every string is NUL-terminated and outlives the
-            // call, and the variadic argument matches the "%s" conversion.
+            // call, and FMI 2.0's variadic argument matches the "%s" conversion.
             unsafe {
-                (self.callback)(
-                    self.environment,
-                    self.instance_name.as_ptr(),
-                    m.status as fmi2Status,
-                    m.category.name_c().as_ptr(),
-                    format.as_ptr(),
-                    m.text.as_ptr() as *const c_char,
-                );
+                match self.callback {
+                    Callback::Fmi2(callback) => callback(
+                        self.environment,
+                        self.instance_name.as_ptr(),
+                        m.status as fmi2Status,
+                        category,
+                        format.as_ptr(),
+                        text,
+                    ),
+                    Callback::Fmi3(callback) => {
+                        callback(self.environment, m.status as fmi3Status, category, text)
+                    }
+                }
             }
         }
     }

@@ -133,6 +133,8 @@ pub struct States {
     /// The instance, the owner of every state here.
     owner: Owner,
     snapshots: BTreeMap<usize, Vec<u8>>,
+    /// The FMU state argument's name in the instance's standard, for messages.
+    argument: &'static str,
 }
 
 impl Drop for States {
@@ -148,13 +150,16 @@ impl Drop for States {
 
 impl States {
     /// No states yet, of the instance named `name` (its handle comes at registration).
-    pub fn new(name: &str) -> Self {
+    /// The states of the instance `name`; `argument` is how its standard's header names an
+    /// FMU state argument in messages ("FMUstate" in FMI 2.0, "FMUState" in FMI 3.0).
+    pub fn new(name: &str, argument: &'static str) -> Self {
         States {
             owner: Owner {
                 instance: 0,
                 name: name.to_owned(),
             },
             snapshots: BTreeMap::new(),
+            argument,
         }
     }
 
@@ -171,19 +176,20 @@ impl States {
     /// Why `handle` is not usable as an FMU state of this instance.
     pub fn unknown(&self, handle: usize) -> Failure {
         if handle == 0 {
-            return Failure::error("FMUstate is NULL");
+            return Failure::error(format!("{} is NULL", self.argument));
         }
         let owner = owners().get(&handle).cloned();
         match owner {
             Some(owner) if owner.instance != self.owner.instance => Failure::error(format!(
-                "FMUstate {handle:#x} belongs to instance '{}', not to this one: an FMU state \
+                "{} {handle:#x} belongs to instance '{}', not to this one: an FMU state \
                  can only be used with the instance that made it (serialize it and \
                  deserialize it here to move it)",
-                owner.name
+                self.argument, owner.name
             )),
             _ => Failure::error(format!(
-                "FMUstate {handle:#x} is not a live FMU state of this instance (already \
-                 freed, or not an FMU state)"
+                "{} {handle:#x} is not a live FMU state of this instance (already \
+                 freed, or not an FMU state)",
+                self.argument
             )),
         }
     }
@@ -255,10 +261,10 @@ mod tests {
     /// (an instance's).
     #[test]
     fn state_handles_are_never_instance_handles() {
-        let slab = crate::fmi2::slab::Slab::new();
+        let slab = crate::fmi::slab::Slab::new();
         let instance = slab.insert(|_| ()).unwrap();
         let state = new_handle();
-        assert!(crate::fmi2::slab::is_handle(state));
+        assert!(crate::fmi::slab::is_handle(state));
         assert_ne!(state, instance);
         assert!(slab.lock(state).is_none());
         assert!(slab.remove(state).is_none());
@@ -268,9 +274,9 @@ mod tests {
     /// A state used with another instance is named with its owner; it dies with it.
     #[test]
     fn states_belong_to_their_instance() {
-        let mut first = States::new("first");
+        let mut first = States::new("first", "FMUstate");
         first.registered_as(HANDLE_TAG | 1);
-        let mut second = States::new("second");
+        let mut second = States::new("second", "FMUstate");
         second.registered_as(HANDLE_TAG | 2);
         let state = first.add(vec![1, 2]);
         assert_eq!(first.bytes(state).unwrap(), &[1, 2]);

@@ -5,6 +5,8 @@
 
 use std::sync::{Arc, OnceLock};
 
+use crate::framework::model::Environment;
+
 use contour_core::contour::planar::TrueErrorIndexes;
 use contour_core::path::five_axis::Planner;
 use contour_core::path::planar::XyPlans;
@@ -25,6 +27,16 @@ pub fn xy_plans() -> Arc<XyPlans> {
 pub fn true_error_indexes() -> Arc<TrueErrorIndexes> {
     static INDEXES: OnceLock<Arc<TrueErrorIndexes>> = OnceLock::new();
     Arc::clone(INDEXES.get_or_init(|| Arc::new(TrueErrorIndexes::new())))
+}
+
+/// A new instance's environment: this process's plans, no resources yet.
+pub fn environment() -> Environment {
+    Environment {
+        resource_dir: None,
+        planner: planner(),
+        xy_plans: xy_plans(),
+        indexes: true_error_indexes(),
+    }
 }
 
 /// Sets the most samples a plan may have (a fuzzer's time limit; see

@@ -17,6 +17,7 @@
 
 use super::instance::Instance;
 use super::slab::{Guard, Slab};
+use super::standard::Standard;
 
 static INSTANCES: Slab<Instance> = Slab::new();
 
@@ -52,6 +53,8 @@ pub fn instance(handle: usize) -> Option<InstanceGuard> {
 
 /// Unregisters an instance (waiting for a call in flight on it); the caller drops it,
 /// outside any lock, and its FMU states are unregistered as it drops.
-pub fn remove_instance(handle: usize) -> Option<Instance> {
-    INSTANCES.remove(handle)
+/// Takes the instance out of the registry if it is `standard`'s: the other standard's
+/// `FreeInstance` leaves it alone.
+pub fn remove_instance(handle: usize, standard: Standard) -> Option<Instance> {
+    INSTANCES.remove_if(handle, |instance| instance.standard == standard)
 }

@@ -6,6 +6,7 @@ use std::ffi::CString;
 
 use super::fmu_state::{self, Snapshot, States};
 use super::logger::{to_c_string, Category, Logger};
+use super::standard::Standard;
 use super::state_machine::{Call, Mode};
 use super::status::{Failure, Outcome, Status};
 use crate::framework::interface::Interface;
@@ -44,6 +45,8 @@ impl Access {
 
 pub struct Instance {
     pub info: &'static ModelInfo,
+    /// The standard whose functions made the instance, the only ones it answers.
+    pub standard: Standard,
     /// [`Access`] of every variable, by value reference.
     access: Box<[Access]>,
     /// The Real outputs, in table order: checked for overflow after each step.
@@ -73,6 +76,16 @@ pub struct Instance {
     pub states: States,
 }
 
+/// A type's name in FMI 3.0 (an Integer that is no enumeration is an Int32).
+fn fmi3_type_name(var_type: VarType) -> &'static str {
+    match var_type {
+        VarType::Real => "Float64",
+        VarType::Integer => "Int32",
+        VarType::Boolean => "Boolean",
+        VarType::String => "String",
+    }
+}
+
 fn time_matches(a: f64, b: f64) -> bool {
     // max(|a|, |b|, 1) by comparisons: `f64::max` spends instructions on NaN, but with a
     // NaN the left side is NaN and the answer false whatever the scale.
@@ -85,6 +98,7 @@ fn time_matches(a: f64, b: f64) -> bool {
 impl Instance {
     /// An instance of `interface`'s model that speaks the interface's units.
     pub fn with_interface(
+        standard: Standard,
         interface: &'static Interface,
         environment: Environment,
         logger: Logger,
@@ -93,6 +107,7 @@ impl Instance {
         let info = interface.model;
         Instance {
             info,
+            standard,
             access: interface.variables.iter().map(Access::of).collect(),
             real_outputs: info
                 .variables
@@ -114,7 +129,7 @@ impl Instance {
             needs_initialize: true,
             logger,
             returned_strings: Vec::new(),
-            states: States::new(name),
+            states: States::new(name, standard.fmu_state_argument()),
         }
     }
 
@@ -242,9 +257,16 @@ impl Instance {
         vrs: &[u32],
         expected: crate::framework::variables::VarType,
     ) -> Outcome {
+        let fmi3 = self.standard == Standard::Fmi3;
         for &vr in vrs {
+            if fmi3 && vr == self.time_vr() {
+                return Err(self.wrong_fmi3_type(vr, fmi3_type_name(expected)));
+            }
             let v = self.variable(vr)?;
             if v.var_type() != expected {
+                if fmi3 {
+                    return Err(self.wrong_fmi3_type(vr, fmi3_type_name(expected)));
+                }
                 return Err(Failure::error(format!(
                     "variable '{}' (value reference {vr}) is of type {}, not {}",
                     v.name,
@@ -254,6 +276,59 @@ impl Instance {
             }
         }
         Ok(())
+    }
+
+    /// The value reference of FMI 3.0's independent variable `time`: the first after the
+    /// table's.
+    pub fn time_vr(&self) -> u32 {
+        self.variables.len() as u32
+    }
+
+    /// The instance's time (s): the start time until the first step, then the end of the
+    /// last successful one.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// FMI 3.0's integer types: an Enumeration is read and written as Int64 (`enumeration`
+    /// true), every other Integer as Int32. Checks every reference first, as `check_type`.
+    pub fn check_fmi3_integers(&self, vrs: &[u32], enumeration: bool) -> Outcome {
+        for &vr in vrs {
+            if vr == self.time_vr() {
+                return Err(self.wrong_fmi3_type(vr, if enumeration { "Int64" } else { "Int32" }));
+            }
+            let v = self.variable(vr)?;
+            if v.var_type() != VarType::Integer || v.enumeration.is_some() != enumeration {
+                return Err(self.wrong_fmi3_type(vr, if enumeration { "Int64" } else { "Int32" }));
+            }
+        }
+        Ok(())
+    }
+
+    /// The refusal of a value reference through an FMI 3.0 function of the wrong type
+    /// (`wanted`: "Float32", "Int8", ...): unknown, or of another type, in FMI 3.0's names.
+    pub fn wrong_fmi3_type(&self, vr: u32, wanted: &str) -> Failure {
+        if vr == self.time_vr() {
+            return Failure::error(format!(
+                "variable 'time' (value reference {vr}) is of type Float64, not {wanted}"
+            ));
+        }
+        match self.variable(vr) {
+            Err(unknown) => unknown,
+            Ok(v) => {
+                let actual = match (v.var_type(), v.enumeration) {
+                    (VarType::Real, _) => "Float64",
+                    (VarType::Integer, Some(_)) => "Enumeration (Int64)",
+                    (VarType::Integer, None) => "Int32",
+                    (VarType::Boolean, _) => "Boolean",
+                    (VarType::String, _) => "String",
+                };
+                Failure::error(format!(
+                    "variable '{}' (value reference {vr}) is of type {actual}, not {wanted}",
+                    v.name
+                ))
+            }
+        }
     }
 
     /// Whether every reference is a Real variable.
@@ -412,8 +487,9 @@ impl Instance {
                 (Causality::Parameter, Mode::StepComplete) => {
                     if v.variability != Variability::Tunable {
                         return Err(Failure::error(format!(
-                            "parameter '{}' is fixed: set it before fmi2ExitInitializationMode",
-                            v.name
+                            "parameter '{}' is fixed: set it before {}ExitInitializationMode",
+                            v.name,
+                            self.standard.prefix()
                         )));
                     }
                     tunable_changed = true;
@@ -655,7 +731,7 @@ impl Instance {
         self.logger.log(
             failure.status,
             Category::for_status(failure.status),
-            &format!("{}: {}", call.name(), failure.message),
+            &format!("{}: {}", call.name(self.standard), failure.message),
         );
         failure.status
     }
@@ -681,7 +757,13 @@ mod tests {
             &path_interpolator_2d::INFO,
             crate::framework::interface::UnitSystem::Millimetre,
         );
-        let mut instance = Instance::with_interface(interface, Environment::default(), logger, "t");
+        let mut instance = Instance::with_interface(
+            Standard::Fmi2,
+            interface,
+            Environment::default(),
+            logger,
+            "t",
+        );
         instance.setup_experiment(start, None).unwrap();
         instance.enter_initialization_mode().unwrap();
         instance.exit_initialization_mode().unwrap();

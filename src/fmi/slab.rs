@@ -301,14 +301,24 @@ impl<T> Slab<T> {
     /// Takes the live value with `handle` out of the slab (waiting for a call that holds
     /// it); the handle is refused from then on. The caller drops the value, outside any
     /// lock.
+    #[cfg(test)]
     pub fn remove(&self, handle: usize) -> Option<T> {
+        self.remove_if(handle, |_| true)
+    }
+
+    /// [`Slab::remove`] when `qualifies` says so of the value (under the lock: a value
+    /// that does not qualify stays, untouched).
+    pub fn remove_if(&self, handle: usize, qualifies: impl FnOnce(&T) -> bool) -> Option<T> {
         let (index, generation) = decode(handle)?;
         let slot = self.slot(index)?;
         if slot.live.load(Ordering::Acquire) != handle {
             return None;
         }
         slot.lock();
-        if slot.live.load(Ordering::Relaxed) != handle {
+        // SAFETY (the read of the value): the lock is held.
+        if slot.live.load(Ordering::Relaxed) != handle
+            || !unsafe { (*slot.value.get()).as_ref() }.is_some_and(qualifies)
+        {
             slot.unlock();
             return None;
         }
