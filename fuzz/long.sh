@@ -12,5 +12,5 @@ runs=${1:-10000000}
 shift || true
 [ $# -gt 0 ] && TARGETS=("$@")
 build_targets
-write_state_seeds
+write_seeds
 run_targets -runs="$runs" ${MAX_SECONDS:+-max_total_time=$MAX_SECONDS}

@@ -8,5 +8,5 @@ set -euo pipefail
 source "$(dirname "$0")/common.sh"
 seconds=${1:-30}
 build_targets
-write_state_seeds
+write_seeds
 run_targets -max_total_time="$seconds"

@@ -24,8 +24,8 @@ use std::cell::RefCell;
 use std::ffi::c_char;
 use std::ptr;
 
-use contour_core::path::five_axis::Planner;
 use contour_core::contour::planar::TrueErrorIndexes;
+use contour_core::path::five_axis::Planner;
 use contour_core::path::planar::XyPlans;
 use contour_fmu::framework::model::{Environment, ModelInfo};
 use contour_fmu::framework::variables::{Values, VarType};
@@ -256,7 +256,7 @@ fuzz_target!(
         install_panic_hook();
         // A restored five-axis state plans again: within the 10 s a fuzz input may take
         // (FUZZ_SAMPLE_BUDGET), a longer plan refused.
-        contour_fmu::fmi2::set_plan_sample_budget(FUZZ_SAMPLE_BUDGET);
+        contour_fmu::fmi::set_plan_sample_budget(FUZZ_SAMPLE_BUDGET);
         check_envelope();
         if let Some(dir) = std::env::var_os("CONTOUR_FUZZ_SEEDS") {
             write_seeds(std::path::Path::new(&dir));

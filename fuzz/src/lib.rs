@@ -1,6 +1,7 @@
 //! What the fuzz targets share: the exported `fmi2*` functions linked statically (those
-//! of tests/abi/common/linked.rs plus the rest), a logger that reads every message it is
-//! sent, the panic policy, and the small path files under `fuzz/resources/`.
+//! of tests/abi/common/linked.rs plus the rest) and the `fmi3*` ones ([`fmi3`]), loggers
+//! of both standards that read every message they are sent, the panic policy, and the
+//! small path files under `fuzz/resources/`.
 //!
 //! Built only by `cargo fuzz` (with `RUSTC_BOOTSTRAP=1`): the logger is a real C variadic
 //! function, so that the `"%s"` argument of every message is read too, not just the
@@ -10,6 +11,7 @@
 
 use std::ffi::{c_char, CStr};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
 
 use fmi2_bindings::{
     fmi2Boolean, fmi2CallbackFunctions, fmi2Component, fmi2ComponentEnvironment, fmi2Integer,
@@ -19,6 +21,9 @@ use fmi2_bindings::{
 #[path = "../../tests/abi/common/linked.rs"]
 pub mod linked;
 
+pub mod fmi3;
+
+pub use fmi3::*;
 pub use linked::*;
 
 // The exported functions tests/abi/common/linked.rs does not declare.
@@ -157,6 +162,9 @@ pub fn resources_uri() -> String {
 /// and whether that call frees it.
 pub static REENTER: AtomicUsize = AtomicUsize::new(0);
 pub static REENTER_FREES: AtomicBool = AtomicBool::new(false);
+/// The handles the logger freed (cleared by the target), so that a target knows which of
+/// its instances are gone without its doing.
+pub static FREED_BY_LOGGER: Mutex<Vec<usize>> = Mutex::new(Vec::new());
 static IN_LOGGER: AtomicBool = AtomicBool::new(false);
 /// Messages received, so the reading of each one is not optimised away.
 pub static MESSAGE_BYTES: AtomicUsize = AtomicUsize::new(0);
@@ -201,17 +209,56 @@ pub unsafe extern "C" fn checking_logger(
         name.to_bytes().len() + message.to_bytes().len(),
         Ordering::Relaxed,
     );
+    reenter();
+}
+
+/// What both loggers do after reading a message: call back into the [`REENTER`] instance,
+/// whatever its standard (the other standard's calls are refused and logged through the
+/// instance's own callback, which does not recurse), and perhaps free it.
+unsafe fn reenter() {
     let target = REENTER.load(Ordering::Relaxed);
     if target != 0 && !IN_LOGGER.swap(true, Ordering::Relaxed) {
         let c = target as fmi2Component;
         let mut value = 0.0;
         fmi2GetRealStatus(c, 2, &mut value);
         fmi2GetReal(c, std::ptr::null(), 0, std::ptr::null_mut());
+        fmi3GetFloat64(c, std::ptr::null(), 0, std::ptr::null_mut(), 0);
         if REENTER_FREES.load(Ordering::Relaxed) {
+            // One frees it; the other standard's leaves it (or a freed handle) alone.
             fmi2FreeInstance(c);
+            fmi3FreeInstance(c);
+            let mut freed = FREED_BY_LOGGER.lock().unwrap_or_else(|e| e.into_inner());
+            if !freed.contains(&target) {
+                freed.push(target);
+            }
         }
         IN_LOGGER.store(false, Ordering::Relaxed);
     }
+}
+
+/// FMI 3.0's log callback: the message itself, no format and no arguments. Checks what the
+/// library promises (a valid status, a known category, NUL-terminated readable strings)
+/// and calls back into an instance as [`checking_logger`] does.
+///
+/// # Safety
+/// Called by the library with the `fmi3LogMessageCallback` arguments.
+pub unsafe extern "C" fn checking_logger3(
+    _environment: fmi3_bindings::fmi3InstanceEnvironment,
+    status: fmi3_bindings::fmi3Status,
+    category: fmi3_bindings::fmi3String,
+    message: fmi3_bindings::fmi3String,
+) {
+    assert!(status <= 4, "logger: status {status}");
+    assert!(!category.is_null() && !message.is_null());
+    let category = CStr::from_ptr(category)
+        .to_str()
+        .expect("category is UTF-8");
+    assert!(
+        CATEGORIES.contains(&category),
+        "logger: category {category}"
+    );
+    MESSAGE_BYTES.fetch_add(CStr::from_ptr(message).to_bytes().len(), Ordering::Relaxed);
+    reenter();
 }
 
 /// Callbacks with [`checking_logger`], handing `environment` back to it unread.
@@ -225,7 +272,7 @@ pub fn checking_callbacks(environment: usize) -> fmi2CallbackFunctions {
     }
 }
 
-/// The FMU state envelope of src/fmi2/fmu_state.rs, rebuilt here (the module is private)
+/// The FMU state envelope of src/fmi/fmu_state.rs, rebuilt here (the module is private)
 /// so that a target can wrap fuzzed bytes with a valid header and checksum and reach the
 /// decoder and the models' `check_state` instead of dying at the CRC. `check_envelope`
 /// (called from each target's init) fails loudly if the library's format moves on.

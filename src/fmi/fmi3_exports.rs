@@ -641,16 +641,17 @@ pub unsafe extern "C" fn fmi3SetString(
     })
 }
 
-/// A getter or setter of a type no variable here has: every reference is refused as
-/// unknown or of another type (nothing to do for none).
+/// A getter or setter of a type no variable here has: the counts checked as for every type,
+/// then every reference refused as unknown or of another type (nothing to do for none).
 unsafe fn no_such_type(
     instance: fmi3Instance,
     call: Call,
     wanted: &'static str,
-    vr: *const fmi3ValueReference,
-    nvr: usize,
+    (vr, nvr): (*const fmi3ValueReference, usize),
+    nvalues: usize,
 ) -> fmi3Status {
     dispatch(instance, call, |instance| {
+        scalar_count(nvr, nvalues)?;
         match slice(vr, nvr, "valueReferences")?.first() {
             Some(&vr) => Err(instance.wrong_fmi3_type(vr, wanted)),
             None => Ok(()),
@@ -669,14 +670,14 @@ macro_rules! no_variables_of_type {
             valueReferences: *const fmi3ValueReference,
             nValueReferences: usize,
             _values: *mut $t,
-            _nValues: usize,
+            nValues: usize,
         ) -> fmi3Status {
             no_such_type(
                 instance,
                 Call::GetValues(stringify!($get)),
                 $wanted,
-                valueReferences,
-                nValueReferences,
+                (valueReferences, nValueReferences),
+                nValues,
             )
         }
 
@@ -688,14 +689,14 @@ macro_rules! no_variables_of_type {
             valueReferences: *const fmi3ValueReference,
             nValueReferences: usize,
             _values: *const $t,
-            _nValues: usize,
+            nValues: usize,
         ) -> fmi3Status {
             no_such_type(
                 instance,
                 Call::SetValues(stringify!($set)),
                 $wanted,
-                valueReferences,
-                nValueReferences,
+                (valueReferences, nValueReferences),
+                nValues,
             )
         }
     };
@@ -718,14 +719,14 @@ pub unsafe extern "C" fn fmi3GetBinary(
     nValueReferences: usize,
     _valueSizes: *mut usize,
     _values: *mut fmi3Binary,
-    _nValues: usize,
+    nValues: usize,
 ) -> fmi3Status {
     no_such_type(
         instance,
         Call::GetValues("fmi3GetBinary"),
         "Binary",
-        valueReferences,
-        nValueReferences,
+        (valueReferences, nValueReferences),
+        nValues,
     )
 }
 
@@ -738,14 +739,14 @@ pub unsafe extern "C" fn fmi3SetBinary(
     nValueReferences: usize,
     _valueSizes: *const usize,
     _values: *const fmi3Binary,
-    _nValues: usize,
+    nValues: usize,
 ) -> fmi3Status {
     no_such_type(
         instance,
         Call::SetValues("fmi3SetBinary"),
         "Binary",
-        valueReferences,
-        nValueReferences,
+        (valueReferences, nValueReferences),
+        nValues,
     )
 }
 

@@ -8,11 +8,11 @@
 use std::ffi::CString;
 
 use crate::common::fmi3::*;
-use crate::common::{instantiate_raw, lib, ERROR, OK};
+use crate::common::{instantiate_raw, lib, Log, ERROR, OK};
 use contour_fmu::framework::interface::{Interface, UnitSystem};
 use contour_fmu::framework::variables::{Causality, VarType};
 use contour_fmu::models;
-use fmi2_bindings::{fmi2Component, fmi2Type_fmi2CoSimulation};
+use fmi2_bindings::{fmi2CallbackFunctions, fmi2Component, fmi2Type_fmi2CoSimulation};
 
 fn vrs_of(interface: &Interface, causality: Causality) -> Vec<u32> {
     interface
@@ -23,7 +23,21 @@ fn vrs_of(interface: &Interface, causality: Causality) -> Vec<u32> {
         .collect()
 }
 
-fn fmi2_instance(interface: &Interface) -> fmi2Component {
+/// An FMI 2.0 instance of any interface (mm or SI) with its log and callbacks, which must
+/// outlive it; freed on drop.
+struct Fmi2 {
+    c: fmi2Component,
+    _log: Box<Log>,
+    _callbacks: Box<fmi2CallbackFunctions>,
+}
+
+impl Drop for Fmi2 {
+    fn drop(&mut self) {
+        unsafe { lib().fmi2FreeInstance(self.c) };
+    }
+}
+
+fn fmi2_instance(interface: &Interface) -> Fmi2 {
     let (c, log, callbacks) = instantiate_raw(
         Some("fmi2"),
         fmi2Type_fmi2CoSimulation,
@@ -32,9 +46,11 @@ fn fmi2_instance(interface: &Interface) -> fmi2Component {
         false,
     );
     assert!(!c.is_null(), "{:?}", log.records.lock().unwrap());
-    // The log and callbacks must outlive the instance: leaked with it for the test.
-    std::mem::forget((log, callbacks));
-    c
+    Fmi2 {
+        c,
+        _log: log,
+        _callbacks: callbacks,
+    }
 }
 
 /// Inputs that move: a different smooth signal on every input at every step.
@@ -58,7 +74,8 @@ fn every_model_computes_through_fmi3_what_it_computes_through_fmi2_bit_for_bit()
             vrs_of(interface, Causality::Output),
         );
         let h = interface.model.default_experiment.step_size;
-        let c2 = fmi2_instance(interface);
+        let fmi2 = fmi2_instance(interface);
+        let c2 = fmi2.c;
         let i3 = Instance3::new(interface);
         unsafe {
             assert_eq!(lib2.fmi2SetupExperiment(c2, 0, 0.0, 0.0, 0, 0.0), OK);
@@ -98,7 +115,6 @@ fn every_model_computes_through_fmi3_what_it_computes_through_fmi2_bit_for_bit()
         // The independent variable reads the instance's time.
         let (status, time) = i3.get_float64(&[interface.time_vr()]);
         assert_eq!((status, time[0]), (OK3, 300.0 * h), "{label}");
-        unsafe { lib2.fmi2FreeInstance(c2) };
     }
 }
 
@@ -148,7 +164,8 @@ fn a_handle_of_one_standard_is_refused_by_the_other_standards_functions() {
     );
     assert_eq!(i3.step(0.0, 0.001).0, OK3, "{}", i3.last_error());
 
-    let c2 = fmi2_instance(interface);
+    let fmi2 = fmi2_instance(interface);
+    let c2 = fmi2.c;
     unsafe {
         assert_eq!(lib2.fmi2SetupExperiment(c2, 0, 0.0, 0.0, 0, 0.0), OK);
         assert_eq!(lib2.fmi2EnterInitializationMode(c2), OK);
@@ -168,7 +185,6 @@ fn a_handle_of_one_standard_is_refused_by_the_other_standards_functions() {
         lib3().fmi3FreeInstance(c2 as fmi3Instance);
         // Still alive for its own standard.
         assert_eq!(lib2.fmi2DoStep(c2, 0.0, 0.001, 1), OK);
-        lib2.fmi2FreeInstance(c2);
     }
 }
 
@@ -236,6 +252,14 @@ fn fmi3_misuse_gets_an_error_and_a_message() {
             "{}",
             i.last_error()
         );
+        // The counts are checked for the types no variable has too.
+        assert_eq!(
+            lib.fmi3GetFloat32(i.c, std::ptr::null(), 0, &mut f32v, 1),
+            ERROR3
+        );
+        assert!(i
+            .last_error()
+            .contains("nValues = 1 but nValueReferences = 0"));
         let unknown = 100_000u32;
         assert_eq!(lib.fmi3GetFloat32(i.c, &unknown, 1, &mut f32v, 1), ERROR3);
         assert!(i.last_error().contains("unknown value reference 100000"));
