@@ -653,7 +653,7 @@ unsafe fn no_such_type(
     dispatch(instance, call, |instance| {
         scalar_count(nvr, nvalues)?;
         match slice(vr, nvr, "valueReferences")?.first() {
-            Some(&vr) => Err(instance.wrong_fmi3_type(vr, wanted)),
+            Some(&vr) => Err(instance.wrong_type(vr, wanted)),
             None => Ok(()),
         }
     })

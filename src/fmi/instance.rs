@@ -76,16 +76,6 @@ pub struct Instance {
     pub states: States,
 }
 
-/// A type's name in FMI 3.0 (an Integer that is no enumeration is an Int32).
-fn fmi3_type_name(var_type: VarType) -> &'static str {
-    match var_type {
-        VarType::Real => "Float64",
-        VarType::Integer => "Int32",
-        VarType::Boolean => "Boolean",
-        VarType::String => "String",
-    }
-}
-
 fn time_matches(a: f64, b: f64) -> bool {
     // max(|a|, |b|, 1) by comparisons: `f64::max` spends instructions on NaN, but with a
     // NaN the left side is NaN and the answer false whatever the scale.
@@ -257,22 +247,9 @@ impl Instance {
         vrs: &[u32],
         expected: crate::framework::variables::VarType,
     ) -> Outcome {
-        let fmi3 = self.standard == Standard::Fmi3;
         for &vr in vrs {
-            if fmi3 && vr == self.time_vr() {
-                return Err(self.wrong_fmi3_type(vr, fmi3_type_name(expected)));
-            }
-            let v = self.variable(vr)?;
-            if v.var_type() != expected {
-                if fmi3 {
-                    return Err(self.wrong_fmi3_type(vr, fmi3_type_name(expected)));
-                }
-                return Err(Failure::error(format!(
-                    "variable '{}' (value reference {vr}) is of type {}, not {}",
-                    v.name,
-                    v.var_type().name(),
-                    expected.name()
-                )));
+            if !self.variable(vr).is_ok_and(|v| v.var_type() == expected) {
+                return Err(self.wrong_type(vr, self.type_name(expected)));
             }
         }
         Ok(())
@@ -293,41 +270,54 @@ impl Instance {
     /// FMI 3.0's integer types: an Enumeration is read and written as Int64 (`enumeration`
     /// true), every other Integer as Int32. Checks every reference first, as `check_type`.
     pub fn check_fmi3_integers(&self, vrs: &[u32], enumeration: bool) -> Outcome {
+        let wanted = if enumeration { "Int64" } else { "Int32" };
         for &vr in vrs {
-            if vr == self.time_vr() {
-                return Err(self.wrong_fmi3_type(vr, if enumeration { "Int64" } else { "Int32" }));
-            }
-            let v = self.variable(vr)?;
-            if v.var_type() != VarType::Integer || v.enumeration.is_some() != enumeration {
-                return Err(self.wrong_fmi3_type(vr, if enumeration { "Int64" } else { "Int32" }));
+            let fits = self.variable(vr).is_ok_and(|v| {
+                v.var_type() == VarType::Integer && v.enumeration.is_some() == enumeration
+            });
+            if !fits {
+                return Err(self.wrong_type(vr, wanted));
             }
         }
         Ok(())
     }
 
-    /// The refusal of a value reference through an FMI 3.0 function of the wrong type
-    /// (`wanted`: "Float32", "Int8", ...): unknown, or of another type, in FMI 3.0's names.
-    pub fn wrong_fmi3_type(&self, vr: u32, wanted: &str) -> Failure {
-        if vr == self.time_vr() {
+    /// The refusal of a value reference through a getter or setter of another type
+    /// (`wanted`, in the instance's standard's names): unknown, or of another type; in FMI
+    /// 3.0 also the independent variable `time`, a Float64 of its own.
+    pub fn wrong_type(&self, vr: u32, wanted: &str) -> Failure {
+        if self.standard == Standard::Fmi3 && vr == self.time_vr() {
             return Failure::error(format!(
                 "variable 'time' (value reference {vr}) is of type Float64, not {wanted}"
             ));
         }
         match self.variable(vr) {
             Err(unknown) => unknown,
-            Ok(v) => {
-                let actual = match (v.var_type(), v.enumeration) {
-                    (VarType::Real, _) => "Float64",
-                    (VarType::Integer, Some(_)) => "Enumeration (Int64)",
-                    (VarType::Integer, None) => "Int32",
-                    (VarType::Boolean, _) => "Boolean",
-                    (VarType::String, _) => "String",
-                };
-                Failure::error(format!(
-                    "variable '{}' (value reference {vr}) is of type {actual}, not {wanted}",
-                    v.name
-                ))
-            }
+            Ok(v) => Failure::error(format!(
+                "variable '{}' (value reference {vr}) is of type {}, not {wanted}",
+                v.name,
+                self.variable_type_name(v)
+            )),
+        }
+    }
+
+    /// A type's name in the instance's standard (in FMI 3.0 an Integer that is no
+    /// enumeration is an Int32).
+    fn type_name(&self, var_type: VarType) -> &'static str {
+        match (self.standard, var_type) {
+            (Standard::Fmi2, _) => var_type.name(),
+            (Standard::Fmi3, VarType::Real) => "Float64",
+            (Standard::Fmi3, VarType::Integer) => "Int32",
+            (Standard::Fmi3, VarType::Boolean) => "Boolean",
+            (Standard::Fmi3, VarType::String) => "String",
+        }
+    }
+
+    /// A variable's type in the instance's standard: FMI 3.0 reads an enumeration as Int64.
+    fn variable_type_name(&self, v: &Variable) -> &'static str {
+        match (self.standard, v.enumeration) {
+            (Standard::Fmi3, Some(_)) => "Enumeration (Int64)",
+            _ => self.type_name(v.var_type()),
         }
     }
 
