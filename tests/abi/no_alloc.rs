@@ -62,7 +62,9 @@ static GLOBAL: Counting = Counting;
 // they allocate.
 use crate::common::linked::{
     fmi2DoStep, fmi2EnterInitializationMode, fmi2ExitInitializationMode, fmi2FreeInstance,
-    fmi2GetReal, fmi2Instantiate, fmi2SetReal, fmi2SetupExperiment,
+    fmi2GetReal, fmi2Instantiate, fmi2SetReal, fmi2SetupExperiment, fmi3DoStep,
+    fmi3EnterInitializationMode, fmi3ExitInitializationMode, fmi3FreeInstance, fmi3GetFloat64,
+    fmi3InstantiateCoSimulation, fmi3SetFloat64,
 };
 use crate::common::{callbacks, cstr, fmi2ValueReference, Log};
 use contour_fmu::models;
@@ -134,6 +136,89 @@ fn an_fmi_step_round_allocates_nothing_with_logging_off() {
             fmi2FreeInstance(c);
         }
         assert!(log.records.lock().unwrap().is_empty());
+    }
+}
+
+/// The same round through FMI 3.0 (fmi3SetFloat64, fmi3DoStep, fmi3GetFloat64), every
+/// model in both unit systems: its own exports and result pointers allocate nothing either.
+#[test]
+fn an_fmi3_step_round_allocates_nothing_with_logging_off() {
+    use contour_fmu::framework::variables::{Causality, VarType};
+    for interface in models::interfaces() {
+        let real = |causality| -> Vec<u32> {
+            let of = |v: &&contour_fmu::framework::variables::Variable| {
+                v.causality == causality && v.var_type() == VarType::Real
+            };
+            interface
+                .variables
+                .iter()
+                .filter(of)
+                .map(|v| v.vr as u32)
+                .collect()
+        };
+        let (inputs, outputs) = (real(Causality::Input), real(Causality::Output));
+        let (name, token) = (cstr("no-alloc"), cstr(&interface.instantiation_token));
+        // SAFETY: valid strings; no logger, no intermediate variables.
+        let c = unsafe {
+            fmi3InstantiateCoSimulation(
+                name.as_ptr(),
+                token.as_ptr(),
+                std::ptr::null(),
+                false,
+                false,
+                false,
+                false,
+                std::ptr::null(),
+                0,
+                std::ptr::null_mut(),
+                None,
+                None,
+            )
+        };
+        assert!(!c.is_null());
+        let mut read = vec![0.0; outputs.len()];
+        let write: Vec<f64> = (0..inputs.len()).map(|i| 0.1 * i as f64).collect();
+        let (mut event, mut terminate, mut early, mut last) = (false, false, false, 0.0);
+        // SAFETY: a live instance, arrays of the stated lengths, writable results.
+        unsafe {
+            assert_eq!(
+                fmi3EnterInitializationMode(c, false, 0.0, 0.0, false, 0.0),
+                0
+            );
+            assert_eq!(fmi3ExitInitializationMode(c), 0);
+            let mut round = |k: usize| {
+                let t = k as f64 * 1e-3;
+                let (n, m) = (inputs.len(), outputs.len());
+                assert_eq!(fmi3SetFloat64(c, inputs.as_ptr(), n, write.as_ptr(), n), 0);
+                let stepped = fmi3DoStep(
+                    c,
+                    t,
+                    1e-3,
+                    true,
+                    &mut event,
+                    &mut terminate,
+                    &mut early,
+                    &mut last,
+                );
+                assert_eq!(stepped, 0);
+                assert_eq!(
+                    fmi3GetFloat64(c, outputs.as_ptr(), m, read.as_mut_ptr(), m),
+                    0
+                );
+            };
+            round(0);
+            round(1);
+            let n = allocations_during(|| (2..200).for_each(&mut round));
+            assert_eq!(
+                n,
+                0,
+                "{} ({}): {n} allocations in 198 FMI 3.0 step rounds",
+                interface.model.identifier,
+                interface.units.name()
+            );
+            assert_eq!(last, 0.2, "lastSuccessfulTime after 200 steps of 1 ms");
+            fmi3FreeInstance(c);
+        }
     }
 }
 

@@ -106,3 +106,37 @@ def test_an_fmi3_instance_logs_through_fmi3s_callback(fmu_dir):
             pass
     assert any(name == "plant" and "x.J" in message and "-1" in message
                for name, _status, _category, message in log.records), log.records
+
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+
+
+@pytest.mark.parametrize("program", ["own-style/fusion360-makera-style.nc",
+                                     "cambam/enclosure-labels.nc",
+                                     "own-style/fanuc-inventor-hsm-style.nc"])
+def test_users_cam_programs_through_fmi3_give_the_fmi2_trajectories_bit_for_bit(fmu_dir, program):
+    """Public and CAM-shaped G-code (tests/data/cam/README.md names their sources), planned
+    within acceleration and jerk limits, in the shipped loop with the program estimator."""
+    part = str(DATA / "cam" / program)
+    controller = {**LOOPS["two_axis"].feed_forward, "estimator": 4, "path": part}
+    interpolator = {"accel": 2000.0, "jerk": 100000.0}
+    runs = [closed_loop(d, path=part, stop=1.5, controller=controller, interpolator=interpolator)
+            for d in (fmu_dir, fmu_dir.parent / "fmu3")]
+    moved = max(np.ptp(runs[0][0][f"interpolator.ref.{axis}"]) for axis in "xy")
+    assert moved > 0.1, f"the program moved the axes {moved} mm"
+    for phase in (0, 1):
+        assert_same_bits(runs[0][phase], runs[1][phase], program)
+
+
+def test_cl_data_through_the_pole_and_from_creo_through_fmi3_give_the_fmi2_trajectories(fmu_dir,
+                                                                                      tmp_path):
+    """Five-axis CL data: a raster over a dome's apex (the tool axis through the pole) and a
+    Creo CL file (tests/data/cl/README.md), the FMI 3.0 loop against the FMI 2.0 one."""
+    from contour_fmu.demo import cam_paths
+    dome = tmp_path / "dome.cl"
+    dome.write_text(cam_paths.dome_raster())
+    for cl in (dome, DATA / "cl" / "profilfraesen_2.ncl"):
+        runs = [five_axis_closed_loop(d, path=str(cl), feed=50.0, stop=0.8)
+                for d in (fmu_dir, fmu_dir.parent / "fmu3")]
+        for phase in (0, 1):
+            assert_same_bits(runs[0][phase], runs[1][phase], cl.name)

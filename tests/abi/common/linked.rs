@@ -1,4 +1,5 @@
-//! The library's exported `fmi2*` functions linked statically from the rlib instead of
+//! The library's exported `fmi2*` functions (and the `fmi3*` ones of a step round) linked
+//! statically from the rlib instead of
 //! dlopened (as `super::lib()` does): the calls stay inside the test or bench binary, so
 //! its global allocator sees every allocation they make and a timing sees no PLT stub of
 //! a second copy of the library. Plus what an instance with logging off needs around
@@ -18,6 +19,11 @@ use fmi2_bindings::{
     fmi2Boolean, fmi2Byte, fmi2CallbackFunctions, fmi2CallbackLogger, fmi2Component,
     fmi2ComponentEnvironment, fmi2FMUstate, fmi2Integer, fmi2Real, fmi2Status, fmi2String,
     fmi2Type, fmi2Type_fmi2CoSimulation, fmi2ValueReference,
+};
+use fmi3_bindings::{
+    fmi3Boolean, fmi3Float64, fmi3Instance, fmi3InstanceEnvironment,
+    fmi3IntermediateUpdateCallback, fmi3LogMessageCallback, fmi3Status, fmi3String,
+    fmi3ValueReference,
 };
 
 extern "C" {
@@ -92,6 +98,58 @@ extern "C" {
     ) -> fmi2Status;
     pub fn fmi2Terminate(c: fmi2Component) -> fmi2Status;
     pub fn fmi2FreeInstance(c: fmi2Component);
+}
+
+// The FMI 3.0 functions of a step round, the same way.
+extern "C" {
+    pub fn fmi3InstantiateCoSimulation(
+        instanceName: fmi3String,
+        instantiationToken: fmi3String,
+        resourcePath: fmi3String,
+        visible: fmi3Boolean,
+        loggingOn: fmi3Boolean,
+        eventModeUsed: fmi3Boolean,
+        earlyReturnAllowed: fmi3Boolean,
+        requiredIntermediateVariables: *const fmi3ValueReference,
+        nRequiredIntermediateVariables: usize,
+        instanceEnvironment: fmi3InstanceEnvironment,
+        logMessage: fmi3LogMessageCallback,
+        intermediateUpdate: fmi3IntermediateUpdateCallback,
+    ) -> fmi3Instance;
+    pub fn fmi3EnterInitializationMode(
+        instance: fmi3Instance,
+        toleranceDefined: fmi3Boolean,
+        tolerance: fmi3Float64,
+        startTime: fmi3Float64,
+        stopTimeDefined: fmi3Boolean,
+        stopTime: fmi3Float64,
+    ) -> fmi3Status;
+    pub fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status;
+    pub fn fmi3SetFloat64(
+        instance: fmi3Instance,
+        valueReferences: *const fmi3ValueReference,
+        nValueReferences: usize,
+        values: *const fmi3Float64,
+        nValues: usize,
+    ) -> fmi3Status;
+    pub fn fmi3GetFloat64(
+        instance: fmi3Instance,
+        valueReferences: *const fmi3ValueReference,
+        nValueReferences: usize,
+        values: *mut fmi3Float64,
+        nValues: usize,
+    ) -> fmi3Status;
+    pub fn fmi3DoStep(
+        instance: fmi3Instance,
+        currentCommunicationPoint: fmi3Float64,
+        communicationStepSize: fmi3Float64,
+        noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
+        eventHandlingNeeded: *mut fmi3Boolean,
+        terminateSimulation: *mut fmi3Boolean,
+        earlyReturn: *mut fmi3Boolean,
+        lastSuccessfulTime: *mut fmi3Float64,
+    ) -> fmi3Status;
+    pub fn fmi3FreeInstance(instance: fmi3Instance);
 }
 
 /// A logger that drops every message. Declared with the five fixed parameters of the C
