@@ -1,10 +1,17 @@
 //! The library's 75 exported `fmi3*` functions, declared for static linking (as
-//! tests/abi/common/linked.rs declares the `fmi2*` ones): one declaration per
-//! `fmi3...TYPE` typedef of the `fmi3-bindings` crate (bindgen's output of the vendored
+//! tests/abi/common/linked.rs declares the `fmi2*` ones and the seven of a step round,
+//! imported from there): one declaration per `fmi3...TYPE` typedef of the `fmi3-bindings` crate (bindgen's output of the vendored
 //! `fmi3Functions.h`), written from them by a script, and checked against them at compile
 //! time below: a declaration that disagrees with its typedef does not build.
 
 use fmi3_bindings::*;
+
+// The functions of a step round are declared once, in tests/abi/common/linked.rs (shared
+// with the ABI tests), and checked below with the rest.
+use crate::linked::{
+    fmi3DoStep, fmi3EnterInitializationMode, fmi3ExitInitializationMode, fmi3FreeInstance,
+    fmi3GetFloat64, fmi3InstantiateCoSimulation, fmi3SetFloat64,
+};
 
 extern "C" {
     pub fn fmi3GetVersion() -> *const ::std::os::raw::c_char;
@@ -23,20 +30,6 @@ extern "C" {
         instanceEnvironment: fmi3InstanceEnvironment,
         logMessage: fmi3LogMessageCallback,
     ) -> fmi3Instance;
-    pub fn fmi3InstantiateCoSimulation(
-        instanceName: fmi3String,
-        instantiationToken: fmi3String,
-        resourcePath: fmi3String,
-        visible: fmi3Boolean,
-        loggingOn: fmi3Boolean,
-        eventModeUsed: fmi3Boolean,
-        earlyReturnAllowed: fmi3Boolean,
-        requiredIntermediateVariables: *const fmi3ValueReference,
-        nRequiredIntermediateVariables: usize,
-        instanceEnvironment: fmi3InstanceEnvironment,
-        logMessage: fmi3LogMessageCallback,
-        intermediateUpdate: fmi3IntermediateUpdateCallback,
-    ) -> fmi3Instance;
     pub fn fmi3InstantiateScheduledExecution(
         instanceName: fmi3String,
         instantiationToken: fmi3String,
@@ -49,16 +42,6 @@ extern "C" {
         lockPreemption: fmi3LockPreemptionCallback,
         unlockPreemption: fmi3UnlockPreemptionCallback,
     ) -> fmi3Instance;
-    pub fn fmi3FreeInstance(instance: fmi3Instance);
-    pub fn fmi3EnterInitializationMode(
-        instance: fmi3Instance,
-        toleranceDefined: fmi3Boolean,
-        tolerance: fmi3Float64,
-        startTime: fmi3Float64,
-        stopTimeDefined: fmi3Boolean,
-        stopTime: fmi3Float64,
-    ) -> fmi3Status;
-    pub fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status;
     pub fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status;
     pub fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status;
     pub fn fmi3Reset(instance: fmi3Instance) -> fmi3Status;
@@ -67,13 +50,6 @@ extern "C" {
         valueReferences: *const fmi3ValueReference,
         nValueReferences: usize,
         values: *mut fmi3Float32,
-        nValues: usize,
-    ) -> fmi3Status;
-    pub fn fmi3GetFloat64(
-        instance: fmi3Instance,
-        valueReferences: *const fmi3ValueReference,
-        nValueReferences: usize,
-        values: *mut fmi3Float64,
         nValues: usize,
     ) -> fmi3Status;
     pub fn fmi3GetInt8(
@@ -165,13 +141,6 @@ extern "C" {
         valueReferences: *const fmi3ValueReference,
         nValueReferences: usize,
         values: *const fmi3Float32,
-        nValues: usize,
-    ) -> fmi3Status;
-    pub fn fmi3SetFloat64(
-        instance: fmi3Instance,
-        valueReferences: *const fmi3ValueReference,
-        nValueReferences: usize,
-        values: *const fmi3Float64,
         nValues: usize,
     ) -> fmi3Status;
     pub fn fmi3SetInt8(
@@ -429,16 +398,6 @@ extern "C" {
         orders: *const fmi3Int32,
         values: *mut fmi3Float64,
         nValues: usize,
-    ) -> fmi3Status;
-    pub fn fmi3DoStep(
-        instance: fmi3Instance,
-        currentCommunicationPoint: fmi3Float64,
-        communicationStepSize: fmi3Float64,
-        noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
-        eventHandlingNeeded: *mut fmi3Boolean,
-        terminateSimulation: *mut fmi3Boolean,
-        earlyReturn: *mut fmi3Boolean,
-        lastSuccessfulTime: *mut fmi3Float64,
     ) -> fmi3Status;
     pub fn fmi3ActivateModelPartition(
         instance: fmi3Instance,
