@@ -1,8 +1,9 @@
 //! The library's 75 exported `fmi3*` functions, declared for static linking (as
 //! tests/abi/common/linked.rs declares the `fmi2*` ones and the seven of a step round,
-//! imported from there): one declaration per `fmi3...TYPE` typedef of the `fmi3-bindings` crate (bindgen's output of the vendored
-//! `fmi3Functions.h`), written from them by a script, and checked against them at compile
-//! time below: a declaration that disagrees with its typedef does not build.
+//! imported from there): one declaration per `fmi3...TYPE` typedef of the `fmi3-bindings`
+//! crate (bindgen's output of the vendored `fmi3Functions.h`), written from them by a
+//! script, and checked against them at compile time below: a declaration that disagrees
+//! with its typedef does not build.
 
 use fmi3_bindings::*;
 
